@@ -1,0 +1,31 @@
+# Two commands set up a fresh clone: `make demo` (environment + main job on the sample) and `make test`.
+PYTHON ?= python3.11
+VENV ?= .venv
+BIN := $(VENV)/bin
+SAMPLE := data/sample
+
+.PHONY: setup demo test bench clean
+
+setup: $(VENV)/.installed
+
+# torch first and pinned: any other torch spec pulls GBs of CUDA wheels.
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+	$(BIN)/pip install -q torch==2.13.0
+	$(BIN)/pip install -q -e ".[dev]"
+	touch $@
+
+demo: setup
+	$(BIN)/lmcr ingest --youcook2 $(SAMPLE)/youcook2 --recipes $(SAMPLE)/nyc \
+		--recipes $(SAMPLE)/recipes_json/recipes_sample.jsonl --recipes $(SAMPLE)/recipes_json/folder \
+		--recipes $(SAMPLE)/feeding_america
+
+test: setup
+	$(BIN)/python -m pytest -q
+
+bench: setup
+	$(BIN)/python bench/bench_ingest.py
+
+clean:
+	rm -rf $(VENV) data/staging data/lmcr.duckdb

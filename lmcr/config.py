@@ -1,0 +1,31 @@
+"""Where LMCR reads and writes: every path comes from the environment or the caller, never hard-coded data."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+
+
+@dataclass(frozen=True)
+class Paths:
+    """The working locations of one LMCR installation."""
+
+    data_dir: Path
+    db: Path
+    sql_dir: Path
+
+    @property
+    def staging(self) -> Path:
+        """Parquet written by parallel workers before the single writer loads it into DuckDB."""
+        return self.data_dir / "staging"
+
+
+def paths_from_env(data_dir: str | Path | None = None, db: str | Path | None = None) -> Paths:
+    """Resolve paths: explicit arguments win, then `LMCR_DATA_DIR` / `LMCR_DB` / `LMCR_SQL_DIR`, then defaults."""
+    data = Path(data_dir or os.environ.get("LMCR_DATA_DIR") or "data")
+    database = Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb")
+    sql_dir = Path(os.environ.get("LMCR_SQL_DIR") or REPO_ROOT / "sql")
+    return Paths(data_dir=data, db=database, sql_dir=sql_dir)

@@ -1,0 +1,115 @@
+"""Which adapter reads a path, and how user paths expand into ingestable sources."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from lmcr.ingest.feeding_america import parse_feeding_america
+from lmcr.ingest.mealmaster import START_RE, parse_mealmaster
+from lmcr.ingest.recipe_json import parse_recipe_json
+from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.ingest.youcook2 import parse_youcook2
+
+FORMATS: dict[str, Callable[..., ParsedFile]] = {
+    "youcook2": parse_youcook2,
+    "recipe_json": parse_recipe_json,
+    "mealmaster": parse_mealmaster,
+    "feeding_america": parse_feeding_america,
+}
+CORPORA = ("youcook2", "recipes")
+TEXT_SUFFIXES = (".mmf", ".mm", ".mxp", ".nyc", ".txt")
+
+
+@dataclass(frozen=True)
+class Source:
+    """One ingestable input: a file, or a folder of one-JSON-per-recipe files."""
+
+    path: Path
+    format: str
+    corpus: str
+    encoding: str | None = None
+
+    @property
+    def key(self) -> str:
+        """The identity its rows are stored under (re-ingesting it replaces them)."""
+        return str(self.path)
+
+    def sha256(self) -> str:
+        """Content hash; for a folder, over its JSON files' names and contents."""
+        digest = hashlib.sha256()
+        files = sorted(self.path.rglob("*.json")) if self.path.is_dir() else [self.path]
+        for file in files:
+            digest.update(file.relative_to(self.path).as_posix().encode() if self.path.is_dir() else b"")
+            with open(file, "rb") as handle:
+                for chunk in iter(lambda: handle.read(1 << 20), b""):
+                    digest.update(chunk)
+        return digest.hexdigest()
+
+
+def _sniff(path: Path) -> str:
+    with open(path, "rb") as handle:
+        head = handle.read(8192).decode("latin-1")
+    if '"database"' in head:
+        return "youcook2"
+    if any(START_RE.match(line) or line.strip().lower().startswith("title:") for line in head.splitlines()):
+        return "mealmaster"
+    if head.lstrip().startswith("{"):
+        return "recipe_json"
+    if "<cookbook" in head:
+        return "feeding_america"
+    raise IngestError(str(path), None, "unrecognised format; pass --format " + "|".join(FORMATS))
+
+
+def detect_format(path: Path) -> str:
+    """The adapter for a path, from its name and, where that is ambiguous, its first bytes."""
+    name = path.name.lower()
+    if path.is_dir():
+        return "recipe_json"
+    if name.endswith((".jsonl", ".jsonl.gz", ".ndjson", ".ndjson.gz")):
+        return "recipe_json"
+    if name.endswith(".xml"):
+        return "feeding_america"
+    if name.endswith(TEXT_SUFFIXES):
+        return "mealmaster"
+    return _sniff(path)
+
+
+def expand_inputs(
+    paths: list[Path], corpus: str, fmt: str | None = None, encoding: str | None = None
+) -> list[Source]:
+    """Sources for user paths: a folder of XML or text exports gives one source per file (so they
+    parse in parallel); a folder of JSON files is one source; missing paths fail clearly."""
+    if corpus not in CORPORA:
+        raise ValueError(f"corpus must be one of {CORPORA}, not {corpus!r}")
+    if fmt is not None and fmt not in FORMATS:
+        raise ValueError(f"format must be one of {sorted(FORMATS)}, not {fmt!r}")
+    sources: list[Source] = []
+    for path in (Path(p).resolve() for p in paths):
+        if not path.exists():
+            raise IngestError(str(path), None, "no such file or folder")
+        if path.is_dir() and corpus == "youcook2":
+            files = sorted(path.glob("*.json"))
+            if not files:
+                raise IngestError(str(path), None, "folder holds no YouCook2 .json annotation files")
+            sources += [Source(f, fmt or "youcook2", corpus, encoding) for f in files]
+            continue
+        if path.is_dir():
+            files = sorted(p for p in path.iterdir() if p.suffix.lower() in (".xml", *TEXT_SUFFIXES))
+            if files and not any(path.rglob("*.json")):
+                sources += [Source(f, fmt or detect_format(f), corpus, encoding) for f in files]
+                continue
+            if not any(path.rglob("*.json")):
+                raise IngestError(str(path), None, "folder holds no .json, .xml or recipe text files")
+        sources.append(Source(path, fmt or detect_format(path), corpus, encoding))
+    return sources
+
+
+def parse_source(source: Source) -> ParsedFile:
+    """Run the source's adapter."""
+    parser = FORMATS[source.format]
+    if source.format == "mealmaster":
+        return parser(source.path, source.corpus, encoding=source.encoding)
+    return parser(source.path, source.corpus)

@@ -1,0 +1,115 @@
+"""Parquet staging written by parallel workers, and the single-writer load into DuckDB."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import duckdb
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from lmcr.ingest.detect import Source
+from lmcr.ingest.records import IngestError, ParsedFile
+
+DOCUMENT_SCHEMA = pa.schema([
+    ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("title", pa.string()),
+    ("category", pa.string()), ("subset", pa.string()), ("url", pa.string()),
+    ("source_file", pa.string()), ("position", pa.int32()),
+])
+SENTENCE_SCHEMA = pa.schema([
+    ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("sent_id", pa.int32()),
+    ("kind", pa.string()), ("text", pa.string()), ("n_words", pa.int32()), ("source_file", pa.string()),
+    ("position", pa.int32()), ("seg_start", pa.float64()), ("seg_end", pa.float64()),
+])
+QUARANTINE_SCHEMA = pa.schema([
+    ("stage", pa.string()), ("corpus", pa.string()), ("source_file", pa.string()),
+    ("position", pa.int32()), ("reason", pa.string()), ("record", pa.string()),
+])
+TABLES = {"documents": DOCUMENT_SCHEMA, "sentences": SENTENCE_SCHEMA, "quarantine": QUARANTINE_SCHEMA}
+
+
+@dataclass(frozen=True)
+class StagedFile:
+    """A parsed source as Parquet files plus its counts, ready for `load_staged`."""
+
+    source_file: str
+    sha256: str
+    format: str
+    corpus: str
+    parquet: dict[str, str]
+    records_in: int
+    records_loaded: int
+    records_quarantined: int
+    documents: int
+    sentences: int
+    words: int
+
+
+def write_parquet_atomic(rows: list[dict], schema: pa.Schema, path: Path) -> None:
+    """Write rows as Parquet under a temporary name and rename, so readers never see half a file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    pq.write_table(pa.Table.from_pylist(rows, schema=schema), tmp)
+    os.replace(tmp, path)
+
+
+def stage(source: Source, parsed: ParsedFile, sha256: str, staging_dir: Path) -> StagedFile:
+    """Write one parsed source to `staging_dir/ingest/<sha256>-<corpus>.<table>.parquet`."""
+    rows = {"documents": parsed.documents, "sentences": parsed.sentences, "quarantine": parsed.rejects}
+    paths: dict[str, str] = {}
+    for table, schema in TABLES.items():
+        path = staging_dir / "ingest" / f"{sha256[:24]}-{source.corpus}.{table}.parquet"
+        write_parquet_atomic(rows[table], schema, path)
+        paths[table] = str(path)
+    return StagedFile(
+        source_file=source.key, sha256=sha256, format=source.format, corpus=source.corpus, parquet=paths,
+        records_in=parsed.records_in, records_loaded=parsed.records_loaded,
+        records_quarantined=len(parsed.rejects), documents=len(parsed.documents),
+        sentences=len(parsed.sentences), words=parsed.words,
+    )
+
+
+def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) -> bool:
+    """True when this exact content was loaded for this source and corpus: re-ingesting is a no-op."""
+    row = con.execute(
+        "select 1 from ingested_files where source_file = ? and sha256 = ? and corpus = ? and format = ?",
+        [source.key, sha256, source.corpus, source.format],
+    ).fetchone()
+    return row is not None
+
+
+def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
+    for table in ("documents", "sentences"):
+        con.execute(f"delete from {table} where source_file = ?", [staged.source_file])
+    con.execute("delete from quarantine where stage = 'ingest' and source_file = ?", [staged.source_file])
+    con.execute("delete from ingested_files where source_file = ?", [staged.source_file])
+    clash = con.execute(
+        "select d.doc_id, d.source_file from documents d join read_parquet(?) p using (doc_id) limit 1",
+        [staged.parquet["documents"]],
+    ).fetchone()
+    if clash:
+        raise IngestError(staged.source_file, None,
+                          f"document id {clash[0]!r} is already loaded from {clash[1]}; rename one file")
+    for table, schema in TABLES.items():
+        columns = ", ".join(schema.names)
+        con.execute(f"insert into {table} ({columns}) select {columns} from read_parquet(?)",
+                    [staged.parquet[table]])
+    con.execute(
+        "insert into ingested_files (source_file, sha256, format, corpus, records_in, records_loaded,"
+        " records_quarantined, documents, sentences, words) values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+        [staged.source_file, staged.sha256, staged.format, staged.corpus, staged.records_in,
+         staged.records_loaded, staged.records_quarantined, staged.documents, staged.sentences, staged.words],
+    )
+
+
+def load_staged(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
+    """Replace a source's rows with its staged Parquet in one transaction (all or nothing)."""
+    con.execute("begin transaction")
+    try:
+        _replace_rows(con, staged)
+    except BaseException:
+        con.execute("rollback")
+        raise
+    con.execute("commit")

@@ -1,0 +1,114 @@
+"""The DuckDB store: connecting, numbered append-only migrations, and table contracts that run as queries."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import duckdb
+
+MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
+
+
+class MigrationError(RuntimeError):
+    """A migration failed (it was rolled back and stays pending) or an applied one was edited."""
+
+
+class ContractViolation(RuntimeError):
+    """A table contract query returned offending rows."""
+
+
+@dataclass(frozen=True)
+class Migration:
+    version: int
+    name: str
+    path: Path
+
+    @property
+    def sha256(self) -> str:
+        return hashlib.sha256(self.path.read_bytes()).hexdigest()
+
+
+def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.DuckDBPyConnection:
+    """Open the store (creating its folder) and bring its schema up to date unless read-only."""
+    if str(db) != ":memory:":
+        Path(db).parent.mkdir(parents=True, exist_ok=True)
+    con = duckdb.connect(str(db), read_only=read_only)
+    if not read_only:
+        migrate(con, sql_dir)
+    return con
+
+
+def list_migrations(sql_dir: Path) -> list[Migration]:
+    """The `NNN_name.sql` files of `sql_dir`, in version order; duplicate versions are an error."""
+    found: dict[int, Migration] = {}
+    for path in sorted(sql_dir.glob("*.sql")):
+        match = MIGRATION_NAME.match(path.name)
+        if not match:
+            continue
+        version = int(match.group(1))
+        if version in found:
+            raise MigrationError(f"{path}: version {version:03d} also used by {found[version].path.name}")
+        found[version] = Migration(version, path.stem, path)
+    return [found[v] for v in sorted(found)]
+
+
+def applied_migrations(con: duckdb.DuckDBPyConnection) -> dict[int, str]:
+    """Version -> sha256 of every migration recorded as applied."""
+    con.execute(
+        "create table if not exists schema_migrations ("
+        " version integer primary key, name varchar not null, sha256 varchar not null,"
+        " applied_at timestamp not null default current_timestamp)"
+    )
+    return dict(con.execute("select version, sha256 from schema_migrations").fetchall())
+
+
+def migrate(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[str]:
+    """Apply pending migrations in order, each in its own transaction; return the names applied.
+
+    A failing migration is rolled back (none of its statements stay) and remains pending, so fixing
+    the file and re-running applies it. An applied migration whose file changed is refused: migrations
+    are append-only and a changed one would leave stores built before and after the edit different.
+    """
+    applied = applied_migrations(con)
+    done: list[str] = []
+    for mig in list_migrations(sql_dir):
+        if mig.version in applied:
+            if applied[mig.version] != mig.sha256:
+                raise MigrationError(f"{mig.path}: edited after it was applied; add a new migration instead")
+            continue
+        con.execute("begin transaction")
+        try:
+            con.execute(mig.path.read_text(encoding="utf-8"))
+            con.execute(
+                "insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
+                [mig.version, mig.name, mig.sha256],
+            )
+            con.execute("commit")
+        except duckdb.Error as exc:
+            con.execute("rollback")
+            reason = " ".join(str(exc).split())  # one line: DuckDB adds "Did you mean" hints
+            raise MigrationError(f"{mig.path}: {reason}; rolled back, still pending") from exc
+        done.append(mig.name)
+    return done
+
+
+def named_query(sql_dir: Path, name: str) -> str:
+    """The text of `sql/queries/<name>.sql`."""
+    path = sql_dir / "queries" / f"{name}.sql"
+    if not path.exists():
+        raise FileNotFoundError(f"no named query {name!r} ({path})")
+    return path.read_text(encoding="utf-8")
+
+
+def check_contracts(con: duckdb.DuckDBPyConnection, sql_dir: Path, prefix: str = "") -> dict[str, int]:
+    """Run every `sql/contracts/<prefix>*.sql` query; each returns offending rows, so any row is a violation."""
+    results: dict[str, int] = {}
+    for path in sorted((sql_dir / "contracts").glob(f"{prefix}*.sql")):
+        results[path.stem] = len(con.execute(path.read_text(encoding="utf-8")).fetchall())
+    bad = {name: n for name, n in results.items() if n}
+    if bad:
+        raise ContractViolation(f"table contracts violated: {bad}")
+    return results

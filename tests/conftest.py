@@ -1,0 +1,40 @@
+"""Shared fixtures: the embedded sample corpus, throwaway stores, and the optional ../shared data."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from lmcr.config import REPO_ROOT, Paths, paths_from_env
+from lmcr.store import connect
+
+SAMPLE = REPO_ROOT / "data" / "sample"
+
+
+@pytest.fixture
+def sample_dir() -> Path:
+    return SAMPLE
+
+
+@pytest.fixture
+def paths(tmp_path: Path) -> Paths:
+    """A private data dir and store for one test."""
+    return paths_from_env(data_dir=tmp_path / "data")
+
+
+@pytest.fixture
+def con(paths: Paths):
+    connection = connect(paths.db, paths.sql_dir)
+    yield connection
+    connection.close()
+
+
+@pytest.fixture
+def shared_dir() -> Path:
+    """The read-only shared data (`LMCR_SHARED_DIR`, else ../shared); tests using it skip without it."""
+    root = Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
+    if not (root / "data").is_dir():
+        pytest.skip(f"shared data not found at {root}")
+    return root

@@ -1,0 +1,33 @@
+"""The `lmcr ingest` command: summary output, skip on re-run, one-line errors with non-zero exit."""
+
+from __future__ import annotations
+
+from typer.testing import CliRunner
+
+from lmcr.cli import app
+
+runner = CliRunner()
+
+
+def test_ingest_sample_then_rerun(sample_dir, tmp_path, monkeypatch):
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    args = ["ingest", "--youcook2", str(sample_dir / "youcook2"), "--recipes", str(sample_dir / "nyc"),
+            "--recipes", str(sample_dir / "feeding_america"), "--workers", "1"]
+    first = runner.invoke(app, args)
+    assert first.exit_code == 0, first.output
+    assert "youcook2" in first.output and "4 loaded, 0 unchanged" in first.output
+    assert (tmp_path / "lmcr.duckdb").exists()
+    second = runner.invoke(app, args)
+    assert "0 loaded, 4 unchanged (skipped)" in second.output
+
+
+def test_ingest_errors_are_one_line(sample_dir, tmp_path, monkeypatch):
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    missing = runner.invoke(app, ["ingest", "--recipes", str(tmp_path / "nope.jsonl")])
+    assert missing.exit_code == 1 and "nope.jsonl: no such file or folder" in missing.output
+    bad = tmp_path / "bad.xml"
+    bad.write_text("<cookbook>\n<recipe>\n</cookbook>")
+    broken = runner.invoke(app, ["ingest", "--recipes", str(bad)])
+    assert broken.exit_code == 1 and "bad.xml:3: malformed XML" in broken.output
+    nothing = runner.invoke(app, ["ingest"])
+    assert nothing.exit_code == 1 and "nothing to ingest" in nothing.output

@@ -1,0 +1,29 @@
+"""The ingest flow end to end under a throwaway Prefect API, with the process-pool task runner."""
+
+from __future__ import annotations
+
+import duckdb
+import pytest
+from prefect.testing.utilities import prefect_test_harness
+
+from flows.ingest import ingest_flow
+
+
+@pytest.fixture(scope="module")
+def prefect_api():
+    with prefect_test_harness():
+        yield
+
+
+def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):
+    kwargs = dict(youcook2=[str(sample_dir / "youcook2")],
+                  recipes=[str(sample_dir / "nyc"), str(sample_dir / "recipes_json" / "recipes_sample.jsonl")],
+                  data_dir=str(tmp_path))
+    summary = ingest_flow(**kwargs)
+    by_corpus = {row["corpus"]: row for row in summary}
+    assert by_corpus["youcook2"]["quarantined"] == 3
+    assert by_corpus["recipes"]["records_in"] == 10 + 11
+    again = ingest_flow(**kwargs)
+    assert again == summary
+    con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
+    assert con.execute("select count(*) from ingested_files").fetchone()[0] == 4

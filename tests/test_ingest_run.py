@@ -1,0 +1,91 @@
+"""Ingesting the sample into a store: counts, idempotence, replacement, all-or-nothing loads."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from lmcr.ingest import IngestError, expand_inputs
+from lmcr.ingest.run import corpus_summary, ingest_sources, parse_and_stage
+from lmcr.ingest.stage import load_staged
+
+
+def sample_sources(sample_dir):
+    return expand_inputs([sample_dir / "youcook2"], "youcook2") + expand_inputs(
+        [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl",
+         sample_dir / "recipes_json" / "folder", sample_dir / "feeding_america"], "recipes")
+
+
+def snapshot(con):
+    return {t: con.execute(f"select * exclude ({'quarantined_at' if t == 'quarantine' else 'loaded_at' if t == 'ingested_files' else 'corpus'}) from {t} order by all").fetchall()
+            for t in ("documents", "sentences", "quarantine", "ingested_files")}
+
+
+def test_sample_counts_balance(con, paths, sample_dir):
+    loaded, skipped = ingest_sources(con, sample_sources(sample_dir), paths.staging, workers=2)
+    assert (len(loaded), skipped) == (6, [])
+    summary = {row["corpus"]: row for row in corpus_summary(con, paths.sql_dir)}
+    assert summary["youcook2"] == {**summary["youcook2"], "records_in": 59, "records_loaded": 56, "quarantined": 3,
+                                   "documents": 11, "sentences": 56}
+    assert summary["recipes"] == {**summary["recipes"], "records_in": 31, "records_loaded": 22, "quarantined": 9,
+                                  "documents": 22}
+    assert con.execute("select count(*) from quarantine").fetchone()[0] == 12
+    assert con.execute("select count(*) from quarantine where reason = '' or source_file is null").fetchone()[0] == 0
+
+
+def test_reingest_is_a_no_op(con, paths, sample_dir):
+    ingest_sources(con, sample_sources(sample_dir), paths.staging)
+    before = snapshot(con)
+    loaded, skipped = ingest_sources(con, sample_sources(sample_dir), paths.staging)
+    assert loaded == [] and len(skipped) == 6
+    assert snapshot(con) == before
+
+
+def test_changed_file_replaces_its_rows(con, paths, sample_dir, tmp_path):
+    path = tmp_path / "r.jsonl"
+    path.write_text('{"title": "A", "ingredients": ["salt"], "directions": ["Pour milk. Stir."]}\n')
+    ingest_sources(con, expand_inputs([path], "recipes"), paths.staging)
+    path.write_text('{"title": "B", "ingredients": [], "directions": ["Heat oil."]}\n{"bad"\n')
+    loaded, _ = ingest_sources(con, expand_inputs([path], "recipes"), paths.staging)
+    assert len(loaded) == 1
+    assert con.execute("select text from sentences order by sent_id").fetchall() == [("B",), ("Heat oil.",)]
+    assert con.execute("select position, reason from quarantine").fetchall()[0][0] == 2
+    corpus_summary(con, paths.sql_dir)  # contracts hold after the replacement
+
+
+def test_failed_load_leaves_previous_rows(con, paths, sample_dir):
+    source = expand_inputs([sample_dir / "recipes_json" / "recipes_sample.jsonl"], "recipes")[0]
+    staged = parse_and_stage(source, source.sha256(), paths.staging)
+    load_staged(con, staged)
+    before = snapshot(con)
+    # A crash between the deletes and the inserts: the staged sentences file vanished.
+    broken = parse_and_stage(source, "f" * 64, paths.staging)
+    shutil.os.remove(broken.parquet["sentences"])
+    with pytest.raises(Exception):
+        load_staged(con, broken)
+    assert snapshot(con) == before
+
+
+def test_document_id_clash_is_refused(con, paths, sample_dir, tmp_path):
+    for sub in ("a", "b"):
+        (tmp_path / sub).mkdir()
+        shutil.copy(sample_dir / "recipes_json" / "recipes_sample.jsonl", tmp_path / sub / "recipes.jsonl")
+    ingest_sources(con, expand_inputs([tmp_path / "a" / "recipes.jsonl"], "recipes"), paths.staging)
+    (tmp_path / "b" / "recipes.jsonl").write_text('{"title": "X", "ingredients": ["salt"]}\n')
+    with pytest.raises(IngestError, match="document id 'recipes:1' is already loaded from"):
+        ingest_sources(con, expand_inputs([tmp_path / "b" / "recipes.jsonl"], "recipes"), paths.staging)
+    corpus_summary(con, paths.sql_dir)
+
+
+@pytest.mark.shared
+def test_real_youcook2_and_one_cookbook(con, paths, shared_dir):
+    data = shared_dir / "data"
+    sources = expand_inputs([data / "youcook2" / "youcookii_annotations_trainval.json"], "youcook2")
+    sources += expand_inputs([data / "recipes" / "feeding_america" / "army.xml"], "recipes")
+    ingest_sources(con, sources, paths.staging)
+    summary = {row["corpus"]: row for row in corpus_summary(con, paths.sql_dir)}
+    assert summary["youcook2"]["sentences"] == 13829 and summary["youcook2"]["documents"] == 1790
+    assert summary["recipes"]["documents"] == 381
+    subsets = dict(con.execute("select subset, count(*) from documents where corpus = 'youcook2' group by 1").fetchall())
+    assert subsets == {"training": 1333, "validation": 457}

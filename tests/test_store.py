@@ -1,0 +1,64 @@
+"""Migrations: applied once, in order, recorded; a failing one rolls back and stays pending."""
+
+from __future__ import annotations
+
+import shutil
+
+import duckdb
+import pytest
+
+from lmcr.config import REPO_ROOT
+from lmcr.store import ContractViolation, MigrationError, check_contracts, connect, list_migrations, migrate
+
+
+@pytest.fixture
+def sql_dir(tmp_path):
+    target = tmp_path / "sql"
+    shutil.copytree(REPO_ROOT / "sql", target)
+    return target
+
+
+def test_real_migrations_apply_once(sql_dir):
+    con = duckdb.connect(":memory:")
+    names = migrate(con, sql_dir)
+    assert names == [m.name for m in list_migrations(sql_dir)] and names[0] == "001_ingest"
+    assert migrate(con, sql_dir) == []
+    assert con.execute("select count(*) from schema_migrations").fetchone()[0] == len(names)
+    assert check_contracts(con, sql_dir)  # empty tables satisfy every contract
+
+
+def test_failing_migration_rolls_back_and_stays_pending(sql_dir):
+    con = duckdb.connect(":memory:")
+    migrate(con, sql_dir)
+    bad = sql_dir / "900_broken.sql"
+    bad.write_text("create table half_done (x integer);\ninsert into no_such_table values (1);\n")
+    with pytest.raises(MigrationError, match="900_broken.sql.*rolled back, still pending"):
+        migrate(con, sql_dir)
+    tables = {r[0] for r in con.execute("select table_name from information_schema.tables").fetchall()}
+    assert "half_done" not in tables
+    assert 900 not in dict(con.execute("select version, name from schema_migrations").fetchall())
+    bad.write_text("create table half_done (x integer);\n")
+    assert migrate(con, sql_dir) == ["900_broken"]
+
+
+def test_edited_migration_is_refused(sql_dir, tmp_path):
+    con = connect(tmp_path / "s.duckdb", sql_dir)
+    first = list_migrations(sql_dir)[0].path
+    first.write_text(first.read_text() + "\n-- edited\n")
+    with pytest.raises(MigrationError, match="edited after it was applied"):
+        migrate(con, sql_dir)
+
+
+def test_duplicate_version_is_refused(sql_dir):
+    (sql_dir / "001_again.sql").write_text("select 1;")
+    with pytest.raises(MigrationError, match="version 001 also used"):
+        list_migrations(sql_dir)
+
+
+def test_contract_violation_is_reported(sql_dir):
+    con = duckdb.connect(":memory:")
+    migrate(con, sql_dir)
+    con.execute("insert into documents values ('recipes','s','d1',null,null,null,null,'f',1),"
+                "('recipes','s','d1',null,null,null,null,'g',1)")
+    with pytest.raises(ContractViolation, match="ingest_documents_unique"):
+        check_contracts(con, sql_dir, prefix="ingest_")
