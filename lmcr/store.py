@@ -36,6 +36,7 @@ def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.Du
     if str(db) != ":memory:":
         Path(db).parent.mkdir(parents=True, exist_ok=True)
     con = duckdb.connect(str(db), read_only=read_only)
+    con.execute("set enable_progress_bar = false")  # library calls report progress their own way
     if not read_only:
         migrate(con, sql_dir)
     return con

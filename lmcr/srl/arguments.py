@@ -1,0 +1,77 @@
+"""From an argument's head token to its value: lowercase singular head lemma with fixed compounds kept.
+
+Determiners, numbers, possessives and ordinary adjectives are dropped ("the melted chocolate" ->
+"chocolate"); compounds stay ("bell pepper", "soy sauce"); a noun-tagged or compound-marked modifier
+is part of the name ("frying pan", "piping bag") while a participle adjective is not ("remaining
+butter"); measure and quantity nouns give way to their of-phrase ("3 tablespoons of olive oil" ->
+"olive oil"); pronouns stay as written.
+"""
+
+from __future__ import annotations
+
+from spacy.tokens import Token
+
+from lmcr.srl.compounds import Compounds
+from lmcr.srl.lexicon import Lexicon
+
+NOUN_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS"})
+HEAD_TAGS = NOUN_TAGS | {"JJ", "VBG"}
+
+
+def _of_object(token: Token) -> Token | None:
+    for child in token.children:
+        if child.dep_ == "prep" and child.lower_ == "of":
+            return next((g for g in child.children if g.dep_ == "pobj"), None)
+    return None
+
+
+def resolve_head(token: Token, lex: Lexicon) -> Token | None:
+    """Follow measure/quantity nouns to their of-object; None where nothing nameable is left."""
+    for _ in range(4):  # "half of a cup of milk": at most a few hops
+        lemma = token.lemma_.lower()
+        if lemma in lex.measure_nouns or lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns:
+            inner = _of_object(token)
+            if inner is not None:
+                token = inner
+                continue
+            if lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns:
+                return None
+        break
+    if token.tag_ == "PRP" or token.lower_ in lex.object_pronouns:
+        return token
+    # The parse says this is an object; the small tagger often calls such nouns adjectives or
+    # gerunds ("with rosemary/JJ", "with frosting/VBG"), so those heads count too.
+    return token if token.tag_ in HEAD_TAGS or token.pos_ in ("NOUN", "PROPN") else None
+
+
+def _is_name_part(child: Token, head: Token, compounds: Compounds | None) -> bool:
+    if child.dep_ not in ("compound", "amod", "nmod") or not child.is_alpha:
+        return False
+    # The parser's compound label stands ("piping/VBG bag"); spaCy also often marks the first word of
+    # a fixed compound as amod with a noun tag ("frying/NN pan").
+    if child.dep_ == "compound" or child.tag_ in NOUN_TAGS:
+        return True
+    # Adjective-tagged modifiers: the corpus decides ("olive oil" joins, "hot oil" does not).
+    return compounds is not None and compounds.joins(child.lower_, head.lower_)
+
+
+def _singular(token: Token) -> str:
+    lemma = token.lemma_.lower()
+    return lemma if token.tag_ in NOUN_TAGS and lemma.isalpha() else token.lower_
+
+
+def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = None) -> tuple[str, int, int] | None:
+    """(value, start_char, end_char) of the argument headed by `token`, or None if it names nothing."""
+    head = resolve_head(token, lex)
+    if head is None:
+        return None
+    if head.tag_ == "PRP" or head.lower_ in lex.object_pronouns:
+        return head.lower_, head.idx, head.idx + len(head)
+    parts: list[Token] = []
+    for child in reversed(list(head.lefts)):
+        if child.i != (parts[0].i if parts else head.i) - 1 or not _is_name_part(child, head, compounds):
+            break
+        parts.insert(0, child)
+    start = parts[0].idx if parts else head.idx
+    value = " ".join([p.lower_ for p in parts] + [_singular(head)])
+    return value, start, head.idx + len(head)

@@ -1,0 +1,158 @@
+"""Verb frames from a dependency parse: the 11 robot predicates with their two roles, generic frames
+(object and prepositional arguments) for every other verb."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from spacy.tokens import Doc, Span, Token
+
+from lmcr.srl.arguments import argument_value
+from lmcr.srl.compounds import Compounds
+from lmcr.srl.lexicon import Lexicon, PredicateSpec
+
+OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
+NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})
+SKIPPED_LEMMAS = frozenset({"be", "have", "do", "let", "go", "will", "would", "can", "could", "should"})
+PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
+
+
+@dataclass
+class Frame:
+    """One predicate occurrence: roles map to values (None when not expressed), spans to char offsets."""
+
+    predicate: str
+    roles: dict[str, str | None]
+    known: bool
+    start: int
+    end: int
+    spans: dict[str, tuple[int, int]] = field(default_factory=dict)
+    # Set when a lone object of an alternating verb got its role by default ("rub the steak").
+    ambiguous_object: str | None = None
+
+    def missing(self) -> list[str]:
+        return [role for role, value in self.roles.items() if value is None]
+
+    def to_json(self) -> dict:
+        return {"predicate": self.predicate, "roles": dict(self.roles)}
+
+    def shifted(self, offset: int) -> Frame:
+        """The same frame with character offsets moved (for text that was re-parsed with a prefix)."""
+        spans = {r: (s + offset, e + offset) for r, (s, e) in self.spans.items()}
+        return Frame(self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans,
+                     self.ambiguous_object)
+
+
+@dataclass
+class _Args:
+    objects: list[Token]
+    preps: list[tuple[str, Token]]
+    particles: list[str]
+
+
+def predicate_lemma(token: Token, lex: Lexicon) -> str | None:
+    """The predicate a verb token evokes, or None if it is no predicate (aux, adjective, noun, copula)."""
+    if not token.tag_.startswith("VB") or token.dep_ in NOT_PREDICATE_DEPS or not token.is_alpha:
+        return None
+    lemma = token.lemma_.lower()
+    if lemma not in lex.predicates and token.lower_ in lex.predicates:
+        lemma = token.lower_  # the lemmatiser follows the tagger, which mis-tags imperatives
+    return None if lemma in SKIPPED_LEMMAS else lemma
+
+
+def _pobj(prep: Token) -> Token | None:
+    """The object of a preposition; a bare gerund counts ("with frosting"), a clause does not."""
+    for child in prep.children:
+        if child.dep_ == "pobj" or child.dep_ == "pcomp" and not any(g.dep_ in OBJECT_DEPS for g in child.children):
+            return child
+    return None
+
+
+def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
+    objects = [c for c in verb.children if c.dep_ in OBJECT_DEPS]
+    if not objects and any(c.dep_ == "dative" for c in verb.children):
+        objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i]  # "fry me an egg"
+    if len(objects) > 1:  # "fry me an egg" parsed as two objects: the recipient is not the theme
+        objects = [o for o in objects if o.lower_ not in lex.recipient_pronouns] or objects[:1]
+    preps: list[tuple[str, Token]] = []
+    particles: list[str] = []
+    for child in verb.children:
+        if child.dep_ not in PREP_DEPS or child.dep_ == "dative" and child.tag_ == "PRP":
+            continue
+        obj = _pobj(child) if child.dep_ != "prt" else None
+        if obj is not None:
+            preps.append((child.lower_, obj))
+        elif child.dep_ == "prt" or child.lower_ in (spec.particles if spec else ()):
+            particles.append(child.lower_)
+    # "sprinkle over the salad": the parser's particle is this verb's role preposition, not a particle.
+    if spec and objects and particles:
+        prt = next((c for c in verb.children if c.dep_ == "prt"), None)
+        if prt is not None and prt.lower_ not in spec.particles and spec.prep_role(prt.lower_) \
+                and prt.i == verb.i + 1 and objects[0].i > prt.i:
+            preps.insert(0, (prt.lower_, objects.pop(0)))
+            particles.remove(prt.lower_)
+    # "pour in the milk": a particle right after the verb whose "object" is really the verb's object.
+    if spec and not objects and preps:
+        prep, obj = preps[0]
+        if prep in spec.particles and obj.head.i == verb.i + 1:
+            objects, preps, particles = [obj], preps[1:], particles + [prep]
+    # PPs the parser hung on the object ("heat some oil in the wok") still belong to the verb.
+    for obj in objects:
+        preps += [(c.lower_, p) for c in obj.children if c.dep_ == "prep" and (p := _pobj(c)) is not None]
+    return _Args(objects, preps, particles)
+
+
+def _right_node_object(verb: Token) -> list[Token]:
+    """'heat and stir the milk': an object-less verb shares the object of the verb coordinated right after it."""
+    for conj in verb.children:
+        if conj.dep_ == "conj" and conj.i == verb.i + 2 and verb.doc[verb.i + 1].dep_ == "cc":
+            return [c for c in conj.children if c.dep_ in OBJECT_DEPS]
+    return []
+
+
+def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None) -> Frame:
+    frame = Frame(spec.name, {role: None for role in spec.roles}, True, verb.idx, verb.idx + len(verb))
+
+    def fill(role: str, token: Token) -> bool:
+        found = argument_value(token, lex, compounds)
+        if found is None or frame.roles[role] is not None:
+            return False
+        frame.roles[role], frame.spans[role] = found[0], found[1:]
+        return True
+
+    for prep, obj in args.preps:
+        role = spec.prep_role(prep)
+        if role:
+            fill(role, obj)
+    if args.objects:
+        obj = args.objects[0]
+        role = spec.object_role if frame.roles[spec.object_role] is None else spec.other(spec.object_role)
+        if fill(role, obj) and spec.alternating and not args.particles and frame.roles[spec.other(role)] is None:
+            frame.ambiguous_object = role
+    return frame
+
+
+def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds: Compounds | None) -> Frame:
+    frame = Frame(lemma, {}, False, verb.idx, verb.idx + len(verb))
+    for role, token in ([("Theme", args.objects[0])] if args.objects else []) + args.preps:
+        found = argument_value(token, lex, compounds)
+        if found and role not in frame.roles:
+            frame.roles[role], frame.spans[role] = found[0], found[1:]
+    return frame
+
+
+def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[Frame]:
+    """Every predicate occurrence in `doc`, in text order; `compounds` (learned) decides adjective-tagged
+    modifiers, without it only noun-tagged modifiers join a name."""
+    frames = []
+    for token in doc:
+        lemma = predicate_lemma(token, lex)
+        if lemma is None:
+            continue
+        spec = lex.predicates.get(lemma)
+        args = _collect(token, lex, spec)
+        if not args.objects and not args.preps:
+            args.objects = _right_node_object(token)
+        frames.append(_known_frame(token, spec, args, lex, compounds) if spec
+                      else _generic_frame(token, lemma, args, lex, compounds))
+    return sorted(frames, key=lambda f: f.start)

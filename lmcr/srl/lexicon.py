@@ -1,0 +1,61 @@
+"""The verb-frame lexicon: the 11 robot predicates, their two roles, and how English realises each role."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+LEXICON_PATH = Path(__file__).with_name("lexicon.json")
+
+
+@dataclass(frozen=True)
+class PredicateSpec:
+    """How one predicate's roles surface: object role, with-role, role prepositions, particles."""
+
+    name: str
+    roles: tuple[str, str]
+    object_role: str
+    with_role: str | None
+    preps: dict[str, frozenset[str]]
+    particles: frozenset[str]
+    alternating: bool
+
+    def prep_role(self, prep: str) -> str | None:
+        """The role a prepositional phrase headed by `prep` fills, if any."""
+        if prep == "with" and self.with_role:
+            return self.with_role
+        return next((role for role, preps in self.preps.items() if prep in preps), None)
+
+    def other(self, role: str) -> str:
+        return self.roles[1] if role == self.roles[0] else self.roles[0]
+
+
+@dataclass(frozen=True)
+class Lexicon:
+    predicates: dict[str, PredicateSpec]
+    measure_nouns: frozenset[str]
+    quantity_nouns: frozenset[str]
+    object_pronouns: frozenset[str]
+    recipient_pronouns: frozenset[str]
+
+
+@lru_cache(maxsize=4)
+def load_lexicon(path: str | None = None) -> Lexicon:
+    """Load the lexicon (`LMCR_LEXICON` or the packaged `lexicon.json`)."""
+    data = json.loads(Path(path or os.environ.get("LMCR_LEXICON") or LEXICON_PATH).read_text("utf-8"))
+    predicates = {
+        name: PredicateSpec(
+            name=name, roles=tuple(spec["roles"]), object_role=spec["object"], with_role=spec.get("with"),
+            preps={role: frozenset(p) for role, p in spec.get("preps", {}).items()},
+            particles=frozenset(spec.get("particles", [])), alternating=bool(spec.get("alternating")),
+        )
+        for name, spec in data["predicates"].items()
+    }
+    return Lexicon(
+        predicates=predicates, measure_nouns=frozenset(data["measure_nouns"]),
+        quantity_nouns=frozenset(data["quantity_nouns"]), object_pronouns=frozenset(data["object_pronouns"]),
+        recipient_pronouns=frozenset(data["recipient_pronouns"]),
+    )

@@ -1,0 +1,77 @@
+"""Role preferences learned from the frame corpus, for the lone object of an alternating verb.
+
+"rub the steak" and "rub the salt in" have the same syntax; what differs is that the corpus shows
+steak as what gets rubbed (Destination) and salt as what is rubbed on (Theme). Counting, over frames
+whose roles were fixed by syntax (a with-phrase or a destination phrase), how often each noun fills
+each role of each verb — pooled over the alternating verbs as a back-off — resolves the lone object.
+No preference is written by hand: an unseen noun keeps the syntactic default (the object role).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+from lmcr.srl.frames import Frame
+
+SMOOTHING = 1.0
+
+
+@dataclass
+class RolePriors:
+    """Counts of (verb, value, role) and (value, role) from unambiguous frames of alternating verbs."""
+
+    by_verb: Counter = field(default_factory=Counter)
+    pooled: Counter = field(default_factory=Counter)
+
+    def observe(self, frames: Iterable[Frame], alternating: set[str]) -> None:
+        """Count role fillers of unambiguous, fully specified alternating-verb frames."""
+        for frame in frames:
+            if frame.predicate not in alternating or frame.ambiguous_object or None in frame.roles.values():
+                continue
+            for role, value in frame.roles.items():
+                self.by_verb[(frame.predicate, value, role)] += 1
+                self.pooled[(value, role)] += 1
+
+    def probability(self, verb: str, value: str, role: str, other: str) -> float | None:
+        """Smoothed P(role | verb, value) backing off to P(role | value); None when never seen."""
+        for counts, key in ((self.by_verb, (verb,)), (self.pooled, ())):
+            hit, miss = counts[(*key, value, role)], counts[(*key, value, other)]
+            if hit + miss:
+                return (hit + SMOOTHING) / (hit + miss + 2 * SMOOTHING)
+        return None
+
+    def resolve(self, frame: Frame) -> Frame:
+        """Swap a default-assigned lone object into the other role when the corpus prefers that role."""
+        role = frame.ambiguous_object
+        if role is None:
+            return frame
+        other = next(r for r in frame.roles if r != role)
+        value = frame.roles[role]
+        p = self.probability(frame.predicate, value, role, other)
+        if p is None or p >= 0.5:
+            return frame
+        roles = {role: None, other: value} if list(frame.roles)[0] == role else {other: value, role: None}
+        roles = {r: roles[r] for r in frame.roles}
+        spans = {other: frame.spans[role]} if role in frame.spans else {}
+        return Frame(frame.predicate, roles, frame.known, frame.start, frame.end, spans, other)
+
+    def save(self, path: Path) -> None:
+        """Write as JSON under a temporary name, then rename."""
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(json.dumps({
+            "by_verb": [[*k, n] for k, n in sorted(self.by_verb.items())],
+            "pooled": [[*k, n] for k, n in sorted(self.pooled.items())],
+        }), encoding="utf-8")
+        os.replace(tmp, path)
+
+    @classmethod
+    def load(cls, path: Path) -> RolePriors:
+        data = json.loads(Path(path).read_text("utf-8"))
+        return cls(Counter({tuple(r[:-1]): r[-1] for r in data["by_verb"]}),
+                   Counter({tuple(r[:-1]): r[-1] for r in data["pooled"]}))
