@@ -20,12 +20,15 @@ demo: setup
 	$(BIN)/lmcr ingest --youcook2 $(SAMPLE)/youcook2 --recipes $(SAMPLE)/nyc \
 		--recipes $(SAMPLE)/recipes_json/recipes_sample.jsonl --recipes $(SAMPLE)/recipes_json/folder \
 		--recipes $(SAMPLE)/feeding_america
+	$(BIN)/lmcr frames --shard-size 100
+	$(BIN)/lmcr srl "could you pour me some water?"
 
 test: setup
 	$(BIN)/python -m pytest -q
 
 bench: setup
 	$(BIN)/python bench/bench_ingest.py
+	$(BIN)/python bench/bench_srl.py
 
 clean:
 	rm -rf $(VENV) data/staging data/lmcr.duckdb

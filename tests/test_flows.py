@@ -27,3 +27,23 @@ def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):
     assert again == summary
     con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
     assert con.execute("select count(*) from ingested_files").fetchone()[0] == 4
+
+
+def test_frames_flow_on_sample(prefect_api, sample_dir, tmp_path):
+    from flows.frames import frames_flow
+
+    ingest_flow(youcook2=[str(sample_dir / "youcook2")], recipes=[str(sample_dir / "nyc")], data_dir=str(tmp_path))
+    result = frames_flow(shard_size=30, data_dir=str(tmp_path))
+    assert not result["skipped"] and result["sentences"] > 60
+    assert {row["predicate"] for row in result["counts"]} >= {"pour", "heat", "fry", "sprinkle"}
+    assert frames_flow(shard_size=30, data_dir=str(tmp_path)) == {"skipped": True}
+
+
+def test_frames_flow_on_a_local_dask_cluster(prefect_api, sample_dir, tmp_path):
+    from flows.frames import run_frames
+
+    ingest_flow(recipes=[str(sample_dir / "recipes_json" / "recipes_sample.jsonl")], data_dir=str(tmp_path))
+    result = run_frames(workers=2, dask="local", shard_size=20, data_dir=str(tmp_path))
+    assert not result["skipped"] and result["sentences"] > 20
+    con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
+    assert con.execute("select count(*) from frames where predicate = 'pour'").fetchone()[0] >= 5

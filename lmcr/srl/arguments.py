@@ -12,6 +12,7 @@ from __future__ import annotations
 from spacy.tokens import Token
 
 from lmcr.srl.compounds import Compounds
+from lmcr.srl.lemmas import lemma as lemma_of
 from lmcr.srl.lexicon import Lexicon
 
 NOUN_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS"})
@@ -28,7 +29,7 @@ def _of_object(token: Token) -> Token | None:
 def resolve_head(token: Token, lex: Lexicon) -> Token | None:
     """Follow measure/quantity nouns to their of-object; None where nothing nameable is left."""
     for _ in range(4):  # "half of a cup of milk": at most a few hops
-        lemma = token.lemma_.lower()
+        lemma = lemma_of(token)
         if lemma in lex.measure_nouns or lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns:
             inner = _of_object(token)
             if inner is not None:
@@ -56,7 +57,7 @@ def _is_name_part(child: Token, head: Token, compounds: Compounds | None) -> boo
 
 
 def _singular(token: Token) -> str:
-    lemma = token.lemma_.lower()
+    lemma = lemma_of(token)
     return lemma if token.tag_ in NOUN_TAGS and lemma.isalpha() else token.lower_
 
 

@@ -9,6 +9,7 @@ from spacy.tokens import Doc, Span, Token
 
 from lmcr.srl.arguments import argument_value
 from lmcr.srl.compounds import Compounds
+from lmcr.srl.lemmas import lemma as lemma_of
 from lmcr.srl.lexicon import Lexicon, PredicateSpec
 
 OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
@@ -54,7 +55,7 @@ def predicate_lemma(token: Token, lex: Lexicon) -> str | None:
     """The predicate a verb token evokes, or None if it is no predicate (aux, adjective, noun, copula)."""
     if not token.tag_.startswith("VB") or token.dep_ in NOT_PREDICATE_DEPS or not token.is_alpha:
         return None
-    lemma = token.lemma_.lower()
+    lemma = lemma_of(token)
     if lemma not in lex.predicates and token.lower_ in lex.predicates:
         lemma = token.lower_  # the lemmatiser follows the tagger, which mis-tags imperatives
     return None if lemma in SKIPPED_LEMMAS else lemma

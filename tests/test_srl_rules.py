@@ -1,0 +1,142 @@
+"""Frame rules on hand-built parses (no spaCy model needed)."""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from lmcr.srl.compounds import Compounds
+from lmcr.srl.frames import extract_frames
+from lmcr.srl.lexicon import load_lexicon
+from lmcr.srl.parser import find_split, needs_reparse
+from lmcr.srl.priors import RolePriors
+from tests.srl_docs import make_doc
+
+LEX = load_lexicon()
+
+
+def frames(spec: str, compounds: Compounds | None = None):
+    return [(f.predicate, f.roles) for f in extract_frames(make_doc(spec), LEX, compounds)]
+
+
+def test_dative_is_not_a_role():
+    doc = "pour/VB/ROOT/0 me/PRP/dative/0 some/DT/det/3 water/NN/dobj/0"
+    assert frames(doc) == [("pour", {"Theme": "water", "Destination": None})]
+
+
+def test_double_object_misparse_keeps_the_theme():
+    doc = "fry/VB/ROOT/0 me/PRP/dative/0 an/DT/det/3 egg/NN/npadvmod/0"
+    assert frames(doc) == [("fry", {"Theme": "egg", "Instrument": None})]
+
+
+def test_with_alternation_gives_the_same_frame():
+    with_phrase = "brush/VB/ROOT/0 the/DT/det/2 bread/NN/dobj/0 with/IN/prep/0 oil/NN/pobj/3"
+    on_phrase = "brush/VB/ROOT/0 oil/NN/dobj/0 on/IN/prep/0 the/DT/det/4 bread/NN/pobj/2"
+    expected = [("brush", {"Theme": "oil", "Destination": "bread"})]
+    assert frames(with_phrase) == frames(on_phrase) == expected
+
+
+def test_fill_and_season_with_phrases():
+    assert frames("fill/VB/ROOT/0 the/DT/det/2 glass/NN/dobj/0 with/IN/prep/0 ice/NN/pobj/3") == [
+        ("fill", {"Destination": "glass", "Theme": "ice"})]
+    assert frames("fill/VB/ROOT/0 water/NN/dobj/0 into/IN/prep/0 the/DT/det/4 pot/NN/pobj/2") == [
+        ("fill", {"Destination": "pot", "Theme": "water"})]
+    assert frames("season/VB/ROOT/0 with/IN/prep/0 salt/NN/pobj/1") == [
+        ("season", {"Theme": None, "Instrument": "salt"})]
+
+
+def test_particles_are_not_destinations():
+    assert frames("pour/VB/ROOT/0 in/IN/prep/0 the/DT/det/3 milk/NN/pobj/1") == [
+        ("pour", {"Theme": "milk", "Destination": None})]
+    assert frames("dip/VB/ROOT/0 it/PRP/dobj/0 in/RP/prt/0") == [("dip", {"Theme": "it", "Destination": None})]
+    # ...but a role preposition the parser called a particle still introduces its role
+    assert frames("sprinkle/VB/ROOT/0 over/RP/prt/0 the/DT/det/3 salad/NN/dobj/0") == [
+        ("sprinkle", {"Theme": None, "Destination": "salad"})]
+    # and an instrument verb's "in" is never a particle
+    assert frames("fry/VB/ROOT/0 in/IN/prep/0 a/DT/det/4 hot/JJ/amod/4 skillet/NN/pobj/1") == [
+        ("fry", {"Theme": None, "Instrument": "skillet"})]
+
+
+def test_coordination():
+    # "heat and stir the milk": the object-less first verb shares the next verb's object
+    assert frames("heat/VB/ROOT/0 and/CC/cc/0 stir/VB/conj/0 the/DT/det/4 milk/NN/dobj/2")[0] == (
+        "heat", {"Theme": "milk", "Instrument": None})
+    # coordinated objects: the first conjunct fills the role
+    doc = ("pour/VB/ROOT/0 the/DT/det/2 milk/NN/dobj/0 and/CC/cc/2 the/DT/det/5 cream/NN/conj/2 "
+           "into/IN/prep/0 the/DT/det/8 pot/NN/pobj/6")
+    assert frames(doc) == [("pour", {"Theme": "milk", "Destination": "pot"})]
+
+
+def test_argument_values():
+    doc = ("heat/VB/ROOT/0 3/CD/nummod/2 tablespoons/NNS/dobj/0/tablespoon of/IN/prep/2 olive/NN/compound/5 "
+           "oil/NN/pobj/3 in/IN/prep/0 a/DT/det/9 large/JJ/amod/9 skillet/NN/pobj/6")
+    assert frames(doc) == [("heat", {"Theme": "olive oil", "Instrument": "skillet"})]
+    # measure nouns stand alone without an of-phrase, quantity words do not
+    assert frames("fill/VB/ROOT/0 each/DT/det/2 cup/NN/dobj/0") == [("fill", {"Destination": "cup", "Theme": None})]
+    assert frames("dip/VB/ROOT/0 a/DT/det/2 few/JJ/dobj/0 in/IN/prep/0 the/DT/det/5 chocolate/NN/pobj/3") == [
+        ("dip", {"Theme": None, "Destination": "chocolate"})]
+    # adjectives and determiners go, plurals become singular, noun-tagged modifiers stay
+    doc = ("pour/VB/ROOT/0 the/DT/det/3 melted/JJ/amod/3 chocolate/NN/dobj/0 into/IN/prep/0 "
+           "the/DT/det/7 frying/NN/amod/7 pans/NNS/pobj/4/pan")
+    assert frames(doc) == [("pour", {"Theme": "chocolate", "Destination": "frying pan"})]
+    assert frames("fry/VB/ROOT/0 them/PRP/dobj/0 in/IN/prep/0 oil/NN/pobj/2") == [
+        ("fry", {"Theme": "them", "Instrument": "oil"})]
+
+
+def test_passive_subject_is_the_theme():
+    doc = ("the/DT/det/1 steak/NN/nsubjpass/4 should/MD/aux/4 be/VB/auxpass/4 seasoned/VBN/ROOT/4/season "
+           "with/IN/prep/4 salt/NN/pobj/5")
+    assert frames(doc) == [("season", {"Theme": "steak", "Instrument": "salt"})]
+
+
+def test_adjectival_participles_and_nouns_are_not_predicates():
+    doc = "add/VB/ROOT/0 the/DT/det/3 fried/VBN/amod/3/fry onions/NNS/dobj/0/onion"
+    assert frames(doc) == [("add", {"Theme": "onion"})]
+    assert frames("use/VB/ROOT/0 a/DT/det/3 pastry/NN/compound/3 brush/NN/dobj/0") == [("use", {"Theme": "pastry brush"})]
+
+
+def test_generic_frames_keep_object_and_prepositions():
+    doc = "add/VB/ROOT/0 the/DT/det/2 shallots/NNS/dobj/0/shallot to/IN/prep/0 the/DT/det/5 pan/NN/pobj/3"
+    assert frames(doc) == [("add", {"Theme": "shallot", "to": "pan"})]
+
+
+def test_learned_compounds_decide_adjective_tagged_modifiers():
+    doc = "sprinkle/VB/ROOT/0 the/DT/det/3 cinnamon/JJ/amod/3 sugar/NN/dobj/0 over/IN/prep/0 toast/NN/pobj/4"
+    assert frames(doc)[0][1]["Theme"] == "sugar"
+    learned = Compounds(head_rates={"cinnamon": 0.41}, strong_bigrams=frozenset({"olive oil"}))
+    assert frames(doc, learned)[0][1]["Theme"] == "cinnamon sugar"
+    assert frames("heat/VB/ROOT/0 olive/JJ/amod/2 oil/NN/dobj/0", learned)[0][1]["Theme"] == "olive oil"
+    assert frames("heat/VB/ROOT/0 hot/JJ/amod/2 oil/NN/dobj/0", learned)[0][1]["Theme"] == "oil"
+
+
+def test_lone_object_of_alternating_verb_is_resolved_by_priors():
+    [frame] = extract_frames(make_doc("rub/VB/ROOT/0 the/DT/det/2 steak/NN/dobj/0"), LEX)
+    assert frame.ambiguous_object == "Theme" and frame.roles == {"Theme": "steak", "Destination": None}
+    priors = RolePriors(by_verb=Counter({("rub", "steak", "Destination"): 9, ("rub", "steak", "Theme"): 1}))
+    resolved = priors.resolve(frame)
+    assert resolved.roles == {"Theme": None, "Destination": "steak"}
+    # a noun seen only with other alternating verbs backs off to the pooled counts
+    pooled = RolePriors(pooled=Counter({("salt", "Theme"): 5}))
+    [salt] = extract_frames(make_doc("rub/VB/ROOT/0 the/DT/det/2 salt/NN/dobj/0"), LEX)
+    assert pooled.resolve(salt).roles == {"Theme": "salt", "Destination": None}
+    assert RolePriors().resolve(frame).roles == frame.roles  # unseen: syntactic default stays
+    # a particle settles it syntactically: "rub the salt in"
+    [particle] = extract_frames(make_doc("rub/VB/ROOT/0 the/DT/det/2 salt/NN/dobj/0 in/RP/prt/0"), LEX)
+    assert particle.ambiguous_object is None
+
+
+def test_priors_round_trip(tmp_path):
+    priors = RolePriors(Counter({("rub", "steak", "Destination"): 3}), Counter({("steak", "Destination"): 3}))
+    priors.save(tmp_path / "p.json")
+    assert RolePriors.load(tmp_path / "p.json") == priors
+
+
+def test_imperative_repair_triggers():
+    misread = make_doc("Heat/NN/compound/1 oil/NN/ROOT/1 in/IN/prep/1 a/DT/det/4 pan/NN/pobj/2")
+    assert needs_reparse(misread[:])
+    declarative = make_doc("Chicken/NN/nsubjpass/3 should/MD/aux/3 be/VB/auxpass/3 fried/VBN/ROOT/3")
+    assert not needs_reparse(declarative[:])
+    verb_first = make_doc("pour/VB/ROOT/0 water/NN/dobj/0")
+    assert not needs_reparse(verb_first[:])
+    clause = make_doc("brush/VB/ROOT/0 bread/NN/dobj/0 and/CC/cc/1 season/NN/conj/1 with/IN/prep/3 salt/NN/pobj/4")
+    assert find_split(clause[:], LEX).text == "season"
+    assert find_split(make_doc("add/VB/ROOT/0 salt/NN/dobj/0 and/CC/cc/1 pepper/NN/conj/1")[:], LEX) is None
