@@ -124,6 +124,68 @@ def frames(
                       f"{build['kept']:,}/{build['reparsed']:,}")
 
 
+@app.command()
+def train(
+    linearization: str = typer.Option("sentence", help="sentence | frame"),
+    corpus: str = typer.Option("all", help="youcook2 | recipes | all"),
+    embedding: int = typer.Option(256, help="Embedding = hidden size."),
+    layers: int = typer.Option(2),
+    dropout: float = typer.Option(0.3),
+    max_epochs: int = typer.Option(8),
+    batch_tokens: int = typer.Option(6000),
+    lr: float = typer.Option(3e-3),
+    min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
+    device: Optional[str] = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Train a language model on a corpus setting and publish its checkpoint."""
+    from lmcr.lm.model import LMConfig
+    from lmcr.lm.run import train_setting
+    from lmcr.lm.train import TrainConfig
+
+    paths = paths_from_env(db=db)
+
+    def show(row: dict) -> None:
+        console.print(f"epoch {row['epoch']}: train ppl {row['train_ppl']:.1f} ({row['objective']} softmax), "
+                      f"val ppl {row['val_ppl']:.1f}, "
+                      f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']} ({row['seconds']:.0f}s)")
+
+    try:
+        con = connect(paths.db, paths.sql_dir)
+        path = train_setting(con, paths.checkpoints, linearization, corpus, LMConfig(0, embedding, layers, dropout),
+                             TrainConfig(max_epochs=max_epochs, lr=lr, batch_tokens=batch_tokens, device=device),
+                             min_freq=min_freq, on_epoch=show)
+    except (MigrationError, ValueError) as exc:
+        fail(str(exc))
+    console.print(f"published {path}")
+
+
+@app.command()
+def score(
+    frames_csv: Path = typer.Option(..., "--frames", help="CSV with verb, role1, arg1, role2, arg2."),
+    out: Path = typer.Option(..., "--out", help="CSV: the input plus one score column per method."),
+    methods: str = typer.Option("sentence_lm,frame_lm", help="Comma-separated: sentence_lm, frame_lm, random."),
+    corpus: str = typer.Option("all", help="Training setting of the LM checkpoints: youcook2 | recipes | all."),
+    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+) -> None:
+    """Score complete frames with each method (higher = more plausible)."""
+    from lmcr.jsonl import InputError
+    from lmcr.lm.checkpoint import CheckpointError
+    from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
+
+    root = checkpoint or paths_from_env().checkpoints
+    try:
+        columns, rows = read_frames_csv(frames_csv)
+        frames = [r.frame for r in rows]
+        started = time.perf_counter()
+        scores = {m: make_scorer(m, root, corpus)(frames) for m in (x.strip() for x in methods.split(",")) if m}
+    except (InputError, CheckpointError, ValueError) as exc:
+        fail(str(exc))
+    elapsed = time.perf_counter() - started
+    write_scores_csv(out, columns, rows, scores)
+    console.print(f"{len(rows):,} frames x {len(scores)} methods -> {out} ({elapsed:.2f}s)")
+
+
 def _srl_parser(model: str | None, resources: Path | None):
     from lmcr.srl.parser import load_parser
 

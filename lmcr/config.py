@@ -23,6 +23,11 @@ class Paths:
         return self.data_dir / "srl"
 
     @property
+    def checkpoints(self) -> Path:
+        """Published language-model checkpoints, one folder per setting (`frame-all`, ...)."""
+        return self.data_dir / "checkpoints"
+
+    @property
     def staging(self) -> Path:
         """Parquet written by parallel workers before the single writer loads it into DuckDB."""
         return self.data_dir / "staging"

@@ -47,3 +47,17 @@ def test_frames_flow_on_a_local_dask_cluster(prefect_api, sample_dir, tmp_path):
     assert not result["skipped"] and result["sentences"] > 20
     con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
     assert con.execute("select count(*) from frames where predicate = 'pour'").fetchone()[0] >= 5
+
+
+def test_train_flow_publishes_requested_settings(prefect_api, sample_dir, tmp_path):
+    from flows.frames import frames_flow
+    from flows.train import train_flow
+
+    ingest_flow(youcook2=[str(sample_dir / "youcook2")], data_dir=str(tmp_path))
+    frames_flow(shard_size=100, data_dir=str(tmp_path))
+    results = train_flow(settings=["frame-youcook2", "sentence-youcook2"], embedding=16, layers=1, max_epochs=2,
+                         data_dir=str(tmp_path))
+    assert [r["setting"] for r in results] == ["frame-youcook2", "sentence-youcook2"]
+    assert all((tmp_path / "checkpoints" / r["setting"] / "LATEST").exists() for r in results)
+    with pytest.raises(ValueError, match="unknown settings"):
+        train_flow(settings=["frame-nyc"], data_dir=str(tmp_path))

@@ -22,6 +22,7 @@ class PredicateSpec:
     preps: dict[str, frozenset[str]]
     particles: frozenset[str]
     alternating: bool
+    sentence: str  # "pour {Theme} into the {Destination}": the sentence-LM linearisation
 
     def prep_role(self, prep: str) -> str | None:
         """The role a prepositional phrase headed by `prep` fills, if any."""
@@ -51,6 +52,7 @@ def load_lexicon(path: str | None = None) -> Lexicon:
             name=name, roles=tuple(spec["roles"]), object_role=spec["object"], with_role=spec.get("with"),
             preps={role: frozenset(p) for role, p in spec.get("preps", {}).items()},
             particles=frozenset(spec.get("particles", [])), alternating=bool(spec.get("alternating")),
+            sentence=spec["sentence"],
         )
         for name, spec in data["predicates"].items()
     }

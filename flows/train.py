@@ -1,0 +1,55 @@
+"""Train flow: one task per requested (linearization, corpus) setting, each publishing a checkpoint.
+
+Settings train one after another: each uses every core through torch's threads already.
+"""
+
+from __future__ import annotations
+
+from prefect import flow, get_run_logger, task
+from prefect.artifacts import create_table_artifact
+
+from lmcr.config import paths_from_env
+from lmcr.lm.corpus import SETTINGS
+from lmcr.lm.linearize import LINEARIZATIONS
+from lmcr.lm.model import LMConfig
+from lmcr.lm.run import train_setting
+from lmcr.lm.train import TrainConfig
+from lmcr.store import connect
+
+ALL_SETTINGS = [f"{lin}-{corpus}" for lin in LINEARIZATIONS for corpus in SETTINGS]
+
+
+@task(name="train-setting", task_run_name="train {setting}")
+def train_task(setting: str, db: str | None, data_dir: str | None, embedding: int, layers: int,
+               max_epochs: int) -> dict:
+    """Train and publish one setting; returns its best validation perplexity and checkpoint."""
+    logger = get_run_logger()
+    linearization, corpus = setting.split("-", 1)
+    paths = paths_from_env(data_dir=data_dir, db=db)
+    with connect(paths.db, paths.sql_dir) as con:
+        path = train_setting(
+            con, paths.checkpoints, linearization, corpus, LMConfig(0, embedding, layers),
+            TrainConfig(max_epochs=max_epochs),
+            on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
+                                             row["val_ppl"], row["tokens_per_s"]),
+        )
+        best = con.execute("select best_val_ppl from lm_runs where checkpoint = ?", [str(path)]).fetchone()[0]
+    return {"setting": setting, "best_val_ppl": round(best, 2), "checkpoint": str(path)}
+
+
+@flow(name="train")
+def train_flow(
+    settings: list[str] = ALL_SETTINGS,  # noqa: B006 - Prefect parameters must be JSON
+    embedding: int = 256,
+    layers: int = 2,
+    max_epochs: int = 8,
+    db: str | None = None,
+    data_dir: str | None = None,
+) -> list[dict]:
+    """Train the requested settings (default: both linearisations x youcook2/recipes/all)."""
+    unknown = sorted(set(settings) - set(ALL_SETTINGS))
+    if unknown:
+        raise ValueError(f"unknown settings {unknown}; choose from {ALL_SETTINGS}")
+    results = [train_task(s, db, data_dir, embedding, layers, max_epochs) for s in settings]
+    create_table_artifact(key="lm-checkpoints", table=results, description="Published language models")
+    return results

@@ -1,0 +1,1 @@
+"""Language models that score how plausible a complete verb frame is (frame- or sentence-linearised)."""

@@ -1,0 +1,74 @@
+"""Training text for each setting: corpus sentences (sentence LM) or linearised frames (frame LM)."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import duckdb
+
+from lmcr.lm.data import split_by_document
+from lmcr.lm.linearize import LINEARIZATIONS, frame_text, tokens
+from lmcr.srl.lexicon import load_lexicon
+
+SETTINGS = ("youcook2", "recipes", "all")
+
+
+@dataclass
+class TrainingText:
+    """Token sequences split by document into train and validation, plus what they came from."""
+
+    train: list[list[str]]
+    val: list[list[str]]
+    provenance: dict
+
+
+def _corpus_filter(setting: str) -> str:
+    if setting not in SETTINGS:
+        raise ValueError(f"corpus must be one of {SETTINGS}, not {setting!r}")
+    return "" if setting == "all" else f"and s.corpus = '{setting}'"
+
+
+def sentence_sequences(con: duckdb.DuckDBPyConnection, setting: str, kinds: tuple[str, ...]) -> list[tuple[str, list[str]]]:
+    rows = con.execute(
+        f"select s.doc_id, s.text from sentences s where list_contains(?, s.kind) {_corpus_filter(setting)} "
+        "order by s.corpus, s.doc_id, s.sent_id", [list(kinds)]).fetchall()
+    return [(doc, tokens(text)) for doc, text in rows]
+
+
+def frame_sequences(con: duckdb.DuckDBPyConnection, setting: str) -> list[tuple[str, list[str]]]:
+    """Every frame with at least one role value, linearised: robot predicates in lexicon role order,
+    generic frames in the order their arguments appear in the sentence."""
+    rows = con.execute(
+        "select s.doc_id, s.predicate, list(r.role order by r.span_start), list(r.value order by r.span_start) "
+        "from frames s join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
+        f"where r.value is not null {_corpus_filter(setting)} "
+        "group by s.corpus, s.doc_id, s.sent_id, s.frame_no, s.predicate order by s.corpus, s.doc_id, s.sent_id, s.frame_no"
+    ).fetchall()
+    lex = load_lexicon()
+    return [(doc, tokens(frame_text(pred, dict(zip(roles, values)), lex))) for doc, pred, roles, values in rows]
+
+
+def corpus_hash(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
+    """Content hash of what the text came from: the ingested files, and the frame build for frames."""
+    files = con.execute("select source_file, sha256 from ingested_files order by all").fetchall()
+    build = con.execute("select fingerprint from frame_builds order by built_at desc limit 1").fetchone()
+    return hashlib.sha256(repr((files, build if linearization == "frame" else None)).encode()).hexdigest()
+
+
+def training_text(con: duckdb.DuckDBPyConnection, linearization: str, setting: str,
+                  kinds: tuple[str, ...] = ("instruction",)) -> TrainingText:
+    """The setting's sequences for a linearisation, split by document (5% held out)."""
+    if linearization not in LINEARIZATIONS:
+        raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {linearization!r}")
+    pairs = (sentence_sequences(con, setting, kinds) if linearization == "sentence"
+             else frame_sequences(con, setting))
+    pairs = [(doc, seq) for doc, seq in pairs if len(seq) >= 2]
+    held = split_by_document([doc for doc, _ in pairs])
+    return TrainingText(
+        train=[seq for (_, seq), h in zip(pairs, held) if not h],
+        val=[seq for (_, seq), h in zip(pairs, held) if h],
+        provenance={"linearization": linearization, "corpus": setting,
+                    "kinds": list(kinds) if linearization == "sentence" else "frames",
+                    "corpus_sha256": corpus_hash(con, linearization)},
+    )

@@ -1,0 +1,51 @@
+"""Linearisations and the tokeniser shared by training and scoring.
+
+Frame-based: `(pour, Theme: water, Destination: cup)` -> "pour water cup" (predicate, then role values
+in the lexicon's role order; generic frames in their stored order). Sentence-based: the predicate's
+template from the lexicon, "pour water into the cup". Both are lowercased and tokenised by `tokens`,
+which is also what the sentence LM's training sentences go through: one casing policy everywhere.
+"""
+
+from __future__ import annotations
+
+import re
+
+from lmcr.srl.lexicon import Lexicon, load_lexicon
+
+LINEARIZATIONS = ("frame", "sentence")
+_TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)?|\d+(?:[./]\d+)?")
+NUMBER = "<num>"
+
+
+def tokens(text: str) -> list[str]:
+    """Lowercase word tokens; numbers become one placeholder (quantities say nothing about plausibility)."""
+    return [NUMBER if t[0].isdigit() else t for t in _TOKEN.findall(text.lower())]
+
+
+def frame_text(predicate: str, roles: dict[str, str | None], lex: Lexicon | None = None) -> str:
+    """'pour water cup': predicate and filled role values, robot predicates in lexicon role order."""
+    lex = lex or load_lexicon()
+    spec = lex.predicates.get(predicate)
+    order = list(spec.roles) if spec else list(roles)
+    return " ".join([predicate] + [roles[r] for r in order if roles.get(r)])
+
+
+def sentence_text(predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:
+    """'pour water into the cup': the lexicon's sentence template with every role filled."""
+    lex = lex or load_lexicon()
+    spec = lex.predicates.get(predicate)
+    if spec is None:
+        raise KeyError(f"no sentence template for predicate {predicate!r}")
+    missing = [r for r in spec.roles if not roles.get(r)]
+    if missing:
+        raise ValueError(f"cannot linearise {predicate} with {missing} unfilled")
+    return spec.sentence.format(**roles)
+
+
+def linearize(linearization: str, predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:
+    """The text a model of the given linearisation scores for a complete frame."""
+    if linearization == "frame":
+        return frame_text(predicate, roles, lex)
+    if linearization == "sentence":
+        return sentence_text(predicate, roles, lex)
+    raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {linearization!r}")

@@ -1,0 +1,71 @@
+"""Train one setting end to end: text from the store, vocabulary, model, training, published checkpoint."""
+
+from __future__ import annotations
+
+import subprocess
+import uuid
+from dataclasses import replace
+from pathlib import Path
+from typing import Callable
+
+import duckdb
+
+import lmcr
+from lmcr.config import REPO_ROOT
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.corpus import training_text
+from lmcr.lm.model import LMConfig, RecurrentLM
+from lmcr.lm.train import TrainConfig, train_lm
+from lmcr.lm.vocab import Vocab
+
+
+def code_version() -> str:
+    """Package version and, in a git checkout, the commit."""
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO_ROOT, capture_output=True,
+                                text=True, timeout=5).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        commit = ""
+    return f"{lmcr.__version__}+{commit}" if commit else lmcr.__version__
+
+
+def train_setting(
+    con: duckdb.DuckDBPyConnection,
+    checkpoints: Path,
+    linearization: str,
+    corpus: str,
+    model_config: LMConfig | None = None,
+    train_config: TrainConfig = TrainConfig(),
+    min_freq: int = 3,
+    max_vocab: int = 30_000,
+    on_epoch: Callable[[dict], None] | None = None,
+) -> Path:
+    """Train `linearization` on `corpus`, publish the checkpoint as the setting's latest, record metrics."""
+    text = training_text(con, linearization, corpus)
+    if not text.train or not text.val:
+        raise ValueError(f"no {linearization} training text for corpus {corpus!r}: run ingest (and frames) first")
+    vocab = Vocab.build(text.train, min_freq=min_freq, max_size=max_vocab)
+    config = replace(model_config or LMConfig(0), vocab_size=len(vocab))
+    model = RecurrentLM(config)
+    run_id = uuid.uuid4().hex[:12]
+    con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size) "
+                "values (?, ?, ?, ?, ?, ?)", [run_id, linearization, corpus, len(text.train), len(text.val), len(vocab)])
+
+    def record(row: dict) -> None:
+        con.execute("insert into lm_epochs values (?, ?, ?, ?, ?, ?, ?, ?)",
+                    [run_id, row["epoch"], row["train_ppl"], row["val_ppl"], row["tokens_per_s"], row["seconds"],
+                     row["device"], row["objective"]])
+        if on_epoch:
+            on_epoch(row)
+
+    history = train_lm(model, [vocab.encode(s) for s in text.train], [vocab.encode(s) for s in text.val],
+                       train_config, record)
+    best = min(row["val_ppl"] for row in history)
+    metrics = {"best_val_ppl": best, "history": history, "train_sequences": len(text.train),
+               "val_sequences": len(text.val)}
+    provenance = {**text.provenance, "code_version": code_version(), "train_config": train_config.to_json(),
+                  "min_freq": min_freq, "run_id": run_id}
+    path = ckpt.publish(checkpoints, f"{linearization}-{corpus}", model.cpu(), vocab, linearization, metrics,
+                        provenance)
+    con.execute("update lm_runs set best_val_ppl = ?, checkpoint = ? where run_id = ?", [best, str(path), run_id])
+    return path

@@ -1,0 +1,123 @@
+"""Batched log-probabilities of many texts at once, sharing work across common prefixes.
+
+Candidate frames share most of their text ("pour water into the cup", "... the mug", ...). The texts
+are put in a token trie and evaluated level by level: one batched LSTM step per depth for every node
+that has children, one softmax per such node, and each text's score is the sum of its edges' log-
+probabilities. Cost grows with the number of distinct prefixes, not with the number of texts.
+
+Normalisation (`norm`): "sum" is the total log-probability, "mean" divides by the number of scored
+tokens (longer object names are not penalised for their length). The end-of-sentence token is not
+scored by default: the sentence LM learned instruction sentences that usually continue ("... and
+stir"), so P(</s>) measures sentence length habits, not plausibility. An unknown word is charged
+log(unk_types) on top of P(<unk>): its share of the probability the model pools over rare words.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import math
+
+import torch
+from torch.nn import functional as F
+
+from lmcr.lm.checkpoint import Checkpoint
+from lmcr.lm.linearize import linearize, tokens
+from lmcr.lm.vocab import UNK
+
+NORMS = ("sum", "mean")
+
+
+@dataclass
+class _Trie:
+    parent: list[int]
+    token: list[int]
+    depth: list[int]
+    has_children: list[bool]
+    leaf_of: list[int]
+
+    @classmethod
+    def build(cls, seqs: list[list[int]]) -> _Trie:
+        trie = cls([-1], [seqs[0][0] if seqs else 0], [0], [False], [])
+        index: dict[tuple[int, int], int] = {}
+        for seq in seqs:
+            node = 0
+            for tok in seq[1:]:
+                child = index.get((node, tok))
+                if child is None:
+                    child = index[(node, tok)] = len(trie.parent)
+                    trie.parent.append(node)
+                    trie.token.append(tok)
+                    trie.depth.append(trie.depth[node] + 1)
+                    trie.has_children.append(False)
+                trie.has_children[node] = True
+                node = child
+            trie.leaf_of.append(node)
+        return trie
+
+
+class LMScorer:
+    """Scores texts or complete frames with a loaded checkpoint."""
+
+    def __init__(self, checkpoint: Checkpoint, score_end: bool = False, chunk: int = 50_000):
+        self.checkpoint = checkpoint
+        self.model = checkpoint.model.eval()
+        self.vocab = checkpoint.vocab
+        self.score_end = score_end
+        self.chunk = chunk
+
+    def encode(self, text: str) -> list[int]:
+        ids = self.vocab.encode(tokens(text))
+        return ids if self.score_end else ids[:-1]
+
+    def logprobs(self, texts: list[str]) -> list[tuple[float, int]]:
+        """(total log-probability, number of scored tokens) for each text."""
+        out: list[tuple[float, int]] = []
+        for start in range(0, len(texts), self.chunk):
+            seqs = [self.encode(t) for t in texts[start:start + self.chunk]]
+            totals = self._score(seqs)
+            out += [(totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
+        return out
+
+    def score(self, texts: list[str], norm: str = "mean") -> list[float]:
+        if norm not in NORMS:
+            raise ValueError(f"norm must be one of {NORMS}")
+        return [total / max(n, 1) if norm == "mean" else total for total, n in self.logprobs(texts)]
+
+    def score_frames(self, frames: list[tuple[str, dict[str, str]]], norm: str = "mean") -> list[float]:
+        """Scores of complete frames (predicate, roles) in this checkpoint's linearisation."""
+        lin = self.checkpoint.linearization
+        return self.score([linearize(lin, predicate, roles) for predicate, roles in frames], norm)
+
+    @torch.no_grad()
+    def _score(self, seqs: list[list[int]]) -> list[float]:
+        if not seqs:
+            return []
+        trie = _Trie.build(seqs)
+        model = self.model
+        edge = torch.zeros(len(trie.parent))
+        levels: dict[int, list[int]] = {}
+        for node, depth in enumerate(trie.depth):
+            levels.setdefault(depth, []).append(node)
+        # Root: <s> from a zero state. Only nodes with children are ever advanced.
+        out, state = model.rnn(model.embed(torch.tensor([[trie.token[0]]])))
+        frontier_out, frontier_pos = out[:, 0], {0: 0}
+        for depth in range(1, max(levels) + 1):
+            nodes = levels[depth]
+            parents = [frontier_pos[trie.parent[n]] for n in nodes]
+            logp = F.log_softmax(model.decoder(frontier_out), dim=-1)  # (P, V) for the frontier nodes
+            edge[nodes] = logp[parents, [trie.token[n] for n in nodes]]
+            grow = [n for n in nodes if trie.has_children[n]]
+            if not grow:
+                break
+            pick = torch.tensor([frontier_pos[trie.parent[n]] for n in grow])
+            x = model.embed(torch.tensor([trie.token[n] for n in grow])).unsqueeze(1)  # (G, 1, E)
+            out, state = model.rnn(x, (state[0][:, pick], state[1][:, pick]))
+            frontier_out, frontier_pos = out[:, 0], {n: i for i, n in enumerate(grow)}
+        # An unknown word gets its share of <unk>'s pooled probability, not all of it.
+        unk, share = self.vocab.words.index(UNK), math.log(self.vocab.unk_types)
+        edge[torch.tensor(trie.token) == unk] -= share
+        total = edge.tolist()
+        for node in range(1, len(total)):  # parents precede children: cumulative sums in one pass
+            total[node] += total[trie.parent[node]]
+        return [total[leaf] for leaf in trie.leaf_of]

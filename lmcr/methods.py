@@ -1,0 +1,99 @@
+"""Frame scorers behind one interface: complete frames in, one float each out (higher = more plausible)."""
+
+from __future__ import annotations
+
+import csv
+import os
+import random
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from lmcr.jsonl import InputError
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.score import LMScorer
+from lmcr.srl.lexicon import load_lexicon
+
+Frame = tuple[str, dict[str, str]]
+LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
+METHODS = ("sentence_lm", "frame_lm", "random")
+REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
+
+
+@dataclass(frozen=True)
+class FrameRow:
+    line: int
+    frame: Frame
+    raw: dict
+
+
+def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Path:
+    """The setting folder `<checkpoints>/<linearization>-<corpus>`, or `checkpoints` itself when it is one
+    checkpoint (a setting or version folder) of that linearisation."""
+    setting = checkpoints / f"{linearization}-{corpus}"
+    if setting.exists():
+        return setting
+    if (checkpoints / "LATEST").exists() or (checkpoints / "manifest.json").exists():
+        return checkpoints
+    raise ckpt.CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
+                               f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
+
+
+def make_scorer(method: str, checkpoints: Path, corpus: str = "all", seed: int = 0) -> Callable[[list[Frame]], list[float]]:
+    """A function scoring a list of complete frames with `method`."""
+    if method in LM_METHODS:
+        loaded = ckpt.load(lm_checkpoint_dir(checkpoints, LM_METHODS[method], corpus))
+        if loaded.linearization != LM_METHODS[method]:
+            raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {LM_METHODS[method]}")
+        scorer = LMScorer(loaded)
+        return scorer.score_frames
+    if method == "random":
+        rng = random.Random(seed)
+        return lambda frames: [rng.random() for _ in frames]
+    raise ValueError(f"unknown or not yet available method {method!r}; available: {', '.join(METHODS)}")
+
+
+def read_frames_csv(path: Path) -> tuple[list[str], list[FrameRow]]:
+    """Rows of a frames CSV (`verb, role1, arg1, role2, arg2`, other columns kept), validated against the
+    lexicon: a bad row fails with file, line and reason."""
+    lex = load_lexicon()
+    try:
+        handle = open(path, newline="", encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+    with handle:
+        reader = csv.DictReader(handle)
+        columns = reader.fieldnames or []
+        missing = [c for c in REQUIRED_COLUMNS if c not in columns]
+        if missing:
+            raise InputError(f"{path}:1: missing columns {missing}")
+        rows = []
+        for row in reader:
+            line = reader.line_num
+            verb = (row["verb"] or "").strip().lower()
+            spec = lex.predicates.get(verb)
+            if spec is None:
+                raise InputError(f"{path}:{line}: unknown verb {row['verb']!r} (one of {', '.join(sorted(lex.predicates))})")
+            roles = {(row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
+                     (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower()}
+            if set(roles) != set(spec.roles):
+                raise InputError(f"{path}:{line}: roles {sorted(roles)} are not {verb}'s {list(spec.roles)}")
+            if not all(roles.values()):
+                raise InputError(f"{path}:{line}: empty argument")
+            rows.append(FrameRow(line, (verb, roles), row))
+    return columns, rows
+
+
+def write_scores_csv(path: Path, columns: list[str], rows: list[FrameRow], scores: dict[str, list[float]]) -> None:
+    """Input columns plus one column per method, written under a temporary name and renamed."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "w", newline="", encoding="utf-8") as out:
+            writer = csv.DictWriter(out, fieldnames=columns + [m for m in scores if m not in columns])
+            writer.writeheader()
+            for k, row in enumerate(rows):
+                writer.writerow({**row.raw, **{m: f"{values[k]:.6f}" for m, values in scores.items()}})
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

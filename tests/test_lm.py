@@ -1,0 +1,119 @@
+"""Language models: linearisers, batching, an overfit-then-reload run, trie scoring, checkpoint integrity."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+import torch
+
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.data import bucket_batches, split_by_document
+from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
+from lmcr.lm.model import LMConfig, RecurrentLM
+from lmcr.lm.score import LMScorer
+from lmcr.lm.train import TrainConfig, train_lm
+from lmcr.lm.vocab import Vocab
+
+CORPUS = [
+    "pour the water into the cup", "pour the milk into the glass", "pour the wine into the glass",
+    "fill the pot with water", "fry the egg in the pan", "heat the oil in the skillet",
+    "sprinkle salt on the steak", "dip the bread in the soup", "blend the banana in the blender",
+] * 4
+
+
+def test_linearisations():
+    roles = {"Theme": "water", "Destination": "cup"}
+    assert frame_text("pour", roles) == "pour water cup"
+    assert sentence_text("pour", roles) == "pour water into the cup"
+    assert linearize("sentence", "fill", {"Destination": "pot", "Theme": "water"}) == "fill the pot with water"
+    assert frame_text("fill", {"Theme": "water", "Destination": "pot"}) == "fill pot water"  # lexicon role order
+    assert frame_text("add", {"Theme": "shallot", "to": "pan"}) == "add shallot pan"
+    with pytest.raises(ValueError, match="unfilled"):
+        sentence_text("pour", {"Theme": "water", "Destination": None})
+    assert tokens("Pour 1 1/2 cups of Milk's foam, then stir.") == [
+        "pour", "<num>", "<num>", "cups", "of", "milk's", "foam", "then", "stir"]
+
+
+def test_vocab_cutoff_and_unknowns():
+    vocab = Vocab.build([["a", "a", "b"], ["a", "c", "c"]], min_freq=2)
+    assert vocab.words[:4] == ("<pad>", "<unk>", "<s>", "</s>") and set(vocab.words[4:]) == {"a", "c"}
+    assert vocab.encode(["a", "b"]) == [2, vocab.words.index("a"), 1, 3]
+    assert vocab.unk_types == 1 and Vocab.build([["x", "y", "z"]], min_freq=2).unk_types == 3
+
+
+def test_bucketed_batches_waste_little_padding():
+    seqs = [[1] * n for n in [3, 9, 4, 8, 3, 9, 5, 4]]
+    batches = bucket_batches(seqs, max_tokens=18, seed=0)
+    assert sum(b.shape[0] for b in batches) == 8 and all(b.numel() <= 18 for b in batches)
+    waste = sum(b.numel() for b in batches) - sum(map(len, seqs))
+    naive = sum(2 * max(len(a), len(b)) for a, b in zip(seqs[::2], seqs[1::2])) - sum(map(len, seqs))
+    assert waste == 5 and naive == 17  # pairs in input order would pad more than three times as much
+    assert bucket_batches(seqs, 18, seed=0)[0].tolist() == batches[0].tolist()  # seeded order
+
+
+def test_validation_split_keeps_documents_whole():
+    keys = [f"recipes:{i // 3}" for i in range(30_000)]
+    held = split_by_document(keys)
+    assert all(held[i] == held[i - i % 3] for i in range(len(keys)))
+    assert 0.03 < sum(held) / len(held) < 0.07
+
+
+@pytest.fixture(scope="module")
+def overfit():
+    seqs = [tokens(t) for t in CORPUS]
+    vocab = Vocab.build(seqs, min_freq=1)
+    ids = [vocab.encode(s) for s in seqs]
+    model = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
+    history = train_lm(model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7))
+    return model, vocab, history
+
+
+def test_tiny_corpus_overfits(overfit):
+    _, _, history = overfit
+    assert history[-1]["val_ppl"] < 1.6 < history[0]["val_ppl"]
+
+
+def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
+    model, vocab, _ = overfit
+    path = ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})
+    scorer = LMScorer(ckpt.load(path))
+    texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
+    with torch.no_grad():
+        direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
+    assert [round(x, 4) for x, _ in scorer.logprobs(texts)] == [round(x, 4) for x in direct]  # no <unk> here
+    scorer.vocab = Vocab(vocab.words, unk_types=50)
+    unknown = scorer.logprobs(["pour water into the teapot"])[0][0]
+    with torch.no_grad():
+        pooled = float(model.token_logprobs(torch.tensor([scorer.encode("pour water into the teapot")])).sum())
+    assert abs(unknown - (pooled - math.log(50))) < 1e-4  # the rare word's share of <unk>
+    scorer.vocab = vocab
+    cup, scissors = scorer.score_frames([("pour", {"Theme": "water", "Destination": "cup"}),
+                                         ("pour", {"Theme": "water", "Destination": "scissors"})])
+    assert cup > scissors
+
+
+def test_publish_reload_identical_and_latest(overfit, tmp_path):
+    model, vocab, history = overfit
+    first = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {"history": history}, {"corpus": "x"})
+    reloaded = ckpt.load(tmp_path / "frame-test")  # through LATEST
+    assert reloaded.path == first and reloaded.linearization == "frame"
+    texts = ["pour water cup", "pour water glass"]
+    assert LMScorer(reloaded).score(texts) == LMScorer(ckpt.load(first)).score(texts)
+    for name, tensor in model.state_dict().items():
+        assert torch.equal(tensor.cpu(), reloaded.model.state_dict()[name])
+    second = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {}, {}, promote=False)
+    assert ckpt.resolve(tmp_path / "frame-test") == first and second.exists()
+    assert not list((tmp_path / "frame-test").glob(".*.tmp"))
+
+
+def test_tampered_checkpoint_is_refused(overfit, tmp_path):
+    model, vocab, _ = overfit
+    path = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {}, {})
+    (path / "vocab.json").write_text(json.dumps({"words": list(vocab.words)[::-1], "unk_types": 1}))
+    with pytest.raises(ckpt.CheckpointError, match="vocab.json: sha256 differs"):
+        ckpt.load(path)
+    (path / "manifest.json").unlink()
+    with pytest.raises(ckpt.CheckpointError, match="no manifest.json"):
+        ckpt.load(path)

