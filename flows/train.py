@@ -26,13 +26,13 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
     logger = get_run_logger()
     linearization, corpus = setting.split("-", 1)
     paths = paths_from_env(data_dir=data_dir, db=db)
+    path = train_setting(
+        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+        LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs),
+        on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
+                                         row["val_ppl"], row["tokens_per_s"]),
+    )
     with connect(paths.db, paths.sql_dir) as con:
-        path = train_setting(
-            con, paths.checkpoints, linearization, corpus, LMConfig(0, embedding, layers),
-            TrainConfig(max_epochs=max_epochs),
-            on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
-                                             row["val_ppl"], row["tokens_per_s"]),
-        )
         best = con.execute("select best_val_ppl from lm_runs where checkpoint = ?", [str(path)]).fetchone()[0]
     return {"setting": setting, "best_val_ppl": round(best, 2), "checkpoint": str(path)}
 

@@ -151,8 +151,8 @@ def train(
                       f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']} ({row['seconds']:.0f}s)")
 
     try:
-        con = connect(paths.db, paths.sql_dir)
-        path = train_setting(con, paths.checkpoints, linearization, corpus, LMConfig(0, embedding, layers, dropout),
+        path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+                             LMConfig(0, embedding, layers, dropout),
                              TrainConfig(max_epochs=max_epochs, lr=lr, batch_tokens=batch_tokens, device=device),
                              min_freq=min_freq, on_epoch=show)
     except (MigrationError, ValueError) as exc:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from contextlib import nullcontext
 
 import pytest
 from typer.testing import CliRunner
@@ -52,7 +53,8 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     paths, con = sample_store
     small = LMConfig(0, embedding=32, layers=1, dropout=0.1)
     for lin in ("sentence", "frame"):
-        path = train_setting(con, paths.checkpoints, lin, "all", small, TrainConfig(max_epochs=3, lr=0.01))
+        path = train_setting(lambda: nullcontext(con), paths.checkpoints, lin, "all", small,
+                             TrainConfig(max_epochs=3, lr=0.01))
         loaded = ckpt.load(path)
         assert loaded.provenance["corpus"] == "all" and loaded.metrics["history"]
     runs = con.execute("select linearization, count(*) from lm_runs r join lm_epochs e using (run_id) "

@@ -13,7 +13,7 @@ import duckdb
 import lmcr
 from lmcr.config import REPO_ROOT
 from lmcr.lm import checkpoint as ckpt
-from lmcr.lm.corpus import training_text
+from lmcr.lm.corpus import TrainingText, training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
@@ -30,7 +30,7 @@ def code_version() -> str:
 
 
 def train_setting(
-    con: duckdb.DuckDBPyConnection,
+    open_store: Callable[[], duckdb.DuckDBPyConnection],
     checkpoints: Path,
     linearization: str,
     corpus: str,
@@ -40,26 +40,20 @@ def train_setting(
     max_vocab: int = 30_000,
     on_epoch: Callable[[dict], None] | None = None,
 ) -> Path:
-    """Train `linearization` on `corpus`, publish the checkpoint as the setting's latest, record metrics."""
-    text = training_text(con, linearization, corpus)
+    """Train `linearization` on `corpus`, publish the checkpoint as the setting's latest, record metrics.
+
+    The store is opened (`open_store`) only to read the text and, afterwards, to record the run: DuckDB
+    admits one writing process, and training takes long enough that holding it would lock users out.
+    """
+    with open_store() as con:
+        text = training_text(con, linearization, corpus)
     if not text.train or not text.val:
         raise ValueError(f"no {linearization} training text for corpus {corpus!r}: run ingest (and frames) first")
     vocab = Vocab.build(text.train, min_freq=min_freq, max_size=max_vocab)
-    config = replace(model_config or LMConfig(0), vocab_size=len(vocab))
-    model = RecurrentLM(config)
-    run_id = uuid.uuid4().hex[:12]
-    con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size) "
-                "values (?, ?, ?, ?, ?, ?)", [run_id, linearization, corpus, len(text.train), len(text.val), len(vocab)])
-
-    def record(row: dict) -> None:
-        con.execute("insert into lm_epochs values (?, ?, ?, ?, ?, ?, ?, ?)",
-                    [run_id, row["epoch"], row["train_ppl"], row["val_ppl"], row["tokens_per_s"], row["seconds"],
-                     row["device"], row["objective"]])
-        if on_epoch:
-            on_epoch(row)
-
+    model = RecurrentLM(replace(model_config or LMConfig(0), vocab_size=len(vocab)))
     history = train_lm(model, [vocab.encode(s) for s in text.train], [vocab.encode(s) for s in text.val],
-                       train_config, record)
+                       train_config, on_epoch)
+    run_id = uuid.uuid4().hex[:12]
     best = min(row["val_ppl"] for row in history)
     metrics = {"best_val_ppl": best, "history": history, "train_sequences": len(text.train),
                "val_sequences": len(text.val)}
@@ -67,5 +61,20 @@ def train_setting(
                   "min_freq": min_freq, "run_id": run_id}
     path = ckpt.publish(checkpoints, f"{linearization}-{corpus}", model.cpu(), vocab, linearization, metrics,
                         provenance)
-    con.execute("update lm_runs set best_val_ppl = ?, checkpoint = ? where run_id = ?", [best, str(path), run_id])
+    with open_store() as con:
+        record_run(con, run_id, text, len(vocab), history, path)
     return path
+
+
+def record_run(con: duckdb.DuckDBPyConnection, run_id: str, text: TrainingText, vocab_size: int,
+               history: list[dict], path: Path) -> None:
+    """One lm_runs row and its lm_epochs rows, in one transaction."""
+    con.execute("begin transaction")
+    con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size,"
+                " best_val_ppl, checkpoint) values (?, ?, ?, ?, ?, ?, ?, ?)",
+                [run_id, text.provenance["linearization"], text.provenance["corpus"], len(text.train), len(text.val),
+                 vocab_size, min(r["val_ppl"] for r in history), str(path)])
+    con.executemany("insert into lm_epochs values (?, ?, ?, ?, ?, ?, ?, ?)",
+                    [[run_id, r["epoch"], r["train_ppl"], r["val_ppl"], r["tokens_per_s"], r["seconds"], r["device"],
+                      r["objective"]] for r in history])
+    con.execute("commit")

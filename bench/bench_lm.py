@@ -1,0 +1,140 @@
+"""Benchmark: LMCR's LM training vs the PyTorch word_language_model example configuration, and scoring.
+
+Usage: python bench/bench_lm.py [--db STORE] [--tokens N] [--checkpoint DIR]
+1. Both trainers get the same recipe sentences (first N training tokens, same vocabulary, same
+   held-out documents) for one epoch on this machine. The reference is the example's default
+   configuration re-implemented: 2-layer LSTM, 200 embedding/hidden, dropout 0.2, untied, full
+   softmax, a continuous token stream in 20 columns, BPTT 35, SGD lr 20, clip 0.25. Prints tokens/s,
+   validation perplexity (per sentence, both the same way) and the speed ratio.
+2. Scoring: candidate frames/s for every verb x object x object combination of the robot's vocabulary
+   with a published checkpoint (if given).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import time
+from pathlib import Path
+
+import duckdb
+import torch
+from torch import nn
+
+from lmcr.config import paths_from_env
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.corpus import training_text
+from lmcr.lm.model import LMConfig, RecurrentLM
+from lmcr.lm.score import LMScorer
+from lmcr.lm.train import TrainConfig, perplexity, train_lm
+from lmcr.lm.vocab import Vocab
+from lmcr.srl.lexicon import load_lexicon
+
+OBJECTS = ["water", "milk", "wine", "oil", "vinegar", "honey", "soy sauce", "chocolate", "batter", "salt", "sugar",
+           "flour", "black pepper", "cinnamon", "parsley", "cheese", "onion", "garlic", "potato", "tomato", "banana",
+           "strawberry", "apple", "bell pepper", "egg", "bread", "steak", "chicken", "fish", "rice", "pasta", "salad",
+           "soup", "cake", "pizza", "butter", "ice", "cup", "glass", "mug", "bowl", "plate", "pan", "pot", "skillet",
+           "blender", "microwave", "oven", "sink", "cutting board", "knife", "spoon", "scissors", "sponge", "towel",
+           "pastry brush"]
+
+
+class ExampleLM(nn.Module):
+    """The word_language_model example's LSTM model at its defaults (untied, full softmax)."""
+
+    def __init__(self, vocab: int, size: int = 200, layers: int = 2, dropout: float = 0.2):
+        super().__init__()
+        self.drop = nn.Dropout(dropout)
+        self.encoder = nn.Embedding(vocab, size)
+        self.rnn = nn.LSTM(size, size, layers, dropout=dropout)
+        self.decoder = nn.Linear(size, vocab)
+
+    def forward(self, x, hidden):
+        out, hidden = self.rnn(self.drop(self.encoder(x)), hidden)
+        return self.decoder(self.drop(out)), hidden
+
+
+def train_example(stream: torch.Tensor, vocab: int, batch: int = 20, bptt: int = 35) -> float:
+    """One epoch of the example's training loop; returns tokens/s."""
+    torch.manual_seed(1111)
+    model, loss_fn = ExampleLM(vocab), nn.CrossEntropyLoss()
+    cols = stream[: stream.numel() // batch * batch].view(batch, -1).t().contiguous()  # (L, B)
+    hidden = None
+    model.train()
+    started = time.perf_counter()
+    for i in range(0, cols.size(0) - 1, bptt):
+        seq = min(bptt, cols.size(0) - 1 - i)
+        x, y = cols[i:i + seq], cols[i + 1:i + 1 + seq]
+        hidden = None if hidden is None else tuple(h.detach() for h in hidden)
+        model.zero_grad()
+        out, hidden = model(x, hidden)
+        loss_fn(out.view(-1, vocab), y.reshape(-1)).backward()
+        nn.utils.clip_grad_norm_(model.parameters(), 0.25)
+        with torch.no_grad():
+            for p in model.parameters():
+                p.add_(p.grad, alpha=-20.0)
+    tokens_per_s = cols.numel() / (time.perf_counter() - started)
+    train_example.model = model
+    return tokens_per_s
+
+
+@torch.no_grad()
+def example_val_ppl(model: ExampleLM, val: list[list[int]], vocab: int) -> float:
+    """Per-sentence perplexity (fresh state per sentence), the same measure LMCR's trainer reports."""
+    model.eval()
+    total, count = 0.0, 0
+    for seq in val:
+        x = torch.tensor(seq[:-1]).unsqueeze(1)
+        out, _ = model(x, None)
+        total += float(nn.functional.cross_entropy(out.view(-1, vocab), torch.tensor(seq[1:]), reduction="sum"))
+        count += len(seq) - 1
+    return math.exp(total / count)
+
+
+def scoring_speed(path: Path) -> str:
+    scorer = LMScorer(ckpt.load(path))
+    lex = load_lexicon()
+    frames = [(verb, dict(zip(spec.roles, pair))) for verb, spec in lex.predicates.items()
+              for pair in itertools.permutations(OBJECTS, 2)]
+    scorer.score_frames(frames[:500])  # warm-up
+    started = time.perf_counter()
+    scorer.score_frames(frames)
+    wall = time.perf_counter() - started
+    return f"scoring {scorer.checkpoint.path.parent.name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--db", type=Path, default=None)
+    parser.add_argument("--tokens", type=int, default=1_000_000)
+    parser.add_argument("--checkpoint", type=Path, action="append", default=[])
+    args = parser.parse_args()
+    paths = paths_from_env(db=args.db)
+    con = duckdb.connect(str(paths.db), read_only=True)
+    text = training_text(con, "sentence", "recipes")
+    train, budget = [], args.tokens
+    for seq in text.train:
+        if budget <= 0:
+            break
+        train.append(seq[:60])
+        budget -= len(seq) + 1
+    val = [s[:60] for s in text.val[:3000]]
+    vocab = Vocab.build(train, min_freq=3)
+    train_ids, val_ids = [vocab.encode(s) for s in train], [vocab.encode(s) for s in val]
+    stream = torch.tensor([t for s in train_ids for t in s[1:]])  # the example's <eos>-separated stream
+    ref_speed = train_example(stream, len(vocab))
+    ref_ppl = example_val_ppl(train_example.model, val_ids, len(vocab))
+    print(f"reference (word_language_model defaults): {ref_speed:,.0f} tokens/s, val ppl {ref_ppl:.1f} after 1 epoch")
+    model = RecurrentLM(LMConfig(len(vocab)))
+    history = train_lm(model, train_ids, val_ids, TrainConfig(max_epochs=1))
+    ours = history[-1]
+    ppl = perplexity(model, val_ids, 6000, torch.device("cpu"))
+    print(f"lmcr (defaults, {ours['objective']} softmax): {ours['tokens_per_s']:,.0f} tokens/s, val ppl {ppl:.1f} after 1 epoch")
+    print(f"speed ratio {ours['tokens_per_s'] / ref_speed:.2f}x at val ppl {ppl:.1f} vs {ref_ppl:.1f} "
+          f"({stream.numel():,} tokens, vocabulary {len(vocab):,})")
+    for path in args.checkpoint:
+        print(scoring_speed(path))
+
+
+if __name__ == "__main__":
+    main()
