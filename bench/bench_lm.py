@@ -1,18 +1,20 @@
 """Benchmark: LMCR's LM training vs the PyTorch word_language_model example configuration, and scoring.
 
-Usage: python bench/bench_lm.py [--db STORE] [--tokens N] [--checkpoint DIR]
+Usage: python bench/bench_lm.py [--db STORE] [--tokens N] [--checkpoint DIR ...] [--ratings CSV] [--skip-training]
 1. Both trainers get the same recipe sentences (first N training tokens, same vocabulary, same
    held-out documents) for one epoch on this machine. The reference is the example's default
    configuration re-implemented: 2-layer LSTM, 200 embedding/hidden, dropout 0.2, untied, full
    softmax, a continuous token stream in 20 columns, BPTT 35, SGD lr 20, clip 0.25. Prints tokens/s,
    validation perplexity (per sentence, both the same way) and the speed ratio.
 2. Scoring: candidate frames/s for every verb x object x object combination of the robot's vocabulary
-   with a published checkpoint (if given).
+   with each published checkpoint given, and with --ratings the Spearman correlation of its `sum` and
+   `mean` scores with the mean dev rating (how the default normalisation was chosen).
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import itertools
 import math
 import time
@@ -20,6 +22,7 @@ from pathlib import Path
 
 import duckdb
 import torch
+from scipy.stats import spearmanr
 from torch import nn
 
 from lmcr.config import paths_from_env
@@ -103,12 +106,53 @@ def scoring_speed(path: Path) -> str:
     return f"scoring {scorer.checkpoint.path.parent.name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s"
 
 
+def dev_frames(ratings_csv: Path) -> list[tuple[tuple[str, dict[str, str]], float]]:
+    """(frame, mean rating) from an MTurk batch-results file: rejected assignments, repeated downloads of
+    an assignment and answers outside 1..5 are left out (the full ingestion is `lmcr annotate`)."""
+    ratings: dict[tuple, list[int]] = {}
+    seen: set[str] = set()
+    with open(ratings_csv, newline="", encoding="utf-8") as handle:
+        for row in csv.DictReader(handle):
+            if row["AssignmentStatus"] == "Rejected" or row["AssignmentId"] in seen:
+                continue
+            seen.add(row["AssignmentId"])
+            for k in itertools.count(1):
+                if f"Input.verb_{k}" not in row:
+                    break
+                verb, answer = row[f"Input.verb_{k}"], row.get(f"Answer.rating_{k}", "")
+                if not verb or not answer.isdigit() or not 1 <= int(answer) <= 5:
+                    continue
+                key = (verb, row[f"Input.role1_{k}"], row[f"Input.arg1_{k}"], row[f"Input.role2_{k}"], row[f"Input.arg2_{k}"])
+                ratings.setdefault(key, []).append(int(answer))
+    return [((v, {r1: a1, r2: a2}), sum(x) / len(x)) for (v, r1, a1, r2, a2), x in ratings.items()]
+
+
+def normalisation_check(path: Path, ratings_csv: Path) -> str:
+    """Spearman correlation of each normalisation's scores with the mean crowd rating."""
+    scorer = LMScorer(ckpt.load(path))
+    rated = dev_frames(ratings_csv)
+    means = [m for _, m in rated]
+    parts = []
+    for norm in ("sum", "mean"):
+        rho = spearmanr(scorer.score_frames([f for f, _ in rated], norm=norm), means).statistic
+        parts.append(f"{norm}: rho={rho:.3f}")
+    return f"{scorer.checkpoint.path.parent.name} on {len(rated)} rated dev frames: " + ", ".join(parts)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--db", type=Path, default=None)
     parser.add_argument("--tokens", type=int, default=1_000_000)
     parser.add_argument("--checkpoint", type=Path, action="append", default=[])
+    parser.add_argument("--ratings", type=Path, default=None, help="dev ratings (MTurk CSV) for the normalisation check")
+    parser.add_argument("--skip-training", action="store_true")
     args = parser.parse_args()
+    for path in args.checkpoint:
+        print(scoring_speed(path))
+        if args.ratings:
+            print(normalisation_check(path, args.ratings))
+    if args.skip_training:
+        return
     paths = paths_from_env(db=args.db)
     con = duckdb.connect(str(paths.db), read_only=True)
     text = training_text(con, "sentence", "recipes")
@@ -132,8 +176,6 @@ def main() -> None:
     print(f"lmcr (defaults, {ours['objective']} softmax): {ours['tokens_per_s']:,.0f} tokens/s, val ppl {ppl:.1f} after 1 epoch")
     print(f"speed ratio {ours['tokens_per_s'] / ref_speed:.2f}x at val ppl {ppl:.1f} vs {ref_ppl:.1f} "
           f"({stream.numel():,} tokens, vocabulary {len(vocab):,})")
-    for path in args.checkpoint:
-        print(scoring_speed(path))
 
 
 if __name__ == "__main__":

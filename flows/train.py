@@ -21,14 +21,14 @@ ALL_SETTINGS = [f"{lin}-{corpus}" for lin in LINEARIZATIONS for corpus in SETTIN
 
 @task(name="train-setting", task_run_name="train {setting}")
 def train_task(setting: str, db: str | None, data_dir: str | None, embedding: int, layers: int,
-               max_epochs: int) -> dict:
+               max_epochs: int, max_minutes: float | None) -> dict:
     """Train and publish one setting; returns its best validation perplexity and checkpoint."""
     logger = get_run_logger()
     linearization, corpus = setting.split("-", 1)
     paths = paths_from_env(data_dir=data_dir, db=db)
     path = train_setting(
         lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
-        LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs),
+        LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
         on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
                                          row["val_ppl"], row["tokens_per_s"]),
     )
@@ -43,6 +43,7 @@ def train_flow(
     embedding: int = 256,
     layers: int = 2,
     max_epochs: int = 8,
+    max_minutes: float | None = 55.0,
     db: str | None = None,
     data_dir: str | None = None,
 ) -> list[dict]:
@@ -50,6 +51,6 @@ def train_flow(
     unknown = sorted(set(settings) - set(ALL_SETTINGS))
     if unknown:
         raise ValueError(f"unknown settings {unknown}; choose from {ALL_SETTINGS}")
-    results = [train_task(s, db, data_dir, embedding, layers, max_epochs) for s in settings]
+    results = [train_task(s, db, data_dir, embedding, layers, max_epochs, max_minutes) for s in settings]
     create_table_artifact(key="lm-checkpoints", table=results, description="Published language models")
     return results

@@ -132,6 +132,7 @@ def train(
     layers: int = typer.Option(2),
     dropout: float = typer.Option(0.3),
     max_epochs: int = typer.Option(8),
+    max_minutes: Optional[float] = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
     batch_tokens: int = typer.Option(6000),
     lr: float = typer.Option(3e-3),
     min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
@@ -153,7 +154,8 @@ def train(
     try:
         path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
                              LMConfig(0, embedding, layers, dropout),
-                             TrainConfig(max_epochs=max_epochs, lr=lr, batch_tokens=batch_tokens, device=device),
+                             TrainConfig(max_epochs=max_epochs, lr=lr, batch_tokens=batch_tokens, device=device,
+                                         max_minutes=max_minutes),
                              min_freq=min_freq, on_epoch=show)
     except (MigrationError, ValueError) as exc:
         fail(str(exc))

@@ -75,6 +75,14 @@ def test_tiny_corpus_overfits(overfit):
     assert history[-1]["val_ppl"] < 1.6 < history[0]["val_ppl"]
 
 
+def test_time_budget_stops_between_epochs(overfit):
+    _, vocab, _ = overfit
+    ids = [vocab.encode(tokens(t)) for t in CORPUS]
+    model = RecurrentLM(LMConfig(len(vocab), embedding=16, layers=1))
+    history = train_lm(model, ids, ids, TrainConfig(max_epochs=50, patience=50, max_minutes=1e-9))
+    assert len(history) == 1  # the first epoch always runs; the budget stops the next
+
+
 def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     model, vocab, _ = overfit
     path = ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})

@@ -24,6 +24,7 @@ class TrainConfig:
     seed: int = 1234
     max_len: int = 60  # tokens per sequence; longer sentences are cut (recipes rarely exceed it)
     device: str | None = None  # None: CUDA when present, else CPU
+    max_minutes: float | None = None  # no epoch starts that would likely end past this budget
 
     def to_json(self) -> dict:
         return asdict(self)
@@ -68,7 +69,11 @@ def train_lm(
     train = [s[: config.max_len] for s in train]
     noise = unigram_noise(train, model.config.vocab_size).to(device)
     best, best_state, waited, history = math.inf, None, 0, []
+    budget_ends = time.perf_counter() + 60 * config.max_minutes if config.max_minutes else math.inf
     for epoch in range(1, config.max_epochs + 1):
+        last = history[-1]["seconds"] * 1.1 if history else 0.0  # the next epoch takes about as long
+        if history and time.perf_counter() + last > budget_ends:
+            break
         model.train()
         started, total, count = time.perf_counter(), 0.0, 0
         for batch in bucket_batches(train, config.batch_tokens, seed=config.seed + epoch):
