@@ -99,7 +99,7 @@ class _Segment:
 class ParseStats:
     """How often the imperative repair fired and was kept (reported by `lmcr srl` and the benchmark)."""
 
-    sentences: int = 0
+    texts: int = 0
     reparsed: int = 0
     accepted: int = 0
     direct: int = 0
@@ -195,7 +195,7 @@ class FrameParser:
         for seg in segments:
             if seg.depth == 0:
                 self.stats.words += len(seg.text.split())
-                self.stats.sentences += 1
+                self.stats.texts += 1
         self.stats.reparsed += len(requests)
         for prefix in PREFIXES:
             retry: list[tuple[_Segment, Span, int]] = []
