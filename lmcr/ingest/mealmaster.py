@@ -11,6 +11,7 @@ UTF-8; the encoding is detected unless given.
 from __future__ import annotations
 
 import re
+import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,9 +23,11 @@ START_RE = re.compile(
 END_RE = re.compile(r"^\s*(?:MMMMM|-{5}|END RECIPE|\*\*\s*Exported from .*\*\*)\s*$", re.I)
 SECTION_RE = re.compile(r"^\s*(?:MMMMM|-{5})-*\s*([A-Za-z][^-]*?)?\s*-{3,}\s*$")
 HEADER_RE = re.compile(r"^\s*(Title|Categories|Servings|Yield)\s*:\s*(.*)$", re.I)
+# Comment paragraphs start with a label ("Notes:", "Source:") or a byline ("Posted by", "Typed to").
 COMMENT_RE = re.compile(
-    r"^\s*(Source|From|Posted|Typed|Recipe by|Formatted|Notes?|Per serving|Copyright|Date|Shared by|"
-    r"Contributor|MC formatted|Nutrition|Exchanges?)\b", re.I
+    r"^\s*(?:(?:Source|From|Notes?|Per serving|Date|Nutrition|Exchanges?|Contributor|Comments?)\s*:"
+    r"|(?:Posted|Typed|Formatted|Shared|Entered|Converted|Recipe)\s+(?:by|to|in|for)\b|Copyright|MC formatted)",
+    re.I,
 )
 # Meal-Master ingredient columns: quantity right-aligned in 7, unit in 2, then the text; lines
 # without a quantity are indented to the text column.
@@ -32,9 +35,18 @@ QUANTITY = r"(?:\d+(?:[ -]\d+/\d+|/\d+|\.\d+)?|\.\d+)"
 INGREDIENT_RE = re.compile(rf"^ {{0,8}}{QUANTITY}(?:-{QUANTITY})?\s+\S|^ {{5,}}\S")
 TWO_COLUMN_AT = 41
 
-# Characters that make a decoding plausible in recipe text, and ones that betray the wrong codec.
-_LIKELY = set("éèêëàâäçîïôöûüùñÉÀ½¼¾°’‘“”–—")
-_UNLIKELY = set("ΓΘσ╛╜╚╔═║│┤╡╢╖╕╣╗╝¬¦ª") | {chr(c) for c in range(0x80, 0xA0)}
+
+def _plausibility(ch: str) -> int:
+    """How a non-ASCII character argues for a decoding of recipe text: accented Latin letters, fractions,
+    degrees and typographic quotes for; box drawing, C1 controls, Greek and maths symbols (what cp437
+    bytes look like through the wrong codec, and vice versa) against."""
+    code = ord(ch)
+    if code < 0x80:
+        return 0
+    if 0x80 <= code < 0xA0 or 0x2500 <= code <= 0x25FF or 0x0370 <= code <= 0x03FF or 0x2200 <= code <= 0x22FF:
+        return -3
+    name = unicodedata.name(ch, "")
+    return 1 if "LATIN" in name or "FRACTION" in name or "QUOTATION" in name or ch in "°–—" else 0
 
 
 def decode(raw: bytes, path: str, encoding: str | None = None) -> str:
@@ -50,7 +62,7 @@ def decode(raw: bytes, path: str, encoding: str | None = None) -> str:
         pass
 
     def score(text: str) -> int:
-        return sum(ch in _LIKELY for ch in text) - 3 * sum(ch in _UNLIKELY for ch in text)
+        return sum(_plausibility(ch) for ch in text)
 
     candidates = [raw.decode("cp437"), raw.decode("cp1252", errors="replace"), raw.decode("latin-1")]
     return max(candidates, key=score)
