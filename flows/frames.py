@@ -17,7 +17,7 @@ from lmcr.config import paths_from_env
 from lmcr.srl.corpus import (FrameCorpusConfig, Shard, ShardResult, finish_build, parse_shard, prepare_build,
                              shard_output_dir, summarize_build)
 from lmcr.srl.parser import COMPOUNDS_FILE
-from lmcr.store import check_contracts, connect, named_query
+from lmcr.store import check_contracts, connect, named_query, query_dicts
 
 
 @task(name="parse-shard", task_run_name="parse shard {shard.number}")
@@ -32,8 +32,7 @@ def load_frames_task(db: Path, sql_dir: Path, srl_dir: Path, results: list[Shard
     with connect(db, sql_dir) as con:
         finish_build(con, srl_dir, results, build)
         check_contracts(con, sql_dir, prefix="frames_")
-        cursor = con.execute(named_query(sql_dir, "frame_counts"))
-        return [dict(zip([d[0] for d in cursor.description], row)) for row in cursor.fetchall()]
+        return query_dicts(con, named_query(sql_dir, "frame_counts"))
 
 
 @flow(name="frames", task_runner=ProcessPoolTaskRunner(max_workers=2))

@@ -96,7 +96,7 @@ def frames(
 ) -> None:
     """Build the frame corpora from the ingested sentences (skipped when nothing changed)."""
     from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
-    from lmcr.store import named_query
+    from lmcr.store import named_query, query_dicts
 
     paths = paths_from_env(db=db)
     config = FrameCorpusConfig(kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
@@ -111,8 +111,7 @@ def frames(
             build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers,
                                        on_shard=lambda r: progress.advance(bar))
         check_contracts(con, paths.sql_dir, prefix="frames_")
-        cursor = con.execute(named_query(paths.sql_dir, "frame_counts"))
-        rows = [dict(zip([d[0] for d in cursor.description], r)) for r in cursor.fetchall()]
+        rows = query_dicts(con, named_query(paths.sql_dir, "frame_counts"))
     except (MigrationError, ContractViolation, RuntimeError) as exc:
         fail(str(exc))
     print_rows(f"robot-predicate frames in {paths.db}", rows)

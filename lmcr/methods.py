@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import csv
-import os
 import random
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from lmcr.files import atomic_path
 from lmcr.jsonl import InputError
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.score import LMScorer
@@ -86,14 +86,8 @@ def read_frames_csv(path: Path) -> tuple[list[str], list[FrameRow]]:
 
 def write_scores_csv(path: Path, columns: list[str], rows: list[FrameRow], scores: dict[str, list[float]]) -> None:
     """Input columns plus one column per method, written under a temporary name and renamed."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w", newline="", encoding="utf-8") as out:
-            writer = csv.DictWriter(out, fieldnames=columns + [m for m in scores if m not in columns])
-            writer.writeheader()
-            for k, row in enumerate(rows):
-                writer.writerow({**row.raw, **{m: f"{values[k]:.6f}" for m, values in scores.items()}})
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as out:
+        writer = csv.DictWriter(out, fieldnames=columns + [m for m in scores if m not in columns])
+        writer.writeheader()
+        for k, row in enumerate(rows):
+            writer.writerow({**row.raw, **{m: f"{values[k]:.6f}" for m, values in scores.items()}})

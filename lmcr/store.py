@@ -104,6 +104,13 @@ def named_query(sql_dir: Path, name: str) -> str:
     return path.read_text(encoding="utf-8")
 
 
+def query_dicts(con: duckdb.DuckDBPyConnection, sql: str, params: list | None = None) -> list[dict]:
+    """Rows of a query as dicts keyed by column name."""
+    cursor = con.execute(sql, params or [])
+    names = [d[0] for d in cursor.description]
+    return [dict(zip(names, row)) for row in cursor.fetchall()]
+
+
 def check_contracts(con: duckdb.DuckDBPyConnection, sql_dir: Path, prefix: str = "") -> dict[str, int]:
     """Run every `sql/contracts/<prefix>*.sql` query; each returns offending rows, so any row is a violation."""
     results: dict[str, int] = {}

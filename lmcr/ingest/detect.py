@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from lmcr.files import hash_file
 from lmcr.ingest.feeding_america import parse_feeding_america
 from lmcr.ingest.mealmaster import START_RE, parse_mealmaster
 from lmcr.ingest.recipe_json import parse_recipe_json
@@ -43,9 +44,7 @@ class Source:
         files = sorted(self.path.rglob("*.json")) if self.path.is_dir() else [self.path]
         for file in files:
             digest.update(file.relative_to(self.path).as_posix().encode() if self.path.is_dir() else b"")
-            with open(file, "rb") as handle:
-                for chunk in iter(lambda: handle.read(1 << 20), b""):
-                    digest.update(chunk)
+            hash_file(digest, file)
         return digest.hexdigest()
 
 

@@ -10,7 +10,7 @@ import duckdb
 
 from lmcr.ingest.detect import Source, parse_source
 from lmcr.ingest.stage import StagedFile, already_loaded, load_staged, stage
-from lmcr.store import check_contracts, named_query
+from lmcr.store import check_contracts, named_query, query_dicts
 
 
 def plan(con: duckdb.DuckDBPyConnection, sources: list[Source]) -> tuple[list[tuple[Source, str]], list[Source]]:
@@ -67,6 +67,4 @@ def _size(path: Path) -> int:
 def corpus_summary(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[dict]:
     """Per corpus: records in, loaded, quarantined, documents, sentences, words; contracts checked first."""
     check_contracts(con, sql_dir, prefix="ingest_")
-    cursor = con.execute(named_query(sql_dir, "corpus_summary"))
-    names = [d[0] for d in cursor.description]
-    return [dict(zip(names, row)) for row in cursor.fetchall()]
+    return query_dicts(con, named_query(sql_dir, "corpus_summary"))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,6 +9,7 @@ import duckdb
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from lmcr.files import atomic_path
 from lmcr.ingest.detect import Source
 from lmcr.ingest.records import IngestError, ParsedFile
 
@@ -49,10 +49,8 @@ class StagedFile:
 
 def write_parquet_atomic(rows: list[dict], schema: pa.Schema, path: Path) -> None:
     """Write rows as Parquet under a temporary name and rename, so readers never see half a file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    pq.write_table(pa.Table.from_pylist(rows, schema=schema), tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:
+        pq.write_table(pa.Table.from_pylist(rows, schema=schema), tmp)
 
 
 def stage(source: Source, parsed: ParsedFile, sha256: str, staging_dir: Path) -> StagedFile:

@@ -9,7 +9,6 @@ file are needed to load and score.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import shutil
@@ -19,6 +18,7 @@ from pathlib import Path
 
 import torch
 
+from lmcr.files import atomic_path, file_sha256
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
 
@@ -37,14 +37,6 @@ class Checkpoint:
     linearization: str
     metrics: dict
     provenance: dict
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def _write_json(path: Path, data: object) -> None:
@@ -69,7 +61,7 @@ def publish(root: Path, setting: str, model: RecurrentLM, vocab: Vocab, lineariz
         _write_json(tmp / "metrics.json", metrics)
         _write_json(tmp / "provenance.json", provenance)
         _write_json(tmp / "manifest.json", {"setting": setting, "version": version,
-                                            "files": {name: _sha256(tmp / name) for name in FILES}})
+                                            "files": {name: file_sha256(tmp / name) for name in FILES}})
         os.replace(tmp, final)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -81,10 +73,8 @@ def publish(root: Path, setting: str, model: RecurrentLM, vocab: Vocab, lineariz
 
 def set_latest(root: Path, setting: str, version: str) -> None:
     """Point the setting's LATEST at `version` (atomic replace)."""
-    pointer = root / setting / "LATEST"
-    tmp = pointer.with_name(f".LATEST.{os.getpid()}.tmp")
-    tmp.write_text(version + "\n", encoding="utf-8")
-    os.replace(tmp, pointer)
+    with atomic_path(root / setting / "LATEST") as tmp:
+        tmp.write_text(version + "\n", encoding="utf-8")
 
 
 def resolve(path: Path) -> Path:
@@ -105,7 +95,7 @@ def verify(path: Path) -> dict:
         file = path / name
         if not file.exists():
             raise CheckpointError(f"{file}: listed in the manifest but missing")
-        if _sha256(file) != expected:
+        if file_sha256(file) != expected:
             raise CheckpointError(f"{file}: sha256 differs from the manifest (modified after publishing)")
     return manifest
 

@@ -12,11 +12,12 @@ A modifier is part of the name when either is high. Both come from `sentences`, 
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import duckdb
+
+from lmcr.files import atomic_path
 
 HEAD_RATE_MIN = 0.10  # nouns measured 0.10-0.49, adjectives/participles 0.00-0.08 (closing note)
 NPMI_MIN = 0.65  # "black pepper" 0.75, "olive oil" 0.84; "salted water" 0.61, "melted butter" 0.52
@@ -71,10 +72,8 @@ class Compounds:
                 or f"{modifier} {head}" in self.strong_bigrams)
 
     def save(self, path: Path) -> None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams)}))
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams)}))
 
     @classmethod
     def load(cls, path: Path) -> Compounds:

@@ -10,7 +10,6 @@ SRL code, compounds) matches the last one.
 from __future__ import annotations
 
 import hashlib
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -22,6 +21,7 @@ import duckdb
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from lmcr.files import atomic_path
 from lmcr.ingest.stage import write_parquet_atomic
 from lmcr.srl.compounds import Compounds, learn_compounds
 from lmcr.srl.frames import Frame
@@ -112,10 +112,9 @@ def export_shards(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, out
     for number, count, words, md5 in stats:
         path = out_dir / f"texts-{md5}.parquet"
         if not path.exists():
-            tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-            con.execute(f"copy (select text, occurrences from _frame_input where shard = {int(number)} "
-                        f"order by first_key, text) to '{tmp}' (format parquet)")
-            os.replace(tmp, path)
+            with atomic_path(path) as tmp:
+                con.execute(f"copy (select text, occurrences from _frame_input where shard = {int(number)} "
+                            f"order by first_key, text) to '{tmp}' (format parquet)")
         shards.append(Shard(int(number), str(path), md5, int(count), int(words)))
     con.execute("drop table _frame_input")
     con.execute("drop table _frame_texts")

@@ -169,8 +169,9 @@ class FrameParser:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
         parses: list[tuple[_Segment, Span, int]] = []  # (segment, parse, offset of the parse's text)
         requests: list[tuple[_Segment, Span, int]] = []  # (segment, sentence, offset of its doc's text)
-        direct = [seg for seg in segments if self._direct(seg)]
-        plain = [seg for seg in segments if not self._direct(seg)]
+        direct, plain = [], []
+        for seg in segments:
+            (direct if self._direct(seg) else plain).append(seg)
         prefix = PREFIXES[0]
         for seg, doc in zip(direct, self._parse(as_request(s.text, prefix) for s in direct)):
             if not _reparse_accepted(doc, prefix):

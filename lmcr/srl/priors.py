@@ -10,12 +10,12 @@ No preference is written by hand: an unseen noun keeps the syntactic default (th
 from __future__ import annotations
 
 import json
-import os
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
 
+from lmcr.files import atomic_path
 from lmcr.srl.frames import Frame
 
 SMOOTHING = 1.0
@@ -62,13 +62,11 @@ class RolePriors:
 
     def save(self, path: Path) -> None:
         """Write as JSON under a temporary name, then rename."""
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps({
-            "by_verb": [[*k, n] for k, n in sorted(self.by_verb.items())],
-            "pooled": [[*k, n] for k, n in sorted(self.pooled.items())],
-        }), encoding="utf-8")
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            tmp.write_text(json.dumps({
+                "by_verb": [[*k, n] for k, n in sorted(self.by_verb.items())],
+                "pooled": [[*k, n] for k, n in sorted(self.pooled.items())],
+            }), encoding="utf-8")
 
     @classmethod
     def load(cls, path: Path) -> RolePriors:
