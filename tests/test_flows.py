@@ -61,3 +61,27 @@ def test_train_flow_publishes_requested_settings(prefect_api, sample_dir, tmp_pa
     assert all((tmp_path / "checkpoints" / r["setting"] / "LATEST").exists() for r in results)
     with pytest.raises(ValueError, match="unknown settings"):
         train_flow(settings=["frame-nyc"], data_dir=str(tmp_path))
+    evaluate_on_trained(tmp_path)
+
+
+def evaluate_on_trained(tmp_path):
+    """The evaluate flow on the checkpoints just trained and a small ratings file: report and calibration."""
+    import csv
+
+    from flows.evaluate import evaluate_flow
+
+    objects = ["cup", "glass", "mug", "bowl", "scissors", "knife", "towel", "sponge", "oven", "sink"]
+    header = ["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
+              "Input.role2", "Input.arg2", "Answer.rating"]
+    with open(tmp_path / "ratings.csv", "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        for i, obj in enumerate(objects):
+            writer.writerow(["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj,
+                             "5" if i < 3 else "1"])
+    results = evaluate_flow(ratings=str(tmp_path / "ratings.csv"), out=str(tmp_path / "report"),
+                            methods=["sentence_lm", "frame_lm", "random"], settings=["sentence_lm/youcook2"],
+                            corpus="youcook2", per_verb=5, data_dir=str(tmp_path))
+    assert set(results["table1"]) == {"sentence_lm", "frame_lm", "random", "sentence_lm/youcook2"}
+    assert (tmp_path / "report" / "report.html").exists() and (tmp_path / "report" / "fig4d.png").exists()
+    assert (tmp_path / "calibration" / "sentence_lm-youcook2.json").exists()

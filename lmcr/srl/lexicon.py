@@ -41,6 +41,7 @@ class Lexicon:
     quantity_nouns: frozenset[str]
     object_pronouns: frozenset[str]
     recipient_pronouns: frozenset[str]
+    objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
 
 
 @lru_cache(maxsize=4)
@@ -59,5 +60,5 @@ def load_lexicon(path: str | None = None) -> Lexicon:
     return Lexicon(
         predicates=predicates, measure_nouns=frozenset(data["measure_nouns"]),
         quantity_nouns=frozenset(data["quantity_nouns"]), object_pronouns=frozenset(data["object_pronouns"]),
-        recipient_pronouns=frozenset(data["recipient_pronouns"]),
+        recipient_pronouns=frozenset(data["recipient_pronouns"]), objects=tuple(data.get("objects", ())),
     )

@@ -1,0 +1,58 @@
+"""Evaluate flow: ratings from the store (or an MTurk CSV) -> scores of every method -> Table I and
+Fig. 4 report, published as Prefect artifacts (the Table I table and a link to the report)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from prefect import flow, get_run_logger, task
+from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
+
+from lmcr.config import paths_from_env
+from lmcr.evaluate.protocol import EvalConfig
+from lmcr.evaluate.ratings import load_ratings
+from lmcr.evaluate.run import SETTINGS, run_evaluation
+from lmcr.methods import METHODS, MethodResources
+from lmcr.srl.lexicon import load_lexicon
+
+
+@task(name="evaluate", retries=0)
+def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
+                  per_verb: int, seed: int, calibration_dir: str | None) -> dict:
+    logger = get_run_logger()
+    paths = paths_from_env()
+    rated = load_ratings(Path(ratings), paths.sql_dir, set(load_lexicon().predicates))
+    results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
+                             Path(calibration_dir) if calibration_dir else None, log=logger.info)
+    return results.to_json()
+
+
+@flow(name="evaluate")
+def evaluate_flow(
+    ratings: str | None = None,
+    out: str | None = None,
+    methods: list[str] = list(METHODS),  # noqa: B006 - Prefect parameters must be JSON
+    settings: list[str] = list(SETTINGS),  # noqa: B006
+    conceptnet: str | None = None,
+    vectors: str | None = None,
+    per_verb: int = 50,
+    seed: int = 0,
+    corpus: str = "all",
+    data_dir: str | None = None,
+) -> dict:
+    """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
+    (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods."""
+    paths = paths_from_env(data_dir=data_dir)
+    res = MethodResources(checkpoints=paths.checkpoints, corpus=corpus, db=paths.db, vectors=Path(vectors) if vectors else None,
+                          conceptnet=Path(conceptnet) if conceptnet else None,
+                          cache_dir=paths.data_dir / "baselines", seed=seed)
+    report = Path(out or paths.data_dir / "report")
+    results = evaluate_task(ratings or str(paths.db), str(report), methods, settings, res, per_verb, seed,
+                            str(paths.data_dir / "calibration"))
+    create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",
+                          table=[{"method": m, "overall": round(acc.get("all", float("nan")), 3)}
+                                 for m, acc in results["table1"].items()])
+    create_markdown_artifact(key="evaluation-report", markdown=(report / "report.md").read_text(encoding="utf-8"),
+                             description=str(report / "report.html"))
+    create_link_artifact(key="evaluation-report-html", link=(report / "report.html").resolve().as_uri())
+    return results

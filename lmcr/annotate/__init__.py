@@ -1,0 +1,1 @@
+"""Crowd annotation: rating tasks out, MTurk results in, aggregation and worker quality."""

@@ -1,0 +1,89 @@
+"""Word-vector baseline: g = -(dist(v, a1) + dist(v, a2) + dist(a1, a2)), cosine distance.
+
+The paper used pretrained GloVe as g = -(dist(v, a2) + dist(a1, a2)); the added dist(v, a1) is the
+same for every candidate of a scenario (see `cooccur`). Vectors come from a file (GloVe text,
+word2vec text/binary, or a gensim `.kv`), e.g. the 10k-word GloVe subset, or are trained with gensim
+word2vec on our own corpus sentences (`train_word2vec`), because that subset misses many cooking words.
+
+OOV policy: a multiword term ("bell pepper") is the mean of its known words; a term with no known
+word has no vector, and its distance to anything is 1.0, what two unrelated (orthogonal) words get.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+from gensim.models import KeyedVectors, Word2Vec
+
+from lmcr.baselines.cooccur import Frame, frame_terms
+from lmcr.files import atomic_path
+from lmcr.lm.linearize import tokens
+
+UNRELATED = 1.0
+
+
+def load_vectors(path: Path) -> KeyedVectors:
+    """GloVe text (no header), word2vec text or binary (`.bin`), or gensim KeyedVectors (`.kv`)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such vector file")
+    if path.suffix == ".kv":
+        return KeyedVectors.load(str(path))
+    if path.suffix == ".bin":
+        return KeyedVectors.load_word2vec_format(str(path), binary=True)
+    with open(path, encoding="utf-8") as handle:
+        first = handle.readline().split()
+    has_header = len(first) == 2 and all(x.isdigit() for x in first)
+    return KeyedVectors.load_word2vec_format(str(path), binary=False, no_header=not has_header)
+
+
+class _Sentences:
+    """Re-iterable token lists, as gensim makes several passes."""
+
+    def __init__(self, texts):
+        self.texts = texts
+
+    def __iter__(self):
+        for text in self.texts():
+            yield tokens(text)
+
+
+def train_word2vec(texts, out: Path, dim: int = 100, window: int = 5, min_count: int = 5, epochs: int = 5,
+                   workers: int = 2, seed: int = 1) -> Path:
+    """Skip-gram word2vec on the corpus sentences (`texts()` yields strings), saved atomically as `.kv`."""
+    model = Word2Vec(sentences=_Sentences(texts), vector_size=dim, window=window, min_count=min_count, sg=1,
+                     epochs=epochs, workers=workers, seed=seed)
+    with atomic_path(Path(out)) as tmp:
+        model.wv.save(str(tmp), separately=[])  # one file, so the rename publishes all of it
+    return Path(out)
+
+
+class VectorScorer:
+    """Scores frames by negative summed cosine distances of their terms' vectors."""
+
+    def __init__(self, vectors: KeyedVectors):
+        self.vectors = vectors
+        self.cache: dict[str, np.ndarray | None] = {}
+
+    def vector(self, term: str) -> np.ndarray | None:
+        if term not in self.cache:
+            known = [self.vectors[w] for w in term.split() if w in self.vectors.key_to_index]
+            mean = np.mean(known, axis=0) if known else None
+            self.cache[term] = None if mean is None or not np.any(mean) else mean / np.linalg.norm(mean)
+        return self.cache[term]
+
+    def dist(self, x: str, y: str) -> float:
+        a, b = self.vector(x), self.vector(y)
+        return UNRELATED if a is None or b is None else 1.0 - float(a @ b)
+
+    def oov(self, terms: Iterable[str]) -> list[str]:
+        return sorted({t for t in terms if self.vector(t) is None})
+
+    def score_frames(self, frames: list[Frame]) -> list[float]:
+        scores = []
+        for frame in frames:
+            v, a1, a2 = frame_terms(frame)
+            scores.append(-(self.dist(v, a1) + self.dist(v, a2) + self.dist(a1, a2)))
+        return scores

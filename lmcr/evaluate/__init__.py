@@ -1,0 +1,1 @@
+"""The paper's evaluation protocol (section IV) on crowd-rated frames, and its reports."""

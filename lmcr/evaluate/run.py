@@ -1,0 +1,79 @@
+"""One evaluation run: score the rated frames with every method and LM setting, sweep, calibrate the
+completion of the LM methods, and write the report."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Callable
+
+from lmcr.complete import calibrate, save_config
+from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
+from lmcr.evaluate.ratings import RatedFrame
+from lmcr.evaluate.report import write_report
+from lmcr.evaluate.scenarios import build_scenarios
+from lmcr.files import file_sha256
+from lmcr.lm import checkpoint as ckpt
+from lmcr.methods import LM_METHODS, MethodResources, lm_checkpoint_dir, make_scorer
+
+SETTINGS = tuple(f"{m}/{c}" for m in LM_METHODS for c in ("youcook2", "recipes", "all"))
+DEVIATIONS = [
+    "Corpora: the shared web recipes and Feeding America stand in for 'Now You're Cooking!' (not available); "
+    "YouCook2 is the real annotation set.",
+    "cooccur, word2vec and conceptnet add the verb-first-argument term to the paper's two terms; it is the "
+    "same for every candidate of a scenario, so rankings are the paper's whichever role varies.",
+    "word2vec: the paper's pretrained GloVe is available here only as its 10k most frequent words, so the "
+    "default vectors are skip-gram word2vec trained with gensim on our corpora (a vector file can be given); "
+    "a term with no known word is at distance 1.0 (unrelated).",
+    "conceptnet: the API is unreachable offline; relatedness is the cosine of PPMI+SVD embeddings of the "
+    "cn100k edge list (Numberbatch's starting point, without its retrofitting), or of a Numberbatch file.",
+    "The paper's published numbers are not available offline; its columns read n/a unless filled in "
+    "lmcr/evaluate/report.py PAPER.",
+]
+
+
+def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None]) -> tuple[dict, list[str]]:
+    """Scorers by name ('sentence_lm', 'sentence_lm/youcook2', 'cooccur', ...); unavailable ones noted."""
+    scorers, notes = {}, []
+    for name in names:
+        method, _, corpus = name.partition("/")
+        try:
+            scorers[name] = make_scorer(method, replace(res, corpus=corpus or res.corpus))
+        except (ckpt.CheckpointError, ValueError, FileNotFoundError) as exc:
+            notes.append(f"{name} not evaluated: {exc}")
+            log(notes[-1])
+    return scorers, notes
+
+
+def calibrate_lms(rated: list[RatedFrame], scores: dict, res: MethodResources, config: EvalConfig,
+                  out_dir: Path, log: Callable[[str], None]) -> list[str]:
+    """Completion temperature and conformal threshold per LM method, from the headline scenarios."""
+    scenarios, _ = build_scenarios(rated, config.lam, config.k, config.per_verb, config.seed)
+    notes = []
+    for method in (m for m in LM_METHODS if m in scores):
+        cal = calibrate([[scores[method][f.key] for f in sc.candidates] for sc in scenarios])
+        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
+        save_config(cal, out_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json"))
+        notes.append(f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
+                     f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
+        log(notes[-1])
+    return notes
+
+
+def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[str], settings: list[str],
+                   config: EvalConfig, out_dir: Path, calibration_dir: Path | None = None,
+                   log: Callable[[str], None] = print) -> Results:
+    started = time.perf_counter()
+    scorers, notes = build_scorers(list(dict.fromkeys(methods + settings)), res, log)
+    scores = {}
+    for name, fn in scorers.items():
+        t = time.perf_counter()
+        scores.update(score_rated(rated, {name: fn}))
+        log(f"scored {len(rated):,} rated frames with {name} in {time.perf_counter() - t:.1f}s")
+    results = evaluate(rated, scores, config)
+    if calibration_dir is not None:
+        notes += calibrate_lms(rated, scores, res, config, calibration_dir, log)
+    notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
+    write_report(results, [m for m in methods if m in scores], [s for s in settings if s in scores], out_dir, notes)
+    return results

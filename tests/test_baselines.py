@@ -1,0 +1,71 @@
+"""Each baseline on a tiny corpus, model-free: a suffix lemmatizer stands in for spaCy's rule tables."""
+
+from __future__ import annotations
+
+import pytest
+
+from lmcr.baselines.conceptnet import ConceptNetScorer, read_edges
+from lmcr.baselines.cooccur import CooccurrenceScorer
+from lmcr.baselines.terms import TermMatcher
+from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
+
+CORPUS = ["Pour the water into the cups.", "Pour water into a cup and stir.", "Poured the milk into the glass.",
+          "Cut the bell peppers with scissors.", "Cut paper with the scissors.", "Chop one bell pepper."] * 5
+
+
+class SuffixLemmas:
+    def lemmas(self, word: str) -> frozenset[str]:
+        return frozenset({word, word.removesuffix("s"), word.removesuffix("ed")})
+
+
+def frame(dest: str) -> tuple[str, dict[str, str]]:
+    return "pour", {"Theme": "water", "Destination": dest}
+
+
+def test_term_matcher_finds_inflected_and_multiword_terms():
+    m = TermMatcher(["pour", "cup", "bell pepper", "pepper"], SuffixLemmas())
+    assert m.find_text("Poured it into two cups") == {"pour", "cup"}
+    assert m.find_text("slice the bell peppers") == {"bell pepper", "pepper"}
+
+
+def test_cooccurrence_counts_and_scores():
+    scorer = CooccurrenceScorer(lambda: iter(CORPUS), SuffixLemmas(), ["pour", "water", "cup"])
+    assert scorer.single["cup"] == 10 and scorer.pairs[("cup", "water")] == 10 and scorer.n_sentences == 30
+    cup, scissors = scorer.score_frames([frame("cup"), frame("scissors")])  # scissors indexed on demand
+    assert cup == pytest.approx(10 / (15 * 10) + 10 / (15 * 10) + 10 / (10 * 10))  # pour 15, water 10, cup 10
+    assert scissors == pytest.approx(10 / (15 * 10)) and scorer.single["scissors"] == 10  # only co(pour, water)
+
+
+def test_vectors_from_a_glove_file_with_oov_policy(tmp_path):
+    path = tmp_path / "tiny.txt"
+    path.write_text("pour 1 0 0\nwater 1 0.1 0\ncup 0.9 0.2 0\nscissors 0 0 1\nbell 0 1 0\npepper 0 1 0.2\n")
+    scorer = VectorScorer(load_vectors(path))
+    cup, scissors, unknown = scorer.score_frames([frame("cup"), frame("scissors"), frame("spatula")])
+    assert cup > unknown > scissors or cup > scissors
+    assert scorer.dist("water", "spatula") == 1.0 and scorer.oov(["spatula", "bell pepper"]) == ["spatula"]
+
+
+def test_word2vec_trained_on_the_corpus_is_saved_atomically(tmp_path):
+    out = train_word2vec(lambda: iter(CORPUS * 4), tmp_path / "w2v.kv", dim=8, min_count=1, epochs=3, workers=1)
+    kv = load_vectors(out)
+    assert {"pour", "water", "scissors"} <= set(kv.key_to_index) and kv.vector_size == 8
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w2v.kv"]
+
+
+def test_conceptnet_relatedness_from_an_edge_list(tmp_path):
+    edges = tmp_path / "train.txt"
+    rows = ["UsedFor\tcup\tdrink water", "AtLocation\twater\tcup", "RelatedTo\tpour\twater", "RelatedTo\tpour\tcup",
+            "UsedFor\tscissors\tcut paper", "AtLocation\tscissors\tdrawer", "RelatedTo\tknife\tcut",
+            "AtLocation\tknife\tdrawer", "IsA\tsoy sauce\tsauce", "RelatedTo\tsauce\trice"]
+    edges.write_text("\n".join(rows) + "\n")
+    assert len(read_edges(tmp_path)) == 10
+    scorer = ConceptNetScorer.from_path(tmp_path, dim=4)
+    cup, scissors, unknown = scorer.score_frames([frame("cup"), frame("scissors"), frame("spatula")])
+    assert cup > scissors and scorer.rel("water", "spatula") == 0.0
+    assert scorer.vector("soy sauce") is not None
+
+
+def test_conceptnet_without_english_edges_is_an_error(tmp_path):
+    (tmp_path / "train.txt").write_text("only one column\n")
+    with pytest.raises(ValueError, match="no English ConceptNet edges"):
+        read_edges(tmp_path)

@@ -1,0 +1,77 @@
+"""Completion edge cases with the real parser and a stand-in scorer, and the calibration rule."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from lmcr.complete import CompletionConfig, CompletionError, calibrate, complete, load_config, save_config, softmax
+from lmcr.srl.parser import NoPredicateError, load_parser
+
+pytestmark = pytest.mark.model
+LIKES = {"cup": 3.0, "glass": 2.9, "bowl": 0.0, "scissors": -5.0, "water": 1.0, "milk": 0.5}
+
+
+def scorer(frames):
+    """Prefers objects by LIKES, summed over roles (a stand-in for an LM)."""
+    return [sum(LIKES.get(v, -1.0) for v in roles.values()) for _, roles in frames]
+
+
+@pytest.fixture(scope="module")
+def parser():
+    return load_parser()
+
+
+def test_one_missing_role_is_filled_with_probabilities(parser):
+    out = complete(parser, scorer, "pour me some water", ["scissors", "cup", "bowl", "water"],
+                   CompletionConfig(set_threshold=0.5))
+    assert out["frame"] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
+    assert out["missing"] == "Destination" and [c["object"] for c in out["candidates"]] == ["cup", "bowl", "scissors"]
+    assert sum(c["probability"] for c in out["candidates"]) == pytest.approx(1, abs=1e-3)
+    assert out["question"] is None  # the stated theme is no candidate; cup clearly wins
+
+
+def test_close_candidates_give_a_question_naming_them(parser):
+    out = complete(parser, scorer, "pour me some water", ["glass", "cup", "bowl"], CompletionConfig(set_threshold=0.3))
+    assert out["frame"]["roles"]["Destination"] == "cup"
+    assert out["question"] and "the cup" in out["question"] and "the glass" in out["question"]
+    assert "bowl" not in out["question"]
+
+
+def test_complete_instruction_comes_back_unchanged(parser):
+    out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
+    assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
+                   "missing": None, "missing_roles": [], "candidates": [], "question": None}
+
+
+def test_two_missing_roles_score_object_pairs(parser):
+    out = complete(parser, scorer, "pour it", ["water", "milk", "cup", "scissors"])
+    assert out["missing_roles"] == ["Theme", "Destination"]
+    assert set(out["frame"]["roles"].values()) == {"cup", "water"}  # the best-scoring pair
+    assert all(c["objects"]["Theme"] != c["objects"]["Destination"] for c in out["candidates"])
+    assert len(out["candidates"]) == 12
+
+
+def test_empty_objects_and_unknown_verbs_are_clear_errors(parser):
+    with pytest.raises(CompletionError, match="no detected objects"):
+        complete(parser, scorer, "pour me some water", [])
+    with pytest.raises(CompletionError, match="no detected objects"):
+        complete(parser, scorer, "pour me some water", ["water"])
+    with pytest.raises(NoPredicateError, match="no known predicate"):
+        complete(parser, scorer, "juggle the oranges", ["cup"])
+    with pytest.raises(CompletionError, match="the limit is 5"):
+        complete(parser, scorer, "pour it", ["water", "milk", "cup"], CompletionConfig(max_frames=5))
+
+
+def test_calibration_temperature_and_conformal_threshold(tmp_path):
+    confident = [[5.0, 0.0, 0.0]] * 20
+    cal = calibrate(confident, alpha=0.1)
+    assert cal.temperature <= 0.1 + 1e-9 and cal.set_threshold > 0.99  # sharper is better when always right
+    mixed = [[2.0, 0.0, 0.0]] * 8 + [[0.0, 2.0, 0.0]] * 2
+    cal = calibrate(mixed, alpha=0.1)
+    probs = [softmax(s, cal.temperature)[0] for s in mixed]
+    assert sum(p >= cal.set_threshold for p in probs) / len(probs) >= 0.9  # coverage on the calibration data
+    assert math.isfinite(cal.temperature)
+    save_config(cal, tmp_path / "c.json", "abc")
+    assert load_config(tmp_path / "c.json", "abc") == cal and load_config(tmp_path / "c.json", "other") is None
