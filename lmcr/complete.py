@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
 
-from lmcr.files import atomic_path
+from lmcr.files import atomic_path, file_sha256
 from lmcr.srl.parser import FrameParser, parse_instruction
 
 Frame = tuple[str, dict[str, str]]
@@ -138,3 +138,17 @@ def load_config(path: Path, checkpoint_sha: str | None) -> CompletionConfig | No
     if data.pop("checkpoint_sha256", None) != checkpoint_sha:
         return None
     return CompletionConfig(**data)
+
+
+def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
+    """The scorer of `method` and the completion settings calibrated for its checkpoint (by `lmcr
+    evaluate`), or uncalibrated defaults when there are none for this exact checkpoint."""
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.methods import LM_METHODS, lm_checkpoint_dir, make_scorer
+
+    scorer = make_scorer(method, res)
+    config = None
+    if method in LM_METHODS:
+        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
+        config = load_config(calibration_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json"))
+    return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")

