@@ -133,8 +133,8 @@ def train(
     dropout: float = typer.Option(0.3),
     max_epochs: int = typer.Option(8),
     max_minutes: Optional[float] = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
-    batch_tokens: int = typer.Option(6000),
-    lr: float = typer.Option(3e-3),
+    batch_tokens: Optional[int] = typer.Option(None, help="Padded tokens per batch (default: TrainConfig's, 2000)."),
+    lr: Optional[float] = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 1e-2)."),
     min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
     device: Optional[str] = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
     db: Optional[Path] = typer.Option(None, help="DuckDB store."),
@@ -154,8 +154,8 @@ def train(
     try:
         path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
                              LMConfig(0, embedding, layers, dropout),
-                             TrainConfig(max_epochs=max_epochs, lr=lr, batch_tokens=batch_tokens, device=device,
-                                         max_minutes=max_minutes),
+                             TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes,
+                                         **{k: v for k, v in (("lr", lr), ("batch_tokens", batch_tokens)) if v}),
                              min_freq=min_freq, on_epoch=show)
     except (MigrationError, ValueError) as exc:
         fail(str(exc))

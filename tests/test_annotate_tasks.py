@@ -70,6 +70,38 @@ def test_tasks_round_trip_with_gold_checks(con, tmp_path):
     assert set(alpha_by_verb(con)) >= {"all", "pour"}
 
 
+def test_preview_page_structure(con, tmp_path):
+    """What a browser would show, checked by parsing: every slot's sentence and five required radios."""
+    from html.parser import HTMLParser
+
+    generate_tasks(con, tmp_path / "tasks", TaskConfig(per_hit=4, gold_per_hit=0, n_frames=8))
+
+    class Page(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.radios, self.required, self.sentences, self.in_sentence = {}, set(), [], False
+
+        def handle_starttag(self, tag, attrs):
+            attrs = dict(attrs)
+            if tag == "input" and attrs.get("type") == "radio":
+                self.radios.setdefault(attrs["name"], []).append(attrs["value"])
+                if "required" in attrs:
+                    self.required.add(attrs["name"])
+            self.in_sentence = tag == "p" and attrs.get("class") == "sentence"
+
+        def handle_data(self, data):
+            if self.in_sentence and data.strip():
+                self.sentences.append(data.strip())
+
+    page = Page()
+    page.feed((tmp_path / "tasks" / "preview.html").read_text())
+    with open(tmp_path / "tasks" / "batch.csv", newline="") as handle:
+        first = next(csv.DictReader(handle))
+    assert page.sentences == [first[f"sentence_{k}"] for k in range(1, 5)]
+    assert page.radios == {f"rating_{k}": ["1", "2", "3", "4", "5"] for k in range(1, 5)}
+    assert page.required == set(page.radios)
+
+
 def test_disagreement_picks_frames_the_scorers_rank_differently():
     pool = [("pour", {"Theme": "water", "Destination": o}) for o in ["cup", "glass", "bowl", "sink"]]
     a = lambda frames: [1.0, 2.0, 3.0, 4.0]  # noqa: E731

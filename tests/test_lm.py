@@ -83,6 +83,16 @@ def test_time_budget_stops_between_epochs(overfit):
     assert len(history) == 1  # the first epoch always runs; the budget stops the next
 
 
+def test_target_perplexity_stops_training(overfit):
+    _, vocab, _ = overfit
+    ids = [vocab.encode(tokens(t)) for t in CORPUS]
+    model = RecurrentLM(LMConfig(len(vocab), embedding=16, layers=1))
+    history = train_lm(model, ids, ids, TrainConfig(max_epochs=50, patience=50, lr=0.02, batch_tokens=200,
+                                                    target_ppl=len(vocab) / 2))
+    assert 1 <= len(history) < 50 and history[-1]["val_ppl"] <= len(vocab) / 2
+    assert all(h["val_ppl"] > len(vocab) / 2 for h in history[:-1])
+
+
 def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     model, vocab, _ = overfit
     path = ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})
