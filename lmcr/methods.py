@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterator
 
-import duckdb
 
 from lmcr.baselines.conceptnet import ConceptNetScorer
 from lmcr.baselines.cooccur import CooccurrenceScorer
@@ -22,6 +21,7 @@ from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
 from lmcr.lm.score import LMScorer
 from lmcr.srl.lexicon import load_lexicon
+from lmcr.store import read_connection
 
 Frame = tuple[str, dict[str, str]]
 LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
@@ -111,7 +111,7 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
     where = "" if res.corpus == "all" else "where corpus = ?"
 
     def stream() -> Iterator[str]:
-        con = duckdb.connect(str(res.db), read_only=True)
+        con = read_connection(res.db)
         try:
             cursor = con.execute(f"select text from sentences {where}", [] if res.corpus == "all" else [res.corpus])
             while batch := cursor.fetchmany(50_000):
@@ -124,7 +124,7 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
 
 def corpus_word2vec(res: MethodResources) -> Path:
     """word2vec vectors trained on the setting's sentences, cached by the corpus content hash."""
-    con = duckdb.connect(str(res.db), read_only=True)
+    con = read_connection(res.db)
     try:
         digest = corpus_hash(con, "sentence")[:12]
     finally:

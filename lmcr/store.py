@@ -42,6 +42,17 @@ def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.Du
     return con
 
 
+def read_connection(db: str | Path) -> duckdb.DuckDBPyConnection:
+    """A connection for reading: read-only, unless this process already has the file open read-write
+    (DuckDB refuses a second configuration of one file within a process; then share its mode)."""
+    try:
+        con = duckdb.connect(str(db), read_only=True)
+    except duckdb.ConnectionException:
+        con = duckdb.connect(str(db))
+    con.execute("set enable_progress_bar = false")
+    return con
+
+
 def list_migrations(sql_dir: Path) -> list[Migration]:
     """The `NNN_name.sql` files of `sql_dir`, in version order; duplicate versions are an error."""
     found: dict[int, Migration] = {}

@@ -71,6 +71,33 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     rows = list(csv.DictReader(out.open()))
     assert [r["id"] for r in rows] == ["1", "2"]
     assert all(float(r["sentence_lm"]) < 0 and float(r["frame_lm"]) < 0 and 0 <= float(r["random"]) < 1 for r in rows)
+    baselines = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur,word2vec"])
+    assert baselines.exit_code == 0, baselines.output
+    rows = list(csv.DictReader(out.open()))
+    assert float(rows[0]["cooccur"]) > 0 and -3 <= float(rows[0]["word2vec"]) <= 0  # the sample pours water into cups
+    assert list((paths.data_dir / "baselines").glob("word2vec-all-*.kv"))  # cached by corpus hash
+    complete_contract(tmp_path)
+
+
+def complete_contract(tmp_path):
+    """`lmcr complete` in the CLI contract's format, and its one-line errors."""
+    import json
+
+    given = tmp_path / "in.jsonl"
+    given.write_text(json.dumps({"id": "a", "instruction": "pour me some water", "objects": ["cup", "scissors"]}) + "\n"
+                     + json.dumps({"id": "b", "instruction": "fill the pot with water", "objects": ["cup"]}) + "\n")
+    out = tmp_path / "out.jsonl"
+    result = runner.invoke(app, ["complete", "--input", str(given), "--output", str(out)])
+    assert result.exit_code == 0, result.output
+    a, b = [json.loads(line) for line in out.read_text().splitlines()]
+    assert a["id"] == "a" and a["missing"] == "Destination" and a["frame"]["predicate"] == "pour"
+    assert a["frame"]["roles"]["Destination"] in {"cup", "scissors"} and len(a["candidates"]) == 2
+    assert {"object", "score", "probability"} <= set(a["candidates"][0]) and "question" in a
+    assert b["missing"] is None and b["candidates"] == []
+    given.write_text(json.dumps({"id": "c", "instruction": "juggle the oranges", "objects": ["cup"]}) + "\n")
+    bad = runner.invoke(app, ["complete", "--input", str(given), "--output", str(tmp_path / "none.jsonl")])
+    assert bad.exit_code == 1 and "in.jsonl:1: no known predicate" in bad.output
+    assert not (tmp_path / "none.jsonl").exists()
 
 
 def test_score_rejects_bad_input(tmp_path):
@@ -85,5 +112,7 @@ def test_score_rejects_bad_input(tmp_path):
     missing = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--checkpoint", str(tmp_path),
                                   "--methods", "frame_lm"])
     assert missing.exit_code == 1 and "no frame checkpoint for corpus 'all'" in missing.output
-    unknown = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur"])
-    assert unknown.exit_code == 1 and "not yet available method 'cooccur'" in unknown.output
+    unknown = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "bigram"])
+    assert unknown.exit_code == 1 and "unknown method 'bigram'" in unknown.output
+    no_edges = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "conceptnet"])
+    assert no_edges.exit_code == 1 and "conceptnet needs an edge list" in no_edges.output and not out.exists()

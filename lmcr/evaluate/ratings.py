@@ -46,7 +46,7 @@ def load_ratings(source: Path, sql_dir: Path, verbs: set[str] | None = None) -> 
         con = store.connect(":memory:", sql_dir)
         ingest_ratings(con, source)
     else:
-        con = duckdb.connect(str(source), read_only=True)
+        con = store.read_connection(source)
     try:
         return rated_frames(con, verbs)
     finally:
