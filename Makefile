@@ -16,11 +16,9 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/pip install -q -e ".[dev]"
 	touch $@
 
+# The main job: the whole pipeline (ingest, frames, train, ratings, evaluation, checkpoints) on the sample.
 demo: setup
-	$(BIN)/lmcr ingest --youcook2 $(SAMPLE)/youcook2 --recipes $(SAMPLE)/nyc \
-		--recipes $(SAMPLE)/recipes_json/recipes_sample.jsonl --recipes $(SAMPLE)/recipes_json/folder \
-		--recipes $(SAMPLE)/feeding_america
-	$(BIN)/lmcr frames --shard-size 100
+	PREFECT_SERVER_ANALYTICS_ENABLED=false $(BIN)/python -m flows.pipeline
 	$(BIN)/lmcr srl "could you pour me some water?"
 
 test: setup

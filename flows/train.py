@@ -21,7 +21,7 @@ ALL_SETTINGS = [f"{lin}-{corpus}" for lin in LINEARIZATIONS for corpus in SETTIN
 
 @task(name="train-setting", task_run_name="train {setting}")
 def train_task(setting: str, db: str | None, data_dir: str | None, embedding: int, layers: int,
-               max_epochs: int, max_minutes: float | None) -> dict:
+               max_epochs: int, max_minutes: float | None, skip_unchanged: bool = False) -> dict:
     """Train and publish one setting; returns its best validation perplexity and checkpoint."""
     logger = get_run_logger()
     linearization, corpus = setting.split("-", 1)
@@ -31,6 +31,7 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
         LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
         on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
                                          row["val_ppl"], row["tokens_per_s"]),
+        skip_unchanged=skip_unchanged,
     )
     with connect(paths.db, paths.sql_dir) as con:
         best = con.execute("select best_val_ppl from lm_runs where checkpoint = ?", [str(path)]).fetchone()[0]
@@ -44,13 +45,15 @@ def train_flow(
     layers: int = 2,
     max_epochs: int = 8,
     max_minutes: float | None = 55.0,
+    skip_unchanged: bool = False,
     db: str | None = None,
     data_dir: str | None = None,
 ) -> list[dict]:
-    """Train the requested settings (default: both linearisations x youcook2/recipes/all)."""
+    """Train the requested settings (default: both linearisations x youcook2/recipes/all); with
+    `skip_unchanged`, a setting whose latest checkpoint matches the corpus and configuration is kept."""
     unknown = sorted(set(settings) - set(ALL_SETTINGS))
     if unknown:
         raise ValueError(f"unknown settings {unknown}; choose from {ALL_SETTINGS}")
-    results = [train_task(s, db, data_dir, embedding, layers, max_epochs, max_minutes) for s in settings]
+    results = [train_task(s, db, data_dir, embedding, layers, max_epochs, max_minutes, skip_unchanged) for s in settings]
     create_table_artifact(key="lm-checkpoints", table=results, description="Published language models")
     return results

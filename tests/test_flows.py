@@ -108,3 +108,15 @@ def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):
     assert out["ingested"][0]["items_loaded"] == 9 and out["ingested"][1]["skipped"]
     assert 0.8 < out["aggregate"]["alpha"]["all"] <= 1 and out["aggregate"]["workers"] == 3
     assert (tmp_path / "decisions.csv").exists()
+
+
+def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
+    from flows.pipeline import PipelineParams, pipeline_flow
+
+    params = PipelineParams(data_dir=str(tmp_path), embedding=16, max_epochs=2, per_verb=5)
+    first = pipeline_flow(params)
+    assert (tmp_path / "report" / "report.html").exists() and set(first["checkpoints"]) == {"sentence-all", "frame-all"}
+    assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
+    second = pipeline_flow(params)
+    assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
+    assert second["table1"] == first["table1"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import uuid
 from dataclasses import replace
@@ -13,7 +14,7 @@ import duckdb
 import lmcr
 from lmcr.config import REPO_ROOT
 from lmcr.lm import checkpoint as ckpt
-from lmcr.lm.corpus import TrainingText, training_text
+from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
@@ -39,13 +40,22 @@ def train_setting(
     min_freq: int = 3,
     max_vocab: int = 30_000,
     on_epoch: Callable[[dict], None] | None = None,
+    promote: bool = True,
+    skip_unchanged: bool = False,
 ) -> Path:
-    """Train `linearization` on `corpus`, publish the checkpoint as the setting's latest, record metrics.
+    """Train `linearization` on `corpus`, publish the checkpoint (as the setting's latest when `promote`),
+    record metrics. With `skip_unchanged`, the setting's latest checkpoint is returned as it is when it
+    was trained on the same corpus content with the same configuration.
 
     The store is opened (`open_store`) only to read the text and, afterwards, to record the run: DuckDB
     admits one writing process, and training takes long enough that holding it would lock users out.
     """
     with open_store() as con:
+        if skip_unchanged:
+            current = up_to_date(checkpoints / f"{linearization}-{corpus}", corpus_hash(con, linearization),
+                                 model_config or LMConfig(0), train_config, min_freq)
+            if current is not None:
+                return current
         text = training_text(con, linearization, corpus)
     if not text.train or not text.val:
         raise ValueError(f"no {linearization} training text for corpus {corpus!r}: run ingest (and frames) first")
@@ -60,10 +70,23 @@ def train_setting(
     provenance = {**text.provenance, "code_version": code_version(), "train_config": train_config.to_json(),
                   "min_freq": min_freq, "run_id": run_id}
     path = ckpt.publish(checkpoints, f"{linearization}-{corpus}", model.cpu(), vocab, linearization, metrics,
-                        provenance)
+                        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote)
     with open_store() as con:
         record_run(con, run_id, text, len(vocab), history, path)
     return path
+
+
+def up_to_date(setting_dir: Path, corpus_sha256: str, model_config: LMConfig, train_config: TrainConfig,
+               min_freq: int) -> Path | None:
+    """The setting's latest checkpoint if it came from this corpus content and configuration."""
+    if not (setting_dir / "LATEST").exists():
+        return None
+    path = ckpt.resolve(setting_dir)
+    prov = json.loads((path / "provenance.json").read_text(encoding="utf-8"))
+    same = (prov.get("corpus_sha256") == corpus_sha256 and prov.get("train_config") == train_config.to_json()
+            and prov.get("model_config") == replace(model_config, vocab_size=0).to_json()
+            and prov.get("min_freq") == min_freq)
+    return path if same else None
 
 
 def record_run(con: duckdb.DuckDBPyConnection, run_id: str, text: TrainingText, vocab_size: int,

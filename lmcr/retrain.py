@@ -1,0 +1,87 @@
+"""Scheduled retraining's decision: is anything new, and is the new checkpoint at least as good?
+
+The inputs of a setting are the ingested corpus files (and, for the frame LM, the frame build) plus
+the rating files, each known by its sha256. When they match the last decision's, nothing is trained.
+Otherwise a candidate is trained without promotion, both it and the current checkpoint are scored on
+the rated frames with the evaluation protocol (overall accuracy at lambda, k), and the candidate
+becomes LATEST only if it is not worse. Every decision and both scores go to `retrain_decisions`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import duckdb
+
+from lmcr.evaluate.protocol import score_rated
+from lmcr.evaluate.ratings import RatedFrame
+from lmcr.evaluate.scenarios import accuracy, build_scenarios
+from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.corpus import corpus_hash
+from lmcr.methods import LM_METHODS, MethodResources, make_scorer
+
+METHOD_OF = {lin: method for method, lin in LM_METHODS.items()}
+
+
+@dataclass(frozen=True)
+class RetrainConfig:
+    setting: str = "sentence-all"
+    lam: float = 1.0
+    k: int = 6
+    per_verb: int = 50
+    seed: int = 0
+
+    @property
+    def linearization(self) -> str:
+        return self.setting.split("-", 1)[0]
+
+
+def inputs_sha256(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
+    """One hash over what a setting is trained and judged on: corpus content and rating files."""
+    ratings = con.execute("select sha256 from rating_files order by 1").fetchall()
+    return hashlib.sha256(repr((corpus_hash(con, linearization), ratings)).encode()).hexdigest()
+
+
+def last_inputs(con: duckdb.DuckDBPyConnection, setting: str) -> str | None:
+    row = con.execute("select inputs_sha256 from retrain_decisions where setting = ? "
+                      "order by decided_at desc limit 1", [setting]).fetchone()
+    return row[0] if row else None
+
+
+def checkpoint_accuracy(version: Path, rated: list[RatedFrame], config: RetrainConfig) -> float:
+    """Overall accuracy of one checkpoint version on the rated frames' scenarios."""
+    method = METHOD_OF[config.linearization]
+    scores = score_rated(rated, {method: make_scorer(method, MethodResources(checkpoints=version))})
+    scenarios, _ = build_scenarios(rated, config.lam, config.k, config.per_verb, config.seed)
+    if not scenarios:
+        raise ValueError(f"the ratings give no scenarios at lambda={config.lam:g}, k={config.k}")
+    return accuracy(scenarios, scores[method])["all"]
+
+
+def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, rated: list[RatedFrame],
+           config: RetrainConfig, inputs: str) -> dict:
+    """Promote `candidate` if it scores at least as well as the current LATEST; record the decision."""
+    setting_dir = checkpoints / config.setting
+    current = ckpt.resolve(setting_dir) if (setting_dir / "LATEST").exists() else None
+    cand_acc = checkpoint_accuracy(candidate, rated, config)
+    cur_acc = checkpoint_accuracy(current, rated, config) if current and current != candidate else None
+    if cur_acc is None or cand_acc >= cur_acc:
+        ckpt.set_latest(checkpoints, config.setting, candidate.name)
+        decision = "promoted"
+        reason = "no current checkpoint" if cur_acc is None else f"not worse: {cand_acc:.3f} >= {cur_acc:.3f}"
+    else:
+        decision, reason = "kept", f"candidate worse: {cand_acc:.3f} < {cur_acc:.3f}"
+    row = {"setting": config.setting, "inputs_sha256": inputs, "decision": decision, "reason": reason,
+           "candidate": str(candidate), "current": str(current) if current else None,
+           "candidate_accuracy": cand_acc, "current_accuracy": cur_acc}
+    record(con, row)
+    return row
+
+
+def record(con: duckdb.DuckDBPyConnection, row: dict) -> None:
+    cols = ["setting", "inputs_sha256", "decision", "reason", "candidate", "current", "candidate_accuracy",
+            "current_accuracy"]
+    con.execute(f"insert into retrain_decisions ({', '.join(cols)}) values ({', '.join('?' * len(cols))})",
+                [row.get(c) for c in cols])

