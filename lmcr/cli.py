@@ -356,6 +356,47 @@ def annotate_quality(
         console.print(f"{sum(1 for r in rows if r['Reject'])} of {len(rows)} assignments to reject -> {decisions}")
 
 
+@app.command()
+def execute(
+    instruction: str = typer.Argument(..., help="The spoken instruction, e.g. \"pour me some water\"."),
+    scene: Path = typer.Option(..., help="Scene JSON: objects with labels and table positions."),
+    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
+    method: str = typer.Option("sentence_lm", help="Scorer that completes the instruction."),
+    corpus: str = typer.Option("all", help="LM training setting."),
+    json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
+    render: Optional[Path] = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
+    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
+) -> None:
+    """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless)."""
+    import json
+
+    from lmcr.complete import CompletionError, completion_scorer
+    from lmcr.executor.execute import ExecutionError, execute as run_instruction, save_render
+    from lmcr.executor.scene import load_scene
+    from lmcr.jsonl import InputError
+    from lmcr.lm.checkpoint import CheckpointError
+    from lmcr.srl.parser import NoPredicateError
+
+    paths = paths_from_env()
+    try:
+        layout = load_scene(scene)
+        scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus), paths.data_dir / "calibration")
+        parser = _srl_parser(model, None)
+        frames: list | None = [] if render else None
+        result = run_instruction(instruction, layout, parser, scorer, config, paths.data_dir / "robot", frames)
+    except (InputError, CheckpointError, ValueError, FileNotFoundError, NoPredicateError, CompletionError,
+            ExecutionError) as exc:
+        fail(str(exc))
+    if render:
+        result["render"] = str(save_render(frames, render))
+    if not json_out:
+        for w in result["waypoints"]:
+            console.print(f"  {w['name']}: {1000 * w['error_m']:.1f} mm", highlight=False)
+        console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
+                      f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
+    print(json.dumps(result))
+
+
 def _srl_parser(model: str | None, resources: Path | None):
     from lmcr.srl.parser import load_parser
 

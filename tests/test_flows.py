@@ -117,6 +117,7 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     first = pipeline_flow(params)
     assert (tmp_path / "report" / "report.html").exists() and set(first["checkpoints"]) == {"sentence-all", "frame-all"}
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
+    assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
     second = pipeline_flow(params)
     assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
     assert second["table1"] == first["table1"]

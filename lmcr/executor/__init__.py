@@ -1,0 +1,1 @@
+"""The robot end: a simulated Baxter (pybullet) that detects, completes, plans and executes."""

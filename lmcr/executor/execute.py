@@ -1,0 +1,73 @@
+"""One instruction in simulation: build the scene, detect the objects, complete the instruction with
+the detected labels, plan and execute the predicate's motion, and check the outcome."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Callable
+
+import pybullet as p
+
+from lmcr.complete import CompletionConfig, complete
+from lmcr.executor.detect import capture, detect
+from lmcr.executor.motion import PLANS, TOLERANCE, choose_arm
+from lmcr.executor.scene import Scene, build_world
+
+
+class ExecutionError(ValueError):
+    """The completed frame names something the robot cannot act on here."""
+
+
+def _connect() -> None:
+    if not p.isConnected():
+        p.connect(p.DIRECT)
+
+
+def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
+            frames: list | None = None) -> dict:
+    """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success.
+    With `frames` (a list), camera images are appended at every waypoint for rendering."""
+    started = time.perf_counter()
+    _connect()
+    robot = build_world(scene, cache_dir)
+    seen = detect(scene.bodies)
+    completion = complete(parser, scorer, instruction, [d.label for d in seen], config)
+    frame = completion["frame"]
+    predicate, roles = frame["predicate"], frame["roles"]
+    held_role, target_role, plan = PLANS[predicate]
+    try:
+        held, target = scene.find(roles[held_role]), scene.find(roles[target_role])
+    except KeyError as exc:
+        raise ExecutionError(f"cannot {predicate} here: {exc.args[0]}") from exc
+    planned = time.perf_counter()
+    arm = choose_arm(robot, scene, held, target)
+    if frames is not None:
+        arm.on_waypoint = lambda: frames.append(capture()[0])
+        frames.append(capture()[0])
+    checks = plan(arm, held, target)
+    waypoints_ok = all(w["error_m"] <= TOLERANCE for w in arm.log)
+    return {"frame": frame, "chosen_object": completion["candidates"][0]["object"] if completion["candidates"] else None,
+            "success": bool(checks["ok"] and waypoints_ok and arm.grasps_ok), "waypoints": arm.log,
+            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
+                       "grasped": arm.grasps_ok, "waypoints_within_tolerance": waypoints_ok},
+            "arm": arm.side, "missing": completion["missing"], "question": completion["question"],
+            "detections": [{"label": d.label, "position": [round(v, 3) for v in d.position]} for d in seen],
+            "seconds": {"perceive_and_complete": round(planned - started, 3),
+                        "plan_and_execute": round(time.perf_counter() - planned, 3)}}
+
+
+def save_render(frames: list, path: Path) -> Path:
+    """The last frame as PNG, or every waypoint's frame as an animated GIF."""
+    from PIL import Image
+
+    from lmcr.files import atomic_path
+
+    images = [Image.fromarray(f) for f in frames]
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        if path.suffix.lower() == ".gif":
+            images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=300, loop=0)
+        else:
+            images[-1].save(tmp, format="PNG")
+    return path

@@ -1,0 +1,203 @@
+"""Kitchen scenes: the scene file (CLI contract), object shapes sized like the real thing, and building
+the table, the robot and the objects in pybullet.
+
+Table frame: origin at the table-top centre, +x away from the robot, +y to its left; objects stand
+within |x| <= 0.3 and |y| <= 0.5. Containers (cups, bowls, pots, the sink, ...) are open boxes built
+from a floor and four walls; bottles and jugs hold liquids, shakers hold powders, food is a box,
+sphere or cylinder.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pybullet as p
+
+from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
+from lmcr.jsonl import InputError
+from lmcr.srl.lexicon import load_lexicon
+
+TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
+TABLE_TOP = 0.75  # height above the floor
+TABLE_SIZE = (0.8, 1.2)
+X_LIMIT, Y_LIMIT = 0.3, 0.5
+
+# label -> (kind, size): container (width, depth, height, wall), bottle (radius, height),
+# food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
+LIQUIDS = ("water", "milk", "wine", "oil", "vinegar", "honey", "soy sauce")
+POWDERS = ("salt", "sugar", "flour", "black pepper", "cinnamon", "parsley", "cheese")
+CONTAINERS = {"cup": (0.08, 0.08, 0.10), "glass": (0.07, 0.07, 0.12), "mug": (0.09, 0.09, 0.10),
+              "bowl": (0.16, 0.16, 0.07), "plate": (0.24, 0.24, 0.025), "pan": (0.26, 0.26, 0.05),
+              "pot": (0.22, 0.22, 0.15), "skillet": (0.26, 0.26, 0.05), "blender": (0.18, 0.18, 0.22),
+              "microwave": (0.30, 0.26, 0.12), "oven": (0.34, 0.30, 0.12), "sink": (0.36, 0.30, 0.10),
+              "cutting board": (0.30, 0.20, 0.02), "soup": (0.16, 0.16, 0.07), "salad": (0.18, 0.18, 0.08),
+              "chocolate": (0.14, 0.14, 0.06), "batter": (0.14, 0.14, 0.06)}  # food served in a bowl
+FOOD = {"onion": ("sphere", 0.035), "garlic": ("sphere", 0.025), "potato": ("sphere", 0.04),
+        "tomato": ("sphere", 0.035), "apple": ("sphere", 0.04), "strawberry": ("sphere", 0.02),
+        "egg": ("sphere", 0.025), "ice": ("box", 0.03, 0.03, 0.03), "banana": ("box", 0.16, 0.035, 0.035),
+        "bell pepper": ("sphere", 0.04), "bread": ("box", 0.10, 0.08, 0.03), "steak": ("box", 0.14, 0.09, 0.025),
+        "chicken": ("box", 0.12, 0.08, 0.04), "fish": ("box", 0.18, 0.06, 0.03), "rice": ("cyl", 0.04, 0.06),
+        "pasta": ("cyl", 0.035, 0.08), "cake": ("cyl", 0.09, 0.06), "pizza": ("cyl", 0.12, 0.015),
+        "butter": ("box", 0.08, 0.04, 0.03), "knife": ("box", 0.20, 0.025, 0.02), "spoon": ("box", 0.16, 0.03, 0.02),
+        "scissors": ("box", 0.16, 0.07, 0.015), "sponge": ("box", 0.09, 0.06, 0.03),
+        "towel": ("box", 0.20, 0.14, 0.015), "pastry brush": ("box", 0.18, 0.03, 0.02)}
+BOTTLE = (0.03, 0.16)  # radius, height of bottles and jugs
+SHAKER = (0.025, 0.09)
+
+
+@dataclass
+class SceneObject:
+    label: str
+    xy: tuple[float, float]
+    body: int = -1
+
+    @property
+    def kind(self) -> str:
+        if self.label in CONTAINERS:
+            return "container"
+        if self.label in LIQUIDS:
+            return "bottle"
+        if self.label in POWDERS:
+            return "shaker"
+        return "food"
+
+
+@dataclass
+class Scene:
+    objects: list[SceneObject]
+    seed: int = 0
+    bodies: dict[int, str] = field(default_factory=dict)
+
+    def find(self, label: str) -> SceneObject:
+        for obj in self.objects:
+            if obj.label == label:
+                return obj
+        raise KeyError(f"no {label!r} on the table (there are: {', '.join(o.label for o in self.objects)})")
+
+
+def footprint(label: str) -> float:
+    """Radius of the circle an object covers on the table."""
+    if label in CONTAINERS:
+        w, d, _ = CONTAINERS[label]
+        return max(w, d) / 2
+    if label in LIQUIDS:
+        return BOTTLE[0]
+    if label in POWDERS:
+        return SHAKER[0]
+    shape = FOOD[label]
+    return shape[1] if shape[0] in ("sphere", "cyl") else max(shape[1], shape[2]) / 2
+
+
+def _overlap(a: str, axy, b: str, bxy) -> bool:
+    gap = ((axy[0] - bxy[0]) ** 2 + (axy[1] - bxy[1]) ** 2) ** 0.5
+    return gap < footprint(a) + footprint(b) + 0.02
+
+
+def load_scene(path: Path) -> Scene:
+    """Read and validate a scene file; objects without `xy` are placed at random (seeded)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}:{exc.lineno}: not JSON: {exc.msg}") from exc
+    if not isinstance(data, dict) or not isinstance(data.get("objects"), list):
+        raise InputError(f"{path}: a scene is an object with an 'objects' list")
+    return make_scene([(o.get("label"), o.get("xy")) for o in data["objects"]], int(data.get("seed", 0)), str(path))
+
+
+def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str = "scene") -> Scene:
+    vocabulary = set(load_lexicon().objects)
+    placed: list[SceneObject] = []
+    for k, (label, xy) in enumerate(items):
+        if label not in vocabulary:
+            raise InputError(f"{where}: object {k}: unknown label {label!r}")
+        if xy is not None:
+            if len(xy) != 2 or abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
+                raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
+            for other in placed:
+                if _overlap(label, xy, other.label, other.xy):
+                    raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
+        placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
+    rng = random.Random(seed)
+    for obj in placed:
+        if obj.xy is None:
+            obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
+    return Scene(placed, seed)
+
+
+def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
+    margin = footprint(label)
+    for _ in range(500):
+        xy = (rng.uniform(-X_LIMIT + margin, X_LIMIT - margin), rng.uniform(-Y_LIMIT + margin, Y_LIMIT - margin))
+        if not any(_overlap(label, xy, o.label, o.xy) for o in placed):
+            return round(xy[0], 3), round(xy[1], 3)
+    raise InputError(f"{where}: no free spot for the {label} on the table")
+
+
+def world_xy(xy: tuple[float, float]) -> tuple[float, float]:
+    return TABLE_CENTRE[0] + xy[0], TABLE_CENTRE[1] + xy[1]
+
+
+def _color(label: str) -> list[float]:
+    rng = random.Random(label)
+    return [rng.uniform(0.2, 0.9), rng.uniform(0.2, 0.9), rng.uniform(0.2, 0.9), 1.0]
+
+
+def _container(label: str, x: float, y: float) -> int:
+    w, d, h = CONTAINERS[label]
+    t = 0.006  # wall thickness
+    parts = [([w / 2, d / 2, t / 2], [0, 0, t / 2]), ([t / 2, d / 2, h / 2], [w / 2 - t / 2, 0, h / 2]),
+             ([t / 2, d / 2, h / 2], [-w / 2 + t / 2, 0, h / 2]), ([w / 2, t / 2, h / 2], [0, d / 2 - t / 2, h / 2]),
+             ([w / 2, t / 2, h / 2], [0, -d / 2 + t / 2, h / 2])]
+    col = p.createCollisionShapeArray([p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts],
+                                      collisionFramePositions=[o for _, o in parts])
+    vis = p.createVisualShapeArray([p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts],
+                                   visualFramePositions=[o for _, o in parts], rgbaColors=[_color(label)] * 5)
+    return p.createMultiBody(0.3, col, vis, [x, y, TABLE_TOP])
+
+
+def _solid(label: str, x: float, y: float) -> int:
+    if label in LIQUIDS or label in POWDERS:
+        radius, height = BOTTLE if label in LIQUIDS else SHAKER
+        shape = ("cyl", radius, height)
+    else:
+        shape = FOOD[label]
+    if shape[0] == "sphere":
+        col, vis, z = (p.createCollisionShape(p.GEOM_SPHERE, radius=shape[1]),
+                       p.createVisualShape(p.GEOM_SPHERE, radius=shape[1], rgbaColor=_color(label)), shape[1])
+    elif shape[0] == "cyl":
+        col = p.createCollisionShape(p.GEOM_CYLINDER, radius=shape[1], height=shape[2])
+        vis = p.createVisualShape(p.GEOM_CYLINDER, radius=shape[1], length=shape[2], rgbaColor=_color(label))
+        z = shape[2] / 2
+    else:
+        half = [s / 2 for s in shape[1:]]
+        col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half)
+        vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_color(label))
+        z = half[2]
+    return p.createMultiBody(0.15, col, vis, [x, y, TABLE_TOP + z + 0.001])
+
+
+def build_world(scene: Scene, cache_dir: Path) -> int:
+    """Reset a DIRECT pybullet world with floor, table, robot and the scene's objects; returns the robot."""
+    p.resetSimulation()
+    p.setGravity(0, 0, -9.81)
+    p.setTimeStep(1 / 240)
+    floor = p.createCollisionShape(p.GEOM_PLANE)
+    p.createMultiBody(0, floor)
+    half = [TABLE_SIZE[0] / 2, TABLE_SIZE[1] / 2, 0.02]
+    p.createMultiBody(0, p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
+                      p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
+                      [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02])
+    robot = p.loadURDF(str(baxter_urdf(cache_dir)), [0, 0, PEDESTAL_HEIGHT], useFixedBase=True)
+    scene.bodies = {}
+    for obj in scene.objects:
+        x, y = world_xy(obj.xy)
+        obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
+        scene.bodies[obj.body] = obj.label
+    for _ in range(120):  # let everything settle
+        p.stepSimulation()
+    return robot
