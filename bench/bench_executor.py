@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import random
 import statistics
-import time
 
 from lmcr.complete import completion_scorer
 from lmcr.config import paths_from_env
