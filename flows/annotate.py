@@ -47,7 +47,7 @@ def aggregate_task(decisions_out: str | None, db: str | None, data_dir: str | No
             write_decisions(Path(decisions_out), decisions(con, QualityRules()))
     create_table_artifact(key="krippendorff-alpha", table=[{"verbs": k, "alpha": round(v, 3)} for k, v in alpha.items()],
                           description="Krippendorff's alpha (interval) over valid ratings")
-    create_table_artifact(key="worker-quality", table=workers.fillna("").to_dict("records"),
+    create_table_artifact(key="worker-quality", table=workers.astype(object).where(workers.notna(), None).to_dict("records"),
                           description="Per worker: leave-one-out agreement, gold accuracy, MACE spam probability")
     return {"alpha": alpha, "workers": len(workers)}
 

@@ -257,15 +257,16 @@ def spill(held: SceneObject, n: int) -> list[int]:
     return bodies
 
 
-def inside(target: SceneObject, point) -> bool:
-    """Whether a point lies within the target's horizontal outline and between the table and its rim."""
+def inside(target: SceneObject, point, above: float = 0.05) -> bool:
+    """Whether a point lies within the target's horizontal outline, above the table and at most `above`
+    over its rim (0.01: held in it, as a liquid must be; more: resting on top of it)."""
     lo, hi = p.getAABB(target.body)
-    return lo[0] <= point[0] <= hi[0] and lo[1] <= point[1] <= hi[1] and TABLE_TOP - 0.01 <= point[2] <= hi[2] + 0.05
+    return lo[0] <= point[0] <= hi[0] and lo[1] <= point[1] <= hi[1] and TABLE_TOP - 0.01 <= point[2] <= hi[2] + above
 
 
-def landed_in(target: SceneObject, bodies: list[int]) -> float:
+def landed_in(target: SceneObject, bodies: list[int], above: float = 0.05) -> float:
     settle(480)
-    hits = sum(inside(target, p.getBasePositionAndOrientation(b)[0]) for b in bodies)
+    hits = sum(inside(target, p.getBasePositionAndOrientation(b)[0], above) for b in bodies)
     return hits / max(len(bodies), 1)
 
 
@@ -293,7 +294,7 @@ def plan_pour(arm: Arm, held: SceneObject, target: SceneObject) -> dict:
     tilt = tilt_for(arm, upright)
     arm.move("tilt to pour", upright, tilt)
     align_spout(arm, held, target, upright, tilt)
-    share = landed_in(target, spill(held, 30))
+    share = landed_in(target, spill(held, 30), above=0.01)  # a liquid must stay inside, below the rim
     arm.move("tilt back", upright + [-0.05, 0, 0.05])  # up and a little towards the robot: easy to reach upright
     return {"liquid_in_target": round(share, 3), "ok": share >= 0.6}
 

@@ -123,7 +123,7 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
                     raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
     rng = random.Random(seed)
-    for obj in placed:
+    for obj in sorted(placed, key=lambda o: -footprint(o.label)):  # big ones first: they need the room
         if obj.xy is None:
             obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
     return Scene(placed, seed)
