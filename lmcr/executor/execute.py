@@ -11,7 +11,7 @@ import pybullet as p
 
 from lmcr.complete import CompletionConfig, complete
 from lmcr.executor.detect import capture, detect
-from lmcr.executor.motion import PLANS, TOLERANCE, choose_arm
+from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
 from lmcr.executor.scene import Scene, build_world
 
 
@@ -41,7 +41,7 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
     except KeyError as exc:
         raise ExecutionError(f"cannot {predicate} here: {exc.args[0]}") from exc
     planned = time.perf_counter()
-    arm = choose_arm(robot, scene, held, target)
+    arm = choose_arm(robot, scene, held, target, tilts=predicate in TILTING)
     if frames is not None:
         arm.on_waypoint = lambda: frames.append(capture()[0])
         frames.append(capture()[0])

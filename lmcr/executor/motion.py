@@ -208,19 +208,28 @@ def top(obj: SceneObject) -> np.ndarray:
     return np.array([pos[0], pos[1], hi[2]])
 
 
+def carry_height(arm: Arm, xy) -> float:
+    """SAFE, or lower where the arm cannot reach that high (the far edge of the table)."""
+    for z in (SAFE, SAFE - 0.08, SAFE - 0.15):
+        if arm.residual([xy[0], xy[1], z]) <= TOLERANCE / 4:
+            return z
+    return SAFE - 0.15
+
+
 def pick(arm: Arm, obj: SceneObject) -> None:
     """Approach from above, grip the object's top, lift to carrying height."""
     t = top(obj)
-    arm.move(f"above {obj.label}", [t[0], t[1], SAFE])
+    z = carry_height(arm, t)
+    arm.move(f"above {obj.label}", [t[0], t[1], z])
     arm.move(f"grip {obj.label}", [t[0], t[1], t[2] + 0.005])  # fingertips at the top: the grasp attaches
     arm.grasp(obj.body, footprint(obj.label))
-    arm.move(f"lift {obj.label}", [t[0], t[1], SAFE])
+    arm.move(f"lift {obj.label}", [t[0], t[1], z])
 
 
 def over(arm: Arm, target: SceneObject, clearance: float, name: str = "") -> np.ndarray:
     t = top(target)
     goal = [t[0], t[1], t[2] + clearance]
-    arm.move(name or f"over {target.label}", [t[0], t[1], SAFE])
+    arm.move(name or f"over {target.label}", [t[0], t[1], carry_height(arm, t)])
     arm.move(f"down to {target.label}", goal)
     return np.asarray(goal)
 
@@ -282,18 +291,19 @@ TILTS = [p.getQuaternionFromEuler(e) for e in ((math.pi, -1.9, 0), (math.pi, 1.9
                                                 (math.pi + 1.9, 0, 0))]
 
 
-def tilt_for(arm: Arm, point) -> tuple:
-    """The most reachable tilt at `point`."""
-    return min(TILTS, key=lambda q: arm.residual(point, q))
+def tilt_for(arm: Arm, point) -> tuple[tuple, np.ndarray]:
+    """The most reachable tilt at `point` or a little above it: (orientation, point)."""
+    options = [(q, np.asarray(point) + [0, 0, dz]) for dz in (0.0, 0.05, 0.10) for q in TILTS]
+    return min(options, key=lambda o: arm.residual(o[1], o[0]) + 0.05 * o[1][2])  # lower is better when tied
 
 
 def plan_pour(arm: Arm, held: SceneObject, target: SceneObject) -> dict:
     """Pick up the liquid, hold it above the target, tilt, let it run; liquid must end in the target."""
     pick(arm, held)
     upright = over(arm, target, 0.12 + height(held.label) / 2)
-    tilt = tilt_for(arm, upright)
-    arm.move("tilt to pour", upright, tilt)
-    align_spout(arm, held, target, upright, tilt)
+    tilt, spout = tilt_for(arm, upright)
+    arm.move("tilt to pour", spout, tilt)
+    align_spout(arm, held, target, spout, tilt)
     share = landed_in(target, spill(held, 30), above=0.01)  # a liquid must stay inside, below the rim
     arm.move("tilt back", upright + [-0.05, 0, 0.05])  # up and a little towards the robot: easy to reach upright
     return {"liquid_in_target": round(share, 3), "ok": share >= 0.6}
@@ -303,7 +313,7 @@ def plan_sprinkle(arm: Arm, held: SceneObject, target: SceneObject) -> dict:
     """Pick up the shaker, hold it above the target, tilt and shake; powder must land on the target."""
     pick(arm, held)
     goal = over(arm, target, 0.15 + height(held.label) / 2)
-    tilt = tilt_for(arm, goal)
+    tilt, goal = tilt_for(arm, goal)
     arm.move("tilt", goal, tilt)
     goal = align_spout(arm, held, target, goal, tilt)
     particles = []
@@ -339,7 +349,8 @@ def plan_dump(arm: Arm, held: SceneObject, target: SceneObject) -> dict:
     """Pick up the object, carry it over the target, turn the gripper over and let go."""
     pick(arm, held)
     goal = over(arm, target, 0.15 + height(held.label))
-    arm.move("turn over", goal, tilt_for(arm, goal))
+    tilt, turned = tilt_for(arm, goal)
+    arm.move("turn over", turned, tilt)
     arm.release()
     ok = rests_in(held, target)
     arm.move("retreat", [goal[0], goal[1], SAFE])
@@ -375,6 +386,7 @@ def plan_stroke(arm: Arm, held: SceneObject, target: SceneObject) -> dict:
     return {"strokes_reached": all(e <= TOLERANCE for e in errors), "over_target": bool(on), "ok": bool(ok)}
 
 
+TILTING = frozenset({"pour", "fill", "sprinkle", "season", "dump"})
 # predicate -> (role held by the gripper, role acted on, plan)
 PLANS = {
     "pour": ("Theme", "Destination", plan_pour),
@@ -391,13 +403,18 @@ PLANS = {
 }
 
 
-def choose_arm(robot: int, scene: Scene, held: SceneObject, target: SceneObject) -> Arm:
-    """The arm whose IK gets closest to both the pick and the target approach points."""
+def choose_arm(robot: int, scene: Scene, held: SceneObject, target: SceneObject, tilts: bool = False) -> Arm:
+    """The arm whose IK gets closest to both the pick and the target approach points (and, for plans
+    that tilt, to a tilted pose above the target)."""
     best, best_cost = None, math.inf
     for side in ("left", "right"):
         arm = Arm(robot, side)
         arm.go_home()
         cost = max(arm.residual([*top(o)[:2], SAFE]) for o in (held, target))
+        if tilts:
+            t = top(target)
+            orientation, point = tilt_for(arm, [t[0], t[1], t[2] + 0.12 + height(held.label) / 2])
+            cost = max(cost, arm.residual(point, orientation))
         # reaching across the body sweeps the arm over the table: prefer the held object's side
         cost += 0.01 * ((top(held)[1] - TABLE_CENTRE[1] < 0) == (side == "left"))
         if cost < best_cost:
