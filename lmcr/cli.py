@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 from typing import Optional
 
+import duckdb
 import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -26,6 +27,11 @@ def fail(message: str) -> None:
     """Exit non-zero with a one-line reason (the CLI contract)."""
     console.print(f"[red]error:[/red] {message}", highlight=False, soft_wrap=True)
     raise typer.Exit(code=1)
+
+
+def _one_line(exc: Exception) -> str:
+    """An exception as the CLI contract's one-line reason (DuckDB adds hints on further lines)."""
+    return " ".join(str(exc).split())
 
 
 def print_rows(title: str, rows: list[dict]) -> None:
@@ -188,8 +194,8 @@ def score(
         frames = [r.frame for r in rows]
         started = time.perf_counter()
         scores = {m: make_scorer(m, res)(frames) for m in (x.strip() for x in methods.split(",")) if m}
-    except (InputError, CheckpointError, ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
+    except (InputError, CheckpointError, ValueError, FileNotFoundError, duckdb.Error) as exc:
+        fail(_one_line(exc))
     elapsed = time.perf_counter() - started
     write_scores_csv(out, columns, rows, scores)
     console.print(f"{len(rows):,} frames x {len(scores)} methods -> {out} ({elapsed:.2f}s)")
@@ -226,8 +232,8 @@ def evaluate(
         results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
                                  out, paths.data_dir / "calibration" if calibrate else None,
                                  log=lambda m: console.print(m, highlight=False))
-    except (InputError, FileNotFoundError, MigrationError) as exc:
-        fail(str(exc))
+    except (InputError, FileNotFoundError, MigrationError, duckdb.Error) as exc:
+        fail(_one_line(exc))
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
@@ -258,8 +264,8 @@ def complete(
     try:
         records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
         scorer, config = completion_scorer(method, res, paths_from_env().data_dir / "calibration")
-    except (InputError, CheckpointError, ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
+    except (InputError, CheckpointError, ValueError, FileNotFoundError, duckdb.Error) as exc:
+        fail(_one_line(exc))
     parser = _srl_parser(model, None)
     out = []
     for line, rec in records:
