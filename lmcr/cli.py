@@ -342,12 +342,15 @@ def annotate_tasks(
 @annotate_app.command("quality")
 def annotate_quality(
     decisions: Optional[Path] = typer.Option(None, help="Write the Approve/Reject re-upload CSV here."),
+    aggregates: Optional[Path] = typer.Option(None, help="Write per-frame mean, n and Dawid-Skene label (CSV)."),
     max_spam: float = typer.Option(0.5, help="Reject workers MACE calls spammers with this probability."),
     min_gold_accuracy: float = typer.Option(0.5, help="Reject assignments failing more gold checks."),
     db: Optional[Path] = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Krippendorff's alpha overall and per verb, the worker table, and approve/reject decisions."""
-    from lmcr.annotate.quality import QualityRules, alpha_by_verb, decisions as decide, worker_table, write_decisions
+    from lmcr.annotate.quality import (QualityRules, alpha_by_verb, dawid_skene, decisions as decide, worker_table,
+                                       write_decisions)
+    from lmcr.files import atomic_path
 
     paths = paths_from_env(db=db)
     con = connect(paths.db, paths.sql_dir)
@@ -360,6 +363,12 @@ def annotate_quality(
         rows = decide(con, QualityRules(max_spam=max_spam, min_gold_accuracy=min_gold_accuracy))
         write_decisions(decisions, rows)
         console.print(f"{sum(1 for r in rows if r['Reject'])} of {len(rows)} assignments to reject -> {decisions}")
+    if aggregates:
+        table = dawid_skene(con)
+        with atomic_path(aggregates) as tmp:
+            table.to_csv(tmp, index=False)
+        agree = float((table["dawid_skene"] == table["mean"].round()).mean())
+        console.print(f"{len(table):,} frames -> {aggregates}; Dawid-Skene label = rounded mean for {agree:.1%}")
 
 
 @app.command()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import re
 
-from lmcr.annotate.quality import alpha_by_verb, decisions, worker_table, write_decisions
+from lmcr.annotate.quality import alpha_by_verb, dawid_skene, decisions, worker_table, write_decisions
 from lmcr.annotate.results import ingest_ratings
 from lmcr.annotate.tasks import TaskConfig, disagreement_frames, generate_tasks, protocol_frames, render
 
@@ -68,6 +68,9 @@ def test_tasks_round_trip_with_gold_checks(con, tmp_path):
     assert out.read_text().splitlines()[0] == "AssignmentId,HITId,WorkerId,AssignmentStatus,Approve,Reject"
     assert con.execute("select count(*) from frame_ratings where arg1 like 'gold%'").fetchone() == (0,)
     assert set(alpha_by_verb(con)) >= {"all", "pour"}
+    ds = dawid_skene(con)  # gold items are left out; every rated frame gets a label 1-5 beside its mean
+    assert len(ds) == con.execute("select count(*) from frame_ratings").fetchone()[0]
+    assert ds["dawid_skene"].between(1, 5).all() and {"mean", "count"} <= set(ds.columns)
 
 
 def test_preview_page_structure(con, tmp_path):

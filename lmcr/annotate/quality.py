@@ -84,7 +84,9 @@ def dawid_skene(con: duckdb.DuckDBPyConnection) -> pd.DataFrame:
     df = ratings_frame(con)
     df = df[~df["frame_id"].isin(_gold(con).keys())]
     task = df[FRAME_KEY].astype(str).agg("|".join, axis=1)
-    ds = DawidSkene(n_iter=100).fit_predict(pd.DataFrame({"task": task, "worker": df["worker_id"], "label": df["rating"]}))
+    with warnings.catch_warnings():  # crowd-kit's deprecated pandas inplace= calls
+        warnings.simplefilter("ignore")
+        ds = DawidSkene(n_iter=100).fit_predict(pd.DataFrame({"task": task, "worker": df["worker_id"], "label": df["rating"]}))
     means = df.assign(task=task).groupby("task")["rating"].agg(["mean", "count"])
     return means.join(ds.rename("dawid_skene")).reset_index()
 
