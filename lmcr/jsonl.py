@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Iterable, Iterator, TextIO
 
 from lmcr.files import atomic_path
 
@@ -13,14 +13,18 @@ class InputError(ValueError):
     """Bad input: names the file and line."""
 
 
+def open_input(path: Path, newline: str | None = None, encoding: str = "utf-8") -> TextIO:
+    """Open an input text file; an unreadable one raises InputError naming it and why."""
+    try:
+        return open(path, newline=newline, encoding=encoding)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+
+
 def read_jsonl(path: Path, required: dict[str, type | tuple[type, ...]]) -> Iterator[tuple[int, dict]]:
     """(line number, record) for each non-blank line; a line that is not a JSON object with the
     required fields of the required types raises InputError naming file and line."""
-    try:
-        handle = open(path, encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
-    with handle:
+    with open_input(path) as handle:
         for line_no, line in enumerate(handle, start=1):
             if not line.strip():
                 continue

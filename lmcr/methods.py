@@ -16,7 +16,7 @@ from lmcr.baselines.terms import default_lemmatizer
 from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
 from lmcr.config import paths_from_env
 from lmcr.files import atomic_path
-from lmcr.jsonl import InputError
+from lmcr.jsonl import InputError, open_input
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
 from lmcr.lm.score import LMScorer
@@ -139,11 +139,7 @@ def read_frames_csv(path: Path) -> tuple[list[str], list[FrameRow]]:
     """Rows of a frames CSV (`verb, role1, arg1, role2, arg2`, other columns kept), validated against the
     lexicon: a bad row fails with file, line and reason."""
     lex = load_lexicon()
-    try:
-        handle = open(path, newline="", encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
-    with handle:
+    with open_input(path, newline="") as handle:
         reader = csv.DictReader(handle)
         columns = reader.fieldnames or []
         missing = [c for c in REQUIRED_COLUMNS if c not in columns]

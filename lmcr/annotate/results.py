@@ -22,7 +22,7 @@ import duckdb
 import pyarrow as pa
 
 from lmcr.files import file_sha256
-from lmcr.jsonl import InputError
+from lmcr.jsonl import InputError, open_input
 
 META = ("HITId", "AssignmentId", "WorkerId", "AssignmentStatus")
 ITEM_FIELDS = ("verb", "role1", "arg1", "role2", "arg2")
@@ -96,11 +96,7 @@ def _item(row: dict, suffix: str) -> tuple[dict | None, str | None]:
 def parse_results(path: Path) -> ParsedResults:
     """Every assignment row of a results file with its valid and defective items."""
     path = Path(path)
-    try:
-        handle = open(path, newline="", encoding="utf-8-sig")
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
-    with handle:
+    with open_input(path, newline="", encoding="utf-8-sig") as handle:
         reader = csv.DictReader(handle)
         layout, suffixes = _slots(reader.fieldnames or [], path)
         assignments, rows = [], 0

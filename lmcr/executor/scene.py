@@ -17,7 +17,7 @@ from pathlib import Path
 import pybullet as p
 
 from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
-from lmcr.jsonl import InputError
+from lmcr.jsonl import InputError, open_input
 from lmcr.srl.lexicon import load_lexicon
 
 TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
@@ -99,9 +99,8 @@ def _overlap(a: str, axy, b: str, bxy) -> bool:
 def load_scene(path: Path) -> Scene:
     """Read and validate a scene file; objects without `xy` are placed at random (seeded)."""
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+        with open_input(path) as handle:
+            data = json.load(handle)
     except json.JSONDecodeError as exc:
         raise InputError(f"{path}:{exc.lineno}: not JSON: {exc.msg}") from exc
     if not isinstance(data, dict) or not isinstance(data.get("objects"), list):
