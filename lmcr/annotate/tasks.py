@@ -19,7 +19,6 @@ import html
 import json
 import random
 import re
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -27,6 +26,7 @@ from typing import Callable
 import duckdb
 import numpy as np
 
+from lmcr.files import atomic_dir
 from lmcr.lm.linearize import sentence_text
 from lmcr.srl.lexicon import load_lexicon
 
@@ -153,23 +153,17 @@ def preview(template: str, row: dict) -> str:
 
 def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict) -> Path:
     """batch.csv, hit_template.html, preview.html and tasks.json, published as one folder."""
-    out_dir = Path(out_dir)
-    tmp = out_dir.with_name(f".{out_dir.name}.tmp")
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
     columns = [f"{name}_{k}" for k in range(1, config.per_hit + 1) for name in FIELDS]
-    with open(tmp / "batch.csv", "w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(rows)
     template = hit_template(config.per_hit)
-    (tmp / "hit_template.html").write_text(template, encoding="utf-8")
-    (tmp / "preview.html").write_text(preview(template, rows[0] if rows else {}), encoding="utf-8")
-    (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__}, indent=2), encoding="utf-8")
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    tmp.rename(out_dir)
-    return out_dir
+    with atomic_dir(out_dir) as tmp:
+        with open(tmp / "batch.csv", "w", newline="", encoding="utf-8") as handle:
+            writer = csv.DictWriter(handle, fieldnames=columns)
+            writer.writeheader()
+            writer.writerows(rows)
+        (tmp / "hit_template.html").write_text(template, encoding="utf-8")
+        (tmp / "preview.html").write_text(preview(template, rows[0] if rows else {}), encoding="utf-8")
+        (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__}, indent=2), encoding="utf-8")
+    return Path(out_dir)
 
 
 def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskConfig,

@@ -6,7 +6,6 @@ from __future__ import annotations
 import base64
 import html
 import json
-import shutil
 from pathlib import Path
 
 import matplotlib
@@ -15,6 +14,7 @@ matplotlib.use("Agg")  # headless: reports are built by flows and CI, never show
 import matplotlib.pyplot as plt  # noqa: E402
 
 from lmcr.evaluate.protocol import Results  # noqa: E402
+from lmcr.files import atomic_dir  # noqa: E402
 
 # The paper's published figures are not in the shared data and cannot be fetched offline; a value
 # added here (method -> verb/'all' -> accuracy) is printed beside ours, anything missing as "n/a".
@@ -65,10 +65,12 @@ def plot(results: Results, series: list[str], key: str, xlabel: str, title: str,
 def write_report(results: Results, methods: list[str], settings: list[str], out_dir: Path,
                  notes: list[str]) -> Path:
     """Write report.md, report.html, fig4{a,b,c,d}.png and figures.json into `out_dir` (replaced whole)."""
-    out_dir = Path(out_dir)
-    tmp = out_dir.with_name(f".{out_dir.name}.tmp")
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
+    with atomic_dir(out_dir) as tmp:
+        _write_files(results, methods, settings, tmp, notes)
+    return Path(out_dir)
+
+
+def _write_files(results: Results, methods: list[str], settings: list[str], tmp: Path, notes: list[str]) -> None:
     cfg = results.config
     groups = {"methods": methods, "settings": settings}
     figures = {"table1": results.table1, "paper_table1": PAPER, **results.to_json()}
@@ -86,15 +88,6 @@ def write_report(results: Results, methods: list[str], settings: list[str], out_
     (tmp / "report.md").write_text(markdown, encoding="utf-8")
     (tmp / "figures.json").write_text(json.dumps(figures, indent=2, default=str), encoding="utf-8")
     (tmp / "report.html").write_text(_html(markdown, tmp), encoding="utf-8")
-    if out_dir.exists():
-        old = out_dir.with_name(f".{out_dir.name}.old")
-        shutil.rmtree(old, ignore_errors=True)
-        out_dir.rename(old)
-        tmp.rename(out_dir)
-        shutil.rmtree(old)
-    else:
-        tmp.rename(out_dir)
-    return out_dir
 
 
 def _html(markdown: str, folder: Path) -> str:
