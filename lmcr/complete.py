@@ -140,15 +140,21 @@ def load_config(path: Path, checkpoint_sha: str | None) -> CompletionConfig | No
     return CompletionConfig(**data)
 
 
+def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str]:
+    """Where an LM method's completion calibration lives, and the sha256 of the manifest of the
+    checkpoint version it is valid for (what `lmcr evaluate` writes and `lmcr complete` reads)."""
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.methods import LM_METHODS, lm_checkpoint_dir
+
+    version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
+    return calibration_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json")
+
+
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
     """The scorer of `method` and the completion settings calibrated for its checkpoint (by `lmcr
     evaluate`), or uncalibrated defaults when there are none for this exact checkpoint."""
-    from lmcr.lm import checkpoint as ckpt
-    from lmcr.methods import LM_METHODS, lm_checkpoint_dir, make_scorer
+    from lmcr.methods import LM_METHODS, make_scorer
 
     scorer = make_scorer(method, res)
-    config = None
-    if method in LM_METHODS:
-        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
-        config = load_config(calibration_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json"))
+    config = load_config(*calibration_file(method, res, calibration_dir)) if method in LM_METHODS else None
     return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")

@@ -8,14 +8,13 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
-from lmcr.complete import calibrate, save_config
+from lmcr.complete import calibrate, calibration_file, save_config
 from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
-from lmcr.files import file_sha256
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import LM_METHODS, MethodResources, lm_checkpoint_dir, make_scorer
+from lmcr.methods import LM_METHODS, MethodResources, make_scorer
 
 SETTINGS = tuple(f"{m}/{c}" for m in LM_METHODS for c in ("youcook2", "recipes", "all"))
 DEVIATIONS = [
@@ -53,8 +52,7 @@ def calibrate_lms(rated: list[RatedFrame], scores: dict, res: MethodResources, c
     notes = []
     for method in (m for m in LM_METHODS if m in scores):
         cal = calibrate([[scores[method][f.key] for f in sc.candidates] for sc in scenarios])
-        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
-        save_config(cal, out_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json"))
+        save_config(cal, *calibration_file(method, res, out_dir))
         notes.append(f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
                      f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
         log(notes[-1])
