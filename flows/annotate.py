@@ -44,7 +44,7 @@ def aggregate_task(decisions_out: str | None, db: str | None, data_dir: str | No
         alpha = alpha_by_verb(con)
         workers = worker_table(con)
         if decisions_out:
-            write_decisions(Path(decisions_out), decisions(con, QualityRules()))
+            write_decisions(Path(decisions_out), decisions(con, QualityRules(), workers=workers))
     create_table_artifact(key="krippendorff-alpha", table=[{"verbs": k, "alpha": round(v, 3)} for k, v in alpha.items()],
                           description="Krippendorff's alpha (interval) over valid ratings")
     create_table_artifact(key="worker-quality", table=workers.astype(object).where(workers.notna(), None).to_dict("records"),

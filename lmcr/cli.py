@@ -360,7 +360,7 @@ def annotate_quality(
     table = worker_table(con)
     print_rows("workers", [{k: (str(v) if isinstance(v, float) else v) for k, v in row.items()} for row in table.to_dict("records")])
     if decisions:
-        rows = decide(con, QualityRules(max_spam=max_spam, min_gold_accuracy=min_gold_accuracy))
+        rows = decide(con, QualityRules(max_spam=max_spam, min_gold_accuracy=min_gold_accuracy), workers=table)
         write_decisions(decisions, rows)
         console.print(f"{sum(1 for r in rows if r['Reject'])} of {len(rows)} assignments to reject -> {decisions}")
     if aggregates:

@@ -119,9 +119,11 @@ def worker_table(con: duckdb.DuckDBPyConnection, seed: int = 0) -> pd.DataFrame:
     return pd.DataFrame(rows).sort_values("worker_id").reset_index(drop=True)
 
 
-def decisions(con: duckdb.DuckDBPyConnection, rules: QualityRules = QualityRules(), seed: int = 0) -> list[dict]:
-    """Approve/Reject per submitted or approved assignment, with the reason (rejected ones are final)."""
-    workers = worker_table(con, seed).set_index("worker_id")
+def decisions(con: duckdb.DuckDBPyConnection, rules: QualityRules = QualityRules(), seed: int = 0,
+              workers: pd.DataFrame | None = None) -> list[dict]:
+    """Approve/Reject per submitted or approved assignment, with the reason (rejected ones are final).
+    `workers` is the `worker_table` when the caller has it already (MACE takes seconds)."""
+    workers = (worker_table(con, seed) if workers is None else workers).set_index("worker_id")
     gold = _gold(con)
     out = []
     rows = con.execute("select a.assignment_id, a.hit_id, a.worker_id, a.status, list(r.frame_id), list(r.rating) "
