@@ -16,7 +16,6 @@ Usage: python bench/bench_lm.py [--db STORE] [--tokens N] [--checkpoint DIR ...]
 from __future__ import annotations
 
 import argparse
-import csv
 import itertools
 import math
 import time
@@ -28,6 +27,7 @@ from scipy.stats import spearmanr
 from torch import nn
 
 from lmcr.config import paths_from_env
+from lmcr.evaluate.ratings import load_ratings
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
@@ -103,35 +103,14 @@ def scoring_speed(path: Path) -> str:
     return f"scoring {scorer.checkpoint.path.parent.name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s"
 
 
-def dev_frames(ratings_csv: Path) -> list[tuple[tuple[str, dict[str, str]], float]]:
-    """(frame, mean rating) from an MTurk batch-results file: rejected assignments, repeated downloads of
-    an assignment and answers outside 1..5 are left out (the full ingestion is `lmcr annotate`)."""
-    ratings: dict[tuple, list[int]] = {}
-    seen: set[str] = set()
-    with open(ratings_csv, newline="", encoding="utf-8") as handle:
-        for row in csv.DictReader(handle):
-            if row["AssignmentStatus"] == "Rejected" or row["AssignmentId"] in seen:
-                continue
-            seen.add(row["AssignmentId"])
-            for k in itertools.count(1):
-                if f"Input.verb_{k}" not in row:
-                    break
-                verb, answer = row[f"Input.verb_{k}"], row.get(f"Answer.rating_{k}", "")
-                if not verb or not answer.isdigit() or not 1 <= int(answer) <= 5:
-                    continue
-                key = (verb, row[f"Input.role1_{k}"], row[f"Input.arg1_{k}"], row[f"Input.role2_{k}"], row[f"Input.arg2_{k}"])
-                ratings.setdefault(key, []).append(int(answer))
-    return [((v, {r1: a1, r2: a2}), sum(x) / len(x)) for (v, r1, a1, r2, a2), x in ratings.items()]
-
-
 def normalisation_check(path: Path, ratings_csv: Path) -> str:
     """Spearman correlation of each normalisation's scores with the mean crowd rating."""
     scorer = LMScorer(ckpt.load(path))
-    rated = dev_frames(ratings_csv)
-    means = [m for _, m in rated]
+    rated = load_ratings(ratings_csv, paths_from_env().sql_dir)  # the store's validation and aggregation
+    means = [r.mean for r in rated]
     parts = []
     for norm in ("sum", "mean"):
-        rho = spearmanr(scorer.score_frames([f for f, _ in rated], norm=norm), means).statistic
+        rho = spearmanr(scorer.score_frames([r.frame for r in rated], norm=norm), means).statistic
         parts.append(f"{norm}: rho={rho:.3f}")
     return f"{scorer.checkpoint.path.parent.name} on {len(rated)} rated dev frames: " + ", ".join(parts)
 
