@@ -49,8 +49,7 @@ def softmax(scores: list[float], temperature: float) -> list[float]:
     return [w / total for w in weights]
 
 
-def _candidate_frames(predicate: str, roles: dict[str, str | None], missing: list[str],
-                      objects: list[str]) -> list[dict[str, str]]:
+def _candidate_frames(missing: list[str], objects: list[str]) -> list[dict[str, str]]:
     """One filling per object (or ordered object pair) for the missing roles."""
     if len(missing) == 1:
         return [{missing[0]: o} for o in objects]
@@ -81,7 +80,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     if len(pool) < len(missing):
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
                               f"{'no detected objects' if not pool else 'too few detected objects'} besides {sorted(stated) or 'none'}")
-    fillings = _candidate_frames(frame.predicate, roles, missing, pool)
+    fillings = _candidate_frames(missing, pool)
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
                               f"the limit is {config.max_frames:,}")

@@ -117,10 +117,6 @@ def parse_results(path: Path) -> ParsedResults:
     return ParsedResults(path, file_sha256(path), layout, rows, assignments)
 
 
-def _arrow(rows: list[dict], names: list[str]) -> pa.Table:
-    return pa.Table.from_pylist([{n: r.get(n) for n in names} for r in rows]) if rows else None
-
-
 def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
     """Load a parsed file in one transaction; returns the file's counts (`skipped` if already loaded)."""
     if con.execute("select 1 from rating_files where sha256 = ?", [parsed.sha256]).fetchone():
@@ -191,10 +187,13 @@ def _insert(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: s
         return
     names = [d[0] for d in con.execute(f"select * from {table} limit 0").description]
     names = [n for n in names if n in rows[0]]
-    batch = _arrow(rows, names)  # noqa: F841 (read by name in the SQL below)
-    cols = ", ".join(names)
-    where = f" where {key} not in (select {key} from {table})" if key else ""
-    con.execute(f"insert into {table} ({cols}) select {cols} from batch{where}")
+    con.register("batch", pa.Table.from_pylist([{n: r.get(n) for n in names} for r in rows]))
+    try:
+        cols = ", ".join(names)
+        where = f" where {key} not in (select {key} from {table})" if key else ""
+        con.execute(f"insert into {table} ({cols}) select {cols} from batch{where}")
+    finally:
+        con.unregister("batch")
 
 
 def ingest_ratings(con: duckdb.DuckDBPyConnection, path: Path) -> dict:
