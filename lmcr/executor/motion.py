@@ -19,25 +19,11 @@ import numpy as np
 import pybullet as p
 
 from lmcr.executor.baxter import FINGER_TRAVEL, JOINTS
-from lmcr.executor.scene import (BOTTLE, CONTAINERS, FOOD, LIQUIDS, POWDERS, SHAKER, TABLE_CENTRE, TABLE_TOP, Scene,
-                                 SceneObject, footprint)
+from lmcr.executor.scene import CONTAINERS, TABLE_CENTRE, TABLE_TOP, Scene, SceneObject, footprint, height
 
 DOWN = p.getQuaternionFromEuler((math.pi, 0, 0))  # gripper pointing at the table
 SAFE = TABLE_TOP + 0.40  # carry height
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
-
-
-def height(label: str) -> float:
-    if label in CONTAINERS:
-        return CONTAINERS[label][2]
-    if label in LIQUIDS:
-        return BOTTLE[1]
-    if label in POWDERS:
-        return SHAKER[1]
-    shape = FOOD[label]
-    if shape[0] == "sphere":
-        return 2 * shape[1]
-    return shape[-1]  # cylinder height, box z size
 
 
 ORIENTATION_WEIGHT = 0.3  # metres of position error one radian of orientation error is worth

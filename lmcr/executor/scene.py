@@ -78,17 +78,30 @@ class Scene:
         raise KeyError(f"no {label!r} on the table (there are: {', '.join(o.label for o in self.objects)})")
 
 
+def solid_shape(label: str) -> tuple:
+    """("sphere", r), ("cyl", r, h) or ("box", sx, sy, sz) of an object that is not a container."""
+    if label in LIQUIDS:
+        return ("cyl", *BOTTLE)
+    if label in POWDERS:
+        return ("cyl", *SHAKER)
+    return FOOD[label]
+
+
 def footprint(label: str) -> float:
     """Radius of the circle an object covers on the table."""
     if label in CONTAINERS:
         w, d, _ = CONTAINERS[label]
         return max(w, d) / 2
-    if label in LIQUIDS:
-        return BOTTLE[0]
-    if label in POWDERS:
-        return SHAKER[0]
-    shape = FOOD[label]
+    shape = solid_shape(label)
     return shape[1] if shape[0] in ("sphere", "cyl") else max(shape[1], shape[2]) / 2
+
+
+def height(label: str) -> float:
+    """How tall an object stands on the table."""
+    if label in CONTAINERS:
+        return CONTAINERS[label][2]
+    shape = solid_shape(label)
+    return 2 * shape[1] if shape[0] == "sphere" else shape[-1]  # cylinder height, box z size
 
 
 def _overlap(a: str, axy, b: str, bxy) -> bool:
@@ -160,24 +173,18 @@ def _container(label: str, x: float, y: float) -> int:
 
 
 def _solid(label: str, x: float, y: float) -> int:
-    if label in LIQUIDS or label in POWDERS:
-        radius, height = BOTTLE if label in LIQUIDS else SHAKER
-        shape = ("cyl", radius, height)
-    else:
-        shape = FOOD[label]
+    shape = solid_shape(label)
     if shape[0] == "sphere":
-        col, vis, z = (p.createCollisionShape(p.GEOM_SPHERE, radius=shape[1]),
-                       p.createVisualShape(p.GEOM_SPHERE, radius=shape[1], rgbaColor=_color(label)), shape[1])
+        col = p.createCollisionShape(p.GEOM_SPHERE, radius=shape[1])
+        vis = p.createVisualShape(p.GEOM_SPHERE, radius=shape[1], rgbaColor=_color(label))
     elif shape[0] == "cyl":
         col = p.createCollisionShape(p.GEOM_CYLINDER, radius=shape[1], height=shape[2])
         vis = p.createVisualShape(p.GEOM_CYLINDER, radius=shape[1], length=shape[2], rgbaColor=_color(label))
-        z = shape[2] / 2
     else:
         half = [s / 2 for s in shape[1:]]
         col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half)
         vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_color(label))
-        z = half[2]
-    return p.createMultiBody(0.15, col, vis, [x, y, TABLE_TOP + z + 0.001])
+    return p.createMultiBody(0.15, col, vis, [x, y, TABLE_TOP + height(label) / 2 + 0.001])
 
 
 def build_world(scene: Scene, cache_dir: Path) -> int:
