@@ -21,7 +21,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import svds
 
-from lmcr.baselines.cooccur import Frame, frame_terms
+from lmcr.baselines.cooccur import Frame, pair_sum
 from lmcr.baselines.vectors import load_vectors
 
 
@@ -118,8 +118,4 @@ class ConceptNetScorer:
         return 0.0 if a is None or b is None else float(a @ b)
 
     def score_frames(self, frames: list[Frame]) -> list[float]:
-        scores = []
-        for frame in frames:
-            v, a1, a2 = frame_terms(frame)
-            scores.append(self.rel(v, a1) + self.rel(v, a2) + self.rel(a1, a2))
-        return scores
+        return [pair_sum(f, self.rel) for f in frames]

@@ -18,10 +18,16 @@ from lmcr.lm.linearize import tokens
 Frame = tuple[str, dict[str, str]]
 
 
-def frame_terms(frame: Frame, roles: tuple[str, ...] | None = None) -> list[str]:
-    """[verb, arg1, arg2] of a complete frame, arguments in the given role order."""
+def frame_terms(frame: Frame) -> list[str]:
+    """[verb, arg1, arg2] of a complete frame, arguments in role order."""
     verb, values = frame
-    return [verb] + [values[r] for r in (roles or tuple(values))]
+    return [verb, *values.values()]
+
+
+def pair_sum(frame: Frame, pair: Callable[[str, str], float]) -> float:
+    """pair(v, a1) + pair(v, a2) + pair(a1, a2): every baseline's score over a frame's three terms."""
+    v, a1, a2 = frame_terms(frame)
+    return pair(v, a1) + pair(v, a2) + pair(a1, a2)
 
 
 class CooccurrenceScorer:
@@ -57,8 +63,4 @@ class CooccurrenceScorer:
 
     def score_frames(self, frames: list[Frame]) -> list[float]:
         self.index(t for f in frames for t in frame_terms(f))
-        scores = []
-        for frame in frames:
-            v, a1, a2 = frame_terms(frame)
-            scores.append(self.co(v, a1) + self.co(v, a2) + self.co(a1, a2))
-        return scores
+        return [pair_sum(f, self.co) for f in frames]

@@ -17,7 +17,7 @@ from typing import Iterable
 import numpy as np
 from gensim.models import KeyedVectors, Word2Vec
 
-from lmcr.baselines.cooccur import Frame, frame_terms
+from lmcr.baselines.cooccur import Frame, pair_sum
 from lmcr.files import atomic_path
 from lmcr.lm.linearize import tokens
 
@@ -82,8 +82,4 @@ class VectorScorer:
         return sorted({t for t in terms if self.vector(t) is None})
 
     def score_frames(self, frames: list[Frame]) -> list[float]:
-        scores = []
-        for frame in frames:
-            v, a1, a2 = frame_terms(frame)
-            scores.append(-(self.dist(v, a1) + self.dist(v, a2) + self.dist(a1, a2)))
-        return scores
+        return [-pair_sum(f, self.dist) for f in frames]
