@@ -193,7 +193,7 @@ def score(
         columns, rows = read_frames_csv(frames_csv)
         frames = [r.frame for r in rows]
         started = time.perf_counter()
-        scores = {m: make_scorer(m, res)(frames) for m in (x.strip() for x in methods.split(",")) if m}
+        scores = {m: make_scorer(m, res)(frames) for m in _split(methods)}
     except (InputError, CheckpointError, ValueError, FileNotFoundError, duckdb.Error) as exc:
         fail(_one_line(exc))
     elapsed = time.perf_counter() - started
