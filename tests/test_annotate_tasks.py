@@ -3,7 +3,13 @@
 from __future__ import annotations
 
 import csv
+import json
 import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
 
 from lmcr.annotate.quality import alpha_by_verb, dawid_skene, decisions, worker_table, write_decisions
 from lmcr.annotate.results import ingest_ratings
@@ -103,6 +109,33 @@ def test_preview_page_structure(con, tmp_path):
     assert page.sentences == [first[f"sentence_{k}"] for k in range(1, 5)]
     assert page.radios == {f"rating_{k}": ["1", "2", "3", "4", "5"] for k in range(1, 5)}
     assert page.required == set(page.radios)
+
+
+BROWSER_DIR = Path(__file__).resolve().parents[1] / "annotation" / "browser"
+
+
+@pytest.mark.skipif(not (shutil.which("node") and (BROWSER_DIR / "node_modules" / "@sparticuz" / "chromium").exists()),
+                    reason="headless Chromium not installed (make browser)")
+def test_preview_in_headless_browser(con, tmp_path):
+    """The preview as Chromium renders it offline: every sentence visible with five clickable radios,
+    no unfilled placeholder, and a screenshot that is not blank."""
+    from PIL import Image
+
+    generate_tasks(con, tmp_path / "tasks", TaskConfig(per_hit=4, gold_per_hit=0, n_frames=8))
+    shot = tmp_path / "preview.png"
+    run = subprocess.run(["node", str(BROWSER_DIR / "check_preview.mjs"), str(tmp_path / "tasks" / "preview.html"),
+                          str(shot)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    seen = json.loads(run.stdout.strip().splitlines()[-1])
+    with open(tmp_path / "tasks" / "batch.csv", newline="") as handle:
+        first = next(csv.DictReader(handle))
+    assert [i["sentence"] for i in seen["items"]] == [first[f"sentence_{k}"] for k in range(1, 5)]
+    assert all(i["visible"] and i["required"] for i in seen["items"])
+    assert [i["radios"] for i in seen["items"]] == [[f"rating_{k}={v}" for v in range(1, 6)] for k in range(1, 5)]
+    assert seen["checked"] == [f"rating_{k}" for k in range(1, 5)] and not seen["unfilled"]
+    image = Image.open(shot).convert("L")
+    low, high = image.getextrema()
+    assert image.width >= 800 and high - low > 100  # text on a background, not an empty page
 
 
 def test_disagreement_picks_frames_the_scorers_rank_differently():
