@@ -155,7 +155,7 @@ def main() -> None:
     def show(row: dict) -> None:
         nonlocal seconds
         seconds += row["seconds"]
-        print(f"lmcr (defaults, {row['objective']} softmax) epoch {row['epoch']}: {row['tokens_per_s']:,.0f} tokens/s, "
+        print(f"lmcr (defaults, {row['objective']} softmax, {row['precision']}) epoch {row['epoch']}: {row['tokens_per_s']:,.0f} tokens/s, "
               f"val ppl {row['val_ppl']:.1f} ({seconds:.0f}s of training)")
 
     # Ours trains until it matches the reference's perplexity (or --max-epochs): the speed claim is

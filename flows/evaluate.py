@@ -12,7 +12,7 @@ from lmcr.config import paths_from_env
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
-from lmcr.methods import METHODS, MethodResources
+from lmcr.methods import METHODS, MethodResources, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 
 
@@ -43,9 +43,7 @@ def evaluate_flow(
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods."""
     paths = paths_from_env(data_dir=data_dir)
-    res = MethodResources(checkpoints=paths.checkpoints, corpus=corpus, db=paths.db, vectors=Path(vectors) if vectors else None,
-                          conceptnet=Path(conceptnet) if conceptnet else None,
-                          cache_dir=paths.data_dir / "baselines", seed=seed)
+    res = resources_from_env(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed, data_dir=data_dir)
     report = Path(out or paths.data_dir / "report")
     results = evaluate_task(ratings or str(paths.db), str(report), methods, settings, res, per_verb, seed,
                             str(paths.data_dir / "calibration"))

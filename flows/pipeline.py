@@ -30,7 +30,7 @@ from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import run_evaluation
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import MethodResources
+from lmcr.methods import resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
 
@@ -75,9 +75,7 @@ def evaluation_key(context, parameters: dict) -> str:
 def evaluate_task(methods: list[str], settings: list[str], conceptnet: str | None, vectors: str | None,
                   per_verb: int, seed: int, data_dir: str | None) -> dict:
     paths = paths_from_env(data_dir=data_dir)
-    res = MethodResources(checkpoints=paths.checkpoints, db=paths.db, vectors=Path(vectors) if vectors else None,
-                          conceptnet=Path(conceptnet) if conceptnet else None, cache_dir=paths.data_dir / "baselines",
-                          seed=seed)
+    res = resources_from_env(vectors=vectors, conceptnet=conceptnet, seed=seed, data_dir=data_dir)
     rated = load_ratings(paths.db, paths.sql_dir, set(load_lexicon().predicates))
     results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed),
                              paths.data_dir / "report", paths.data_dir / "calibration", log=get_run_logger().info)
@@ -93,8 +91,7 @@ def executor_check_task(instruction: str, scene: str, data_dir: str | None) -> d
     from lmcr.srl.parser import load_parser
 
     paths = paths_from_env(data_dir=data_dir)
-    res = MethodResources(checkpoints=paths.checkpoints, db=paths.db)
-    scorer, config = completion_scorer("sentence_lm", res, paths.data_dir / "calibration")
+    scorer, config = completion_scorer("sentence_lm", resources_from_env(data_dir=data_dir), paths.data_dir / "calibration")
     out = execute(instruction, load_scene(Path(scene)), load_parser(None, paths.srl_dir), scorer, config,
                   paths.data_dir / "robot")
     return {k: out[k] for k in ("frame", "chosen_object", "success", "checks")}

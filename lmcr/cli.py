@@ -143,6 +143,7 @@ def train(
     lr: Optional[float] = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 1e-2)."),
     min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
     device: Optional[str] = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
+    precision: str = typer.Option("auto", help="auto | bf16 | fp32 (auto: bf16 autocast where the hardware has it)."),
     db: Optional[Path] = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Train a language model on a corpus setting and publish its checkpoint."""
@@ -155,12 +156,12 @@ def train(
     def show(row: dict) -> None:
         console.print(f"epoch {row['epoch']}: train ppl {row['train_ppl']:.1f} ({row['objective']} softmax), "
                       f"val ppl {row['val_ppl']:.1f}, "
-                      f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']} ({row['seconds']:.0f}s)")
+                      f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']}, {row['precision']} ({row['seconds']:.0f}s)")
 
     try:
         path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
                              LMConfig(0, embedding, layers, dropout),
-                             TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes,
+                             TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes, precision=precision,
                                          **{k: v for k, v in (("lr", lr), ("batch_tokens", batch_tokens)) if v}),
                              min_freq=min_freq, on_epoch=show)
     except (MigrationError, ValueError) as exc:

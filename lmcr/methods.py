@@ -64,11 +64,13 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
                                f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
 
 
-def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vectors: Path | None = None,
-                       conceptnet: Path | None = None, seed: int = 0) -> MethodResources:
+def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
+                       conceptnet: str | Path | None = None, seed: int = 0,
+                       data_dir: str | Path | None = None) -> MethodResources:
     """Method resources from explicit values, then the environment (`LMCR_VECTORS`, `LMCR_CONCEPTNET`,
-    `LMCR_SPACY_MODEL`), then the data folder's defaults."""
-    paths = paths_from_env()
+    `LMCR_SPACY_MODEL`, `LMCR_DATA_DIR`), then the data folder's defaults."""
+    paths = paths_from_env(data_dir=data_dir)
+    vectors, conceptnet = (Path(p) if p else None for p in (vectors, conceptnet))
     env = lambda name: Path(os.environ[name]) if os.environ.get(name) else None  # noqa: E731
     return MethodResources(checkpoints=checkpoint or paths.checkpoints, corpus=corpus, db=paths.db,
                            vectors=vectors or env("LMCR_VECTORS"), conceptnet=conceptnet or env("LMCR_CONCEPTNET"),

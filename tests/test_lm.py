@@ -13,7 +13,7 @@ from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import LMScorer
-from lmcr.lm.train import TrainConfig, train_lm
+from lmcr.lm.train import TrainConfig, pick_precision, train_lm
 from lmcr.lm.vocab import Vocab
 
 CORPUS = [
@@ -73,6 +73,21 @@ def overfit():
 def test_tiny_corpus_overfits(overfit):
     _, _, history = overfit
     assert history[-1]["val_ppl"] < 1.6 < history[0]["val_ppl"]
+
+
+def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
+    """bf16 autocast (emulated where the CPU lacks it) reaches the fp32 run's overfit; fp32 stays fp32."""
+    _, vocab, fp32 = overfit
+    ids = [vocab.encode(tokens(t)) for t in CORPUS]
+    model = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
+    history = train_lm(model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7,
+                                                    precision="bf16"))
+    assert history[-1]["val_ppl"] < 1.6 and {h["precision"] for h in history} == {"bf16"}
+    assert all(p.dtype == torch.float32 for p in model.parameters())  # master weights stay fp32
+    assert {h["precision"] for h in fp32} == {pick_precision("auto", torch.device("cpu"))}
+    assert pick_precision("fp32", torch.device("cpu")) == "fp32"
+    with pytest.raises(ValueError, match="precision must be one of"):
+        pick_precision("fp16", torch.device("cpu"))
 
 
 def test_time_budget_stops_between_epochs(overfit):

@@ -97,7 +97,8 @@ def record_run(con: duckdb.DuckDBPyConnection, run_id: str, text: TrainingText, 
                 " best_val_ppl, checkpoint) values (?, ?, ?, ?, ?, ?, ?, ?)",
                 [run_id, text.provenance["linearization"], text.provenance["corpus"], len(text.train), len(text.val),
                  vocab_size, min(r["val_ppl"] for r in history), str(path)])
-    con.executemany("insert into lm_epochs values (?, ?, ?, ?, ?, ?, ?, ?)",
+    con.executemany("insert into lm_epochs (run_id, epoch, train_ppl, val_ppl, tokens_per_s, seconds, device,"
+                    " objective, precision) values (?, ?, ?, ?, ?, ?, ?, ?, ?)",
                     [[run_id, r["epoch"], r["train_ppl"], r["val_ppl"], r["tokens_per_s"], r["seconds"], r["device"],
-                      r["objective"]] for r in history])
+                      r["objective"], r["precision"]] for r in history])
     con.execute("commit")

