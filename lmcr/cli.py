@@ -365,11 +365,11 @@ def annotate_quality(
         write_decisions(decisions, rows)
         console.print(f"{sum(1 for r in rows if r['Reject'])} of {len(rows)} assignments to reject -> {decisions}")
     if aggregates:
-        table = dawid_skene(con)
+        labels = dawid_skene(con)
         with atomic_path(aggregates) as tmp:
-            table.to_csv(tmp, index=False)
-        agree = float((table["dawid_skene"] == table["mean"].round()).mean())
-        console.print(f"{len(table):,} frames -> {aggregates}; Dawid-Skene label = rounded mean for {agree:.1%}")
+            labels.to_csv(tmp, index=False)
+        agree = float((labels["dawid_skene"] == labels["mean"].round()).mean())
+        console.print(f"{len(labels):,} frames -> {aggregates}; Dawid-Skene label = rounded mean for {agree:.1%}")
 
 
 @app.command()

@@ -84,6 +84,7 @@ def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
                                                     precision="bf16"))
     assert history[-1]["val_ppl"] < 1.6 and {h["precision"] for h in history} == {"bf16"}
     assert all(p.dtype == torch.float32 for p in model.parameters())  # master weights stay fp32
+    assert float(torch.tensor([1e-40]) * 1.0) > 0  # denormal flushing ended with the training steps
     assert {h["precision"] for h in fp32} == {pick_precision("auto", torch.device("cpu"))}
     assert pick_precision("fp32", torch.device("cpu")) == "fp32"
     with pytest.raises(ValueError, match="precision must be one of"):
