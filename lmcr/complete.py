@@ -56,6 +56,14 @@ def _candidate_frames(missing: list[str], objects: list[str]) -> list[dict[str, 
     return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
 
 
+def _unresolved(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) -> dict[str, str]:
+    """Stated fillers the robot cannot ground: neither a detected object nor a word of its object
+    vocabulary ("fry two sunny side up" -> Theme 'side'). They are filled from the objects like a
+    missing role. Without a vocabulary in the lexicon every stated filler is kept."""
+    known = set(vocabulary) | set(detected)
+    return {r: v for r, v in roles.items() if vocabulary and v and v not in known}
+
+
 def _question(predicate: str, roles: dict[str, str | None], missing: list[str], choices: list[dict]) -> str:
     names = [" and ".join(c["objects"][r] for r in missing) for c in choices]
     listed = ", ".join(f"the {n}" for n in names[:-1]) + f" or the {names[-1]}"
@@ -68,14 +76,16 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
              config: CompletionConfig = CompletionConfig()) -> dict:
     """The completion of one instruction in the CLI contract's output format (without the id)."""
     frame = parse_instruction(parser, instruction)
+    pool = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
     roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
+    unresolved = _unresolved(roles, parser.lex.objects, pool)
+    roles = {r: (None if r in unresolved else v) for r, v in roles.items()}
     missing = [r for r, v in roles.items() if v is None]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "candidates": [], "question": None}
+                "unresolved": {}, "candidates": [], "question": None}
     stated = {v for v in roles.values() if v}
-    pool = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
     pool = [o for o in pool if o not in stated]
     if len(pool) < len(missing):
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
@@ -92,12 +102,13 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     chosen = ranked[0][0]
     in_set = [c for c in candidates if c["probability"] >= config.set_threshold]
     question = None
-    if len(in_set) != 1:
-        choices = (in_set or candidates)[: config.max_choices]
-        question = _question(frame.predicate, roles, missing, choices if len(choices) > 1 else candidates[:2]) \
-            if len(candidates) > 1 else None
+    if (len(in_set) != 1 or unresolved) and len(candidates) > 1:  # a replaced word is always confirmed
+        choices = (in_set if len(in_set) > 1 else candidates)[: max(config.max_choices, 2)]
+        question = _question(frame.predicate, roles, missing, choices)
+        if unresolved:
+            question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "candidates": candidates, "question": question}
+            "missing_roles": missing, "unresolved": unresolved, "candidates": candidates, "question": question}
 
 
 def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str = "") -> CompletionConfig:

@@ -42,7 +42,17 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "candidates": [], "question": None}
+                   "missing": None, "missing_roles": [], "unresolved": {}, "candidates": [], "question": None}
+
+
+def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
+    """'side' is neither detected nor in the robot's object vocabulary; 'water' (not detected) is."""
+    out = complete(parser, scorer, "fry two sunny side up in the pan", ["pan", "cup", "glass"])
+    assert out["unresolved"] == {"Theme": "side"} and out["missing"] == "Theme"
+    assert out["frame"]["roles"] == {"Theme": "cup", "Instrument": "pan"}
+    assert out["question"].startswith("I see no side. Which theme") and "the glass" in out["question"]
+    kept = complete(parser, scorer, "pour the water", ["cup", "bowl"])
+    assert kept["unresolved"] == {} and kept["frame"]["roles"]["Theme"] == "water"
 
 
 def test_two_missing_roles_score_object_pairs(parser):

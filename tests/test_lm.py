@@ -65,6 +65,7 @@ def overfit():
     seqs = [tokens(t) for t in CORPUS]
     vocab = Vocab.build(seqs, min_freq=1)
     ids = [vocab.encode(s) for s in seqs]
+    torch.manual_seed(7)  # the initial weights too: otherwise they depend on which tests ran before
     model = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
     history = train_lm(model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7))
     return model, vocab, history
@@ -79,6 +80,7 @@ def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
     """bf16 autocast (emulated where the CPU lacks it) reaches the fp32 run's overfit; fp32 stays fp32."""
     _, vocab, fp32 = overfit
     ids = [vocab.encode(tokens(t)) for t in CORPUS]
+    torch.manual_seed(7)
     model = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
     history = train_lm(model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7,
                                                     precision="bf16"))
@@ -116,7 +118,7 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
     with torch.no_grad():
         direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
-    assert [round(x, 4) for x, _ in scorer.logprobs(texts)] == [round(x, 4) for x in direct]  # no <unk> here
+    assert [x for x, _ in scorer.logprobs(texts)] == pytest.approx(direct, abs=1e-4)  # no <unk> here
     scorer.vocab = Vocab(vocab.words, unk_types=50)
     unknown = scorer.logprobs(["pour water into the teapot"])[0][0]
     with torch.no_grad():
@@ -126,6 +128,22 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     cup, scissors = scorer.score_frames([("pour", {"Theme": "water", "Destination": "cup"}),
                                          ("pour", {"Theme": "water", "Destination": "scissors"})])
     assert cup > scissors
+
+
+@pytest.mark.parametrize("texts", [
+    ["pour water into the cup", "pour water into the glass", "pour water into the bell pepper"],  # shared prefix
+    ["pour water into the cup"],  # one text: all prefix
+    ["pour water", "pour water into the cup", "pour water into the cup"],  # a text inside another, a duplicate
+    ["fill the pot with water", "fill the pot with water"],  # identical texts
+])
+def test_shared_prefix_scoring_equals_a_plain_forward_pass(overfit, tmp_path, texts):
+    model, vocab, _ = overfit
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    with torch.no_grad():
+        direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
+    before = torch.backends.mkldnn.enabled
+    assert [x for x, _ in scorer.logprobs(texts)] == pytest.approx(direct, abs=1e-4)
+    assert torch.backends.mkldnn.enabled == before  # the native-LSTM switch is undone
 
 
 def test_publish_reload_identical_and_latest(overfit, tmp_path):
