@@ -18,7 +18,7 @@ from pathlib import Path
 from lmcr.complete import complete, completion_scorer
 from lmcr.config import paths_from_env
 from lmcr.jsonl import read_jsonl
-from lmcr.methods import resources_from_env
+from lmcr.methods import COMPLETION_METHOD, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import load_parser
 
@@ -56,7 +56,7 @@ def latency(parser, scorer, config, n_objects: int = 40, runs: int = 200) -> str
 def main() -> None:
     parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser_.add_argument("--instructions", type=Path, required=True)
-    parser_.add_argument("--method", default="sentence_lm")
+    parser_.add_argument("--method", default=COMPLETION_METHOD)
     parser_.add_argument("--corpus", default="all")
     args = parser_.parse_args()
     scorer, config = completion_scorer(args.method, resources_from_env(corpus=args.corpus),

@@ -21,7 +21,7 @@ from lmcr.config import paths_from_env
 from lmcr.executor.execute import ExecutionError, execute
 from lmcr.executor.scene import make_scene
 from lmcr.jsonl import InputError
-from lmcr.methods import resources_from_env
+from lmcr.methods import COMPLETION_METHOD, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import load_parser
 
@@ -44,7 +44,7 @@ TASKS = {
 def main() -> None:
     parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser_.add_argument("--placements", type=int, default=20)
-    parser_.add_argument("--method", default="sentence_lm")
+    parser_.add_argument("--method", default=COMPLETION_METHOD)
     parser_.add_argument("--seed", type=int, default=0)
     parser_.add_argument("--predicates", default=",".join(TASKS), help="comma-separated subset")
     parser_.add_argument("--distractors", type=int, default=0,

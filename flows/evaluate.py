@@ -12,7 +12,7 @@ from lmcr.config import paths_from_env
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
-from lmcr.methods import METHODS, MethodResources, resources_from_env
+from lmcr.methods import EVALUATED, MethodResources, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 
 
@@ -31,7 +31,7 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 def evaluate_flow(
     ratings: str | None = None,
     out: str | None = None,
-    methods: list[str] = list(METHODS),  # noqa: B006 - Prefect parameters must be JSON
+    methods: list[str] = list(EVALUATED),  # noqa: B006 - Prefect parameters must be JSON
     settings: list[str] = list(SETTINGS),  # noqa: B006
     conceptnet: str | None = None,
     vectors: str | None = None,

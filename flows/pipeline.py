@@ -30,7 +30,7 @@ from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import run_evaluation
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import resources_from_env
+from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
 
@@ -47,8 +47,7 @@ class PipelineParams(BaseModel):
     conceptnet: str | None = str(SAMPLE / "conceptnet" / "edges.txt")
     vectors: str | None = None
     settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all"])
-    methods: list[str] = Field(default_factory=lambda: ["sentence_lm", "frame_lm", "cooccur", "word2vec",
-                                                        "conceptnet", "random"])
+    methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
     shard_size: int = Field(20_000, gt=0)
     embedding: int = Field(256, gt=0)
     max_epochs: int = Field(8, gt=0)
@@ -67,7 +66,8 @@ def evaluation_key(context, parameters: dict) -> str:
     versions = [str(ckpt.resolve(Path(p).parent)) for p in manifests]
     with read_connection(paths.db) as con:
         ratings = con.execute("select sha256 from rating_files order by 1").fetchall()
-    blob = json.dumps([versions, ratings, {k: v for k, v in parameters.items() if k != "data_dir"}], default=str)
+        frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()  # frame_counts
+    blob = json.dumps([versions, ratings, frames, {k: v for k, v in parameters.items() if k != "data_dir"}], default=str)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -84,14 +84,16 @@ def evaluate_task(methods: list[str], settings: list[str], conceptnet: str | Non
 
 @task(name="executor-check")
 def executor_check_task(instruction: str, scene: str, data_dir: str | None) -> dict:
-    """The published sentence LM completes an instruction and the simulated Baxter carries it out."""
+    """The default completion (published sentence LM times the frame counts) completes an instruction and
+    the simulated Baxter carries it out."""
     from lmcr.complete import completion_scorer
     from lmcr.executor.execute import execute
     from lmcr.executor.scene import load_scene
     from lmcr.srl.parser import load_parser
 
     paths = paths_from_env(data_dir=data_dir)
-    scorer, config = completion_scorer("sentence_lm", resources_from_env(data_dir=data_dir), paths.data_dir / "calibration")
+    scorer, config = completion_scorer(COMPLETION_METHOD, resources_from_env(data_dir=data_dir),
+                                       paths.data_dir / "calibration")
     out = execute(instruction, load_scene(Path(scene)), load_parser(None, paths.srl_dir), scorer, config,
                   paths.data_dir / "robot")
     return {k: out[k] for k in ("frame", "chosen_object", "success", "checks")}

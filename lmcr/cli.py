@@ -15,7 +15,7 @@ from rich.table import Table
 
 from lmcr.config import paths_from_env
 from lmcr.ingest import IngestError, expand_inputs
-from lmcr.methods import resources_from_env
+from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
 from lmcr.store import ContractViolation, MigrationError, check_contracts, connect
 
 app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
@@ -178,7 +178,8 @@ def score(
     frames_csv: Path = typer.Option(..., "--frames", help="CSV with verb, role1, arg1, role2, arg2."),
     out: Path = typer.Option(..., "--out", help="CSV: the input plus one score column per method."),
     methods: str = typer.Option("sentence_lm,frame_lm",
-                                help="Comma-separated: sentence_lm, frame_lm, cooccur, word2vec, conceptnet, random."),
+                                help="Comma-separated: sentence_lm, frame_lm, frame_counts, cooccur, word2vec, "
+                                     "conceptnet, random; a+b sums the scores of a and b."),
     corpus: str = typer.Option("all", help="Training setting of the LM checkpoints: youcook2 | recipes | all."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
@@ -206,7 +207,7 @@ def score(
 def evaluate(
     ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
     out: Path = typer.Option(..., help="Report folder: report.md, report.html, fig4*.png, figures.json."),
-    methods: str = typer.Option("sentence_lm,frame_lm,cooccur,word2vec,conceptnet,random"),
+    methods: str = typer.Option(",".join(EVALUATED)),
     settings: str = typer.Option(",".join(("sentence_lm/youcook2", "sentence_lm/recipes", "sentence_lm/all",
                                            "frame_lm/youcook2", "frame_lm/recipes", "frame_lm/all")),
                                  help="LM settings for Fig. 4 C/D (method/corpus)."),
@@ -248,8 +249,8 @@ def _split(names: str) -> list[str]:
 def complete(
     input: Path = typer.Option(..., "--input", help="JSONL: {id, instruction, objects}."),
     output: Path = typer.Option(..., "--output", help="JSONL: {id, frame, missing, candidates, question}."),
-    method: str = typer.Option("sentence_lm"),
-    corpus: str = typer.Option("all", help="LM training setting."),
+    method: str = typer.Option(COMPLETION_METHOD, help="Scorer (methods as in `lmcr score`; a+b sums two)."),
+    corpus: str = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder."),
     model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
@@ -377,8 +378,8 @@ def execute(
     instruction: str = typer.Argument(..., help="The spoken instruction, e.g. \"pour me some water\"."),
     scene: Path = typer.Option(..., help="Scene JSON: objects with labels and table positions."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
-    method: str = typer.Option("sentence_lm", help="Scorer that completes the instruction."),
-    corpus: str = typer.Option("all", help="LM training setting."),
+    method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
+    corpus: str = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
     render: Optional[Path] = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
     model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
 
-from lmcr.files import atomic_path, file_sha256
+from lmcr.files import atomic_path
 from lmcr.srl.parser import FrameParser, parse_instruction
 
 Frame = tuple[str, dict[str, str]]
@@ -135,36 +135,36 @@ def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str
                             source=source or f"calibrated on {n} dev scenarios (alpha={alpha:g}, NLL {nll(temperature):.3f})")
 
 
-def save_config(config: CompletionConfig, path: Path, checkpoint_sha: str | None) -> None:
+def save_config(config: CompletionConfig, path: Path, fingerprint: str | None) -> None:
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps({**config.to_json(), "checkpoint_sha256": checkpoint_sha}, indent=2), encoding="utf-8")
+        tmp.write_text(json.dumps({**config.to_json(), "fingerprint": fingerprint}, indent=2), encoding="utf-8")
 
 
-def load_config(path: Path, checkpoint_sha: str | None) -> CompletionConfig | None:
-    """The saved calibration when it was made for this checkpoint, else None."""
+def load_config(path: Path, fingerprint: str | None) -> CompletionConfig | None:
+    """The saved calibration when it was made for this fingerprint (the scorer's checkpoints and
+    corpus, see `methods.scorer_fingerprint`), else None."""
     if not Path(path).exists():
         return None
     data = json.loads(Path(path).read_text(encoding="utf-8"))
-    if data.pop("checkpoint_sha256", None) != checkpoint_sha:
+    if data.pop("fingerprint", None) != fingerprint:
         return None
     return CompletionConfig(**data)
 
 
-def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str]:
-    """Where an LM method's completion calibration lives, and the sha256 of the manifest of the
-    checkpoint version it is valid for (what `lmcr evaluate` writes and `lmcr complete` reads)."""
-    from lmcr.lm import checkpoint as ckpt
-    from lmcr.methods import LM_METHODS, lm_checkpoint_dir
+def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str | None]:
+    """Where a method's completion calibration lives (what `lmcr evaluate` writes and `lmcr complete`
+    reads), and the fingerprint it must carry; None for a method that is not calibrated."""
+    from lmcr.methods import scorer_fingerprint
 
-    version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
-    return calibration_dir / f"{method}-{res.corpus}.json", file_sha256(version / "manifest.json")
+    return calibration_dir / f"{method}-{res.corpus}.json", scorer_fingerprint(method, res)
 
 
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
     """The scorer of `method` and the completion settings calibrated for its checkpoint (by `lmcr
     evaluate`), or uncalibrated defaults when there are none for this exact checkpoint."""
-    from lmcr.methods import LM_METHODS, make_scorer
+    from lmcr.methods import make_scorer
 
     scorer = make_scorer(method, res)
-    config = load_config(*calibration_file(method, res, calibration_dir)) if method in LM_METHODS else None
+    path, fingerprint = calibration_file(method, res, calibration_dir)
+    config = load_config(path, fingerprint) if fingerprint else None
     return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")

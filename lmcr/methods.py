@@ -15,7 +15,8 @@ from lmcr.baselines.cooccur import CooccurrenceScorer
 from lmcr.baselines.terms import default_lemmatizer
 from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
 from lmcr.config import paths_from_env
-from lmcr.files import atomic_path
+from lmcr.counts import FrameCountScorer
+from lmcr.files import atomic_path, file_sha256
 from lmcr.jsonl import InputError, open_input
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
@@ -25,7 +26,11 @@ from lmcr.store import read_connection
 
 Frame = tuple[str, dict[str, str]]
 LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
-METHODS = ("sentence_lm", "frame_lm", "cooccur", "word2vec", "conceptnet", "random")
+METHODS = ("sentence_lm", "frame_lm", "frame_counts", "cooccur", "word2vec", "conceptnet", "random")
+# What completes instructions by default: the sentence LM times the frame counts, the most accurate
+# on the dev ratings (Table I) and the dev instructions (README, Completion).
+COMPLETION_METHOD = "sentence_lm+frame_counts"
+EVALUATED = (*METHODS[:3], COMPLETION_METHOD, *METHODS[3:])  # what `lmcr evaluate` compares by default
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
 
@@ -79,12 +84,20 @@ def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vect
 
 
 def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], list[float]]:
-    """A function scoring a list of complete frames with `method`."""
+    """A function scoring a list of complete frames with `method`; 'a+b' sums the scores of methods a
+    and b (for log-probability methods, a product of experts)."""
+    if "+" in method:
+        parts = [make_scorer(m, res) for m in method.split("+")]
+        return lambda frames: [sum(scores) for scores in zip(*(part(frames) for part in parts))]
     if method in LM_METHODS:
         loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
         if loaded.linearization != LM_METHODS[method]:
             raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {LM_METHODS[method]}")
         return LMScorer(loaded).score_frames
+    if method == "frame_counts":
+        if res.db is None or not Path(res.db).exists():
+            raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
+        return FrameCountScorer.from_store(res.db, paths_from_env().sql_dir, res.corpus).score_frames
     if method == "cooccur":
         return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model),
                                   robot_terms()).score_frames
@@ -98,6 +111,26 @@ def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], li
         rng = random.Random(res.seed)
         return lambda frames: [rng.random() for _ in frames]
     raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+
+
+def scorer_fingerprint(method: str, res: MethodResources) -> str | None:
+    """What a completion calibration of `method` is valid for: the sha256 of each LM checkpoint
+    manifest it uses and the store's frame corpus hash for frame_counts; None for methods whose
+    completion is not calibrated (the baselines)."""
+    parts = []
+    for part in method.split("+"):
+        if part in LM_METHODS:
+            version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[part], res.corpus))
+            parts.append(file_sha256(version / "manifest.json"))
+        elif part == "frame_counts":
+            con = read_connection(res.db)
+            try:
+                parts.append(corpus_hash(con, "frame"))
+            finally:
+                con.close()
+        else:
+            return None
+    return "+".join(parts)
 
 
 def robot_terms() -> set[str]:

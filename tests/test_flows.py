@@ -80,11 +80,14 @@ def evaluate_on_trained(tmp_path):
             writer.writerow(["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj,
                              "5" if i < 3 else "1"])
     results = evaluate_flow(ratings=str(tmp_path / "ratings.csv"), out=str(tmp_path / "report"),
-                            methods=["sentence_lm", "frame_lm", "random"], settings=["sentence_lm/youcook2"],
+                            methods=["sentence_lm", "frame_lm", "sentence_lm+frame_counts", "random"],
+                            settings=["sentence_lm/youcook2"],
                             corpus="youcook2", per_verb=5, data_dir=str(tmp_path))
-    assert set(results["table1"]) == {"sentence_lm", "frame_lm", "random", "sentence_lm/youcook2"}
+    assert set(results["table1"]) == {"sentence_lm", "frame_lm", "sentence_lm+frame_counts", "random",
+                                      "sentence_lm/youcook2"}
     assert (tmp_path / "report" / "report.html").exists() and (tmp_path / "report" / "fig4d.png").exists()
-    assert (tmp_path / "calibration" / "sentence_lm-youcook2.json").exists()
+    calibrated = sorted(p.name for p in (tmp_path / "calibration").glob("*.json"))  # not the random baseline
+    assert calibrated == ["frame_lm-youcook2.json", "sentence_lm+frame_counts-youcook2.json", "sentence_lm-youcook2.json"]
 
 
 def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):

@@ -66,11 +66,14 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     out = tmp_path / "scores.csv"
     monkeypatch.setenv("LMCR_DATA_DIR", str(paths.data_dir))
     result = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out),
-                                 "--methods", "sentence_lm,frame_lm,random"])
+                                 "--methods", "sentence_lm,frame_lm,random,frame_counts,sentence_lm+frame_counts"])
     assert result.exit_code == 0, result.output
     rows = list(csv.DictReader(out.open()))
     assert [r["id"] for r in rows] == ["1", "2"]
     assert all(float(r["sentence_lm"]) < 0 and float(r["frame_lm"]) < 0 and 0 <= float(r["random"]) < 1 for r in rows)
+    for r in rows:  # log-probabilities, and a+b is their sum
+        assert float(r["frame_counts"]) < 0
+        assert float(r["sentence_lm+frame_counts"]) == pytest.approx(float(r["sentence_lm"]) + float(r["frame_counts"]), abs=1e-5)
     baselines = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur,word2vec"])
     assert baselines.exit_code == 0, baselines.output
     rows = list(csv.DictReader(out.open()))

@@ -45,14 +45,18 @@ def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], N
     return scorers, notes
 
 
-def calibrate_lms(rated: list[RatedFrame], scores: dict, res: MethodResources, config: EvalConfig,
-                  out_dir: Path, log: Callable[[str], None]) -> list[str]:
-    """Completion temperature and conformal threshold per LM method, from the headline scenarios."""
+def calibrate_completion(rated: list[RatedFrame], scores: dict, methods: list[str], res: MethodResources,
+                         config: EvalConfig, out_dir: Path, log: Callable[[str], None]) -> list[str]:
+    """Completion temperature and conformal threshold of each calibrated method (LMs, frame_counts and
+    their sums), from the headline scenarios."""
     scenarios, _ = build_scenarios(rated, config.lam, config.k, config.per_verb, config.seed)
     notes = []
-    for method in (m for m in LM_METHODS if m in scores):
+    for method in (m for m in methods if m in scores):
+        path, fingerprint = calibration_file(method, res, out_dir)
+        if fingerprint is None:
+            continue
         cal = calibrate([[scores[method][f.key] for f in sc.candidates] for sc in scenarios])
-        save_config(cal, *calibration_file(method, res, out_dir))
+        save_config(cal, path, fingerprint)
         notes.append(f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
                      f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
         log(notes[-1])
@@ -71,7 +75,7 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
         log(f"scored {len(rated):,} rated frames with {name} in {time.perf_counter() - t:.1f}s")
     results = evaluate(rated, scores, config)
     if calibration_dir is not None:
-        notes += calibrate_lms(rated, scores, res, config, calibration_dir, log)
+        notes += calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     write_report(results, [m for m in methods if m in scores], [s for s in settings if s in scores], out_dir, notes)
     return results
