@@ -64,12 +64,17 @@ def _unresolved(roles: dict[str, str | None], vocabulary: tuple[str, ...], detec
     return {r: v for r, v in roles.items() if vocabulary and v and v not in known}
 
 
-def _question(predicate: str, roles: dict[str, str | None], missing: list[str], choices: list[dict]) -> str:
-    names = [" and ".join(c["objects"][r] for r in missing) for c in choices]
-    listed = ", ".join(f"the {n}" for n in names[:-1]) + f" or the {names[-1]}"
-    stated = " ".join(f"the {v}" for v in roles.values() if v)
-    what = " and ".join(r.lower() for r in missing)
-    return f"Which {what} should I use to {predicate}{' ' + stated if stated else ''}: {listed}?"
+def _question(template: str, roles: dict[str, str | None], missing: list[str], choices: list[dict]) -> str:
+    """'Should I pour milk into the bowl, the glass or the plate?': the predicate's sentence template with
+    the choices in the missing slot (one missing role), or one filled template per choice (two)."""
+    def either(items: list[str]) -> str:
+        return ", ".join(items[:-1]) + f" or {items[-1]}"
+
+    if len(missing) == 1:
+        role = missing[0]
+        slot = template.replace(f"the {{{role}}}", f"{{{role}}}")  # each choice brings its own "the"
+        return "Should I " + slot.format(**{**roles, role: either([f"the {c['objects'][role]}" for c in choices])}) + "?"
+    return "Should I " + either([template.format(**{**roles, **c["objects"]}) for c in choices]) + "?"
 
 
 def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: list[str],
@@ -104,7 +109,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     question = None
     if (len(in_set) != 1 or unresolved) and len(candidates) > 1:  # a replaced word is always confirmed
         choices = (in_set if len(in_set) > 1 else candidates)[: max(config.max_choices, 2)]
-        question = _question(frame.predicate, roles, missing, choices)
+        question = _question(parser.lex.predicates[frame.predicate].sentence, roles, missing, choices)
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
