@@ -103,7 +103,8 @@ def complete_contract(tmp_path):
     assert not (tmp_path / "none.jsonl").exists()
 
 
-def test_score_rejects_bad_input(tmp_path):
+def test_score_rejects_bad_input(tmp_path, monkeypatch):
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path / "empty"))
     frames, out = tmp_path / "f.csv", tmp_path / "o.csv"
     frames.write_text("verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\nstir,Theme,soup,Tool,spoon\n")
     bad = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "random"])
@@ -119,3 +120,5 @@ def test_score_rejects_bad_input(tmp_path):
     assert unknown.exit_code == 1 and "unknown method 'bigram'" in unknown.output
     no_edges = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "conceptnet"])
     assert no_edges.exit_code == 1 and "conceptnet needs an edge list" in no_edges.output and not out.exists()
+    no_store = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "random+frame_counts"])
+    assert no_store.exit_code == 1 and "frame_counts needs the store's frames: no store at" in no_store.output
