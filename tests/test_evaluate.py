@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from lmcr.evaluate.protocol import EvalConfig, evaluate
+from lmcr.evaluate.protocol import EvalConfig, Results, evaluate
 from lmcr.evaluate.ratings import RatedFrame
-from lmcr.evaluate.report import write_report
+from lmcr.evaluate.report import table1_markdown, write_report
 from lmcr.evaluate.scenarios import accuracy, build_scenarios, label, scenario_credit
 
 OBJECTS = ["cup", "glass", "mug", "bowl", "scissors", "knife", "towel", "sponge", "oven", "sink", "plate", "spoon"]
@@ -74,3 +74,11 @@ def test_sweeps_skip_infeasible_k_and_the_report_is_complete(tmp_path):
     assert json.loads((out / "figures.json").read_text())["fig4a"]["oracle"]["1"] == 1.0
     write_report(results, ["oracle"], [], out, [])  # re-run replaces the folder whole
     assert "reverse" not in (out / "report.md").read_text()
+
+
+def test_paper_columns_only_for_the_papers_methods():
+    results = Results(EvalConfig())
+    results.table1 = {m: {"pour": 1.0, "all": 1.0} for m in ("sentence_lm", "frame_counts", "sentence_lm+frame_counts")}
+    head, rule, *rows = table1_markdown(results, list(results.table1)).splitlines()
+    assert head.endswith("| paper sentence_lm |") and "paper frame_counts" not in head and "paper sentence_lm+" not in head
+    assert rule.count("---") == 5 and rows[-1] == "| all | 1.000 | 1.000 | 1.000 | n/a |"
