@@ -1,6 +1,6 @@
 """Benchmark: completion on the dev instructions (accuracy, questions) and its latency.
 
-Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm] [--corpus all]
+Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm+frame_counts] [--corpus all]
 Uses the store and checkpoints of $LMCR_DATA_DIR and the calibration `lmcr evaluate` wrote there.
 1. Accuracy: an instruction counts as right when the completed frame is the expected one and no
    question is asked, or when a question is asked and names the expected object.

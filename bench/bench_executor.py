@@ -1,6 +1,6 @@
 """Benchmark: the Baxter executor on random table layouts, per predicate.
 
-Usage: python bench/bench_executor.py [--placements 20] [--distractors 0] [--method sentence_lm] [--seed 0]
+Usage: python bench/bench_executor.py [--placements 20] [--distractors 0] [--method sentence_lm+frame_counts] [--seed 0]
 For each of the 11 predicates, an incomplete instruction (the role the robot must fill is left out)
 on `--placements` random layouts: the two objects the frame needs (plus `--distractors` random other
 objects), placed at random with a seed. The instruction is completed with the published checkpoint of $LMCR_DATA_DIR (with
