@@ -165,8 +165,8 @@ def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str
 
 
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
-    """The scorer of `method` and the completion settings calibrated for its checkpoint (by `lmcr
-    evaluate`), or uncalibrated defaults when there are none for this exact checkpoint."""
+    """The scorer of `method` and the completion settings `lmcr evaluate` calibrated for exactly what it
+    is built from (its fingerprint), or uncalibrated defaults when there are none."""
     from lmcr.methods import make_scorer
 
     scorer = make_scorer(method, res)

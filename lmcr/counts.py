@@ -7,7 +7,7 @@ counts over frames of robot predicates and alpha the smoothing mass:
 
     P(o | v, s = a, m) = (c(v, s=a, m=o) + alpha P(o | v, m)) / (c(v, s=a, m) + alpha)
     P(o | v, m)        = (c(v, m=o)      + alpha P(o))        / (c(v, m)      + alpha)
-    P(o)               = (c(o) + 1) / (N + V)       N filler occurrences, V distinct fillers
+    P(o)               = (c(o) + 1) / (N + V + 1)   N filler occurrences, V distinct fillers, +1 unseen
 
 alpha = 5: of the two values tried on the dev ratings (1 and 5), the better at lambda=1, k=6. Unlike the
 LMs this model sees only frames whose roles the SRL filled, and treats a filler as one symbol: it knows
@@ -61,7 +61,7 @@ class FrameCountScorer:
         return cls(fillers, pairs, alpha)
 
     def p_value(self, value: str) -> float:
-        return (self.value[value] + 1) / (self.n + self.types + 1)  # +1 type: an unseen value
+        return (self.value[value] + 1) / (self.n + self.types + 1)
 
     def p_filler(self, v: str, role: str, value: str) -> float:
         """P(value | v, role)."""
