@@ -27,8 +27,9 @@ DEVIATIONS = [
     "a term with no known word is at distance 1.0 (unrelated).",
     "conceptnet: the API is unreachable offline; relatedness is the cosine of PPMI+SVD embeddings of the "
     "cn100k edge list (Numberbatch's starting point, without its retrofitting), or of a Numberbatch file.",
-    "The paper's published numbers are not available offline; its columns read n/a unless filled in "
-    "lmcr/evaluate/report.py PAPER.",
+    "The paper (Chen, Tan, Kuntz, Bansal, Alterovitz: Enabling Robots to Understand Incomplete Natural "
+    "Language Instructions Using Commonsense Reasoning, ICRA 2020) is not available offline, nor its "
+    "numbers; its columns read n/a unless filled in lmcr/evaluate/report.py PAPER.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
     "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). 'a+b' sums two methods' log-probabilities "
     "(a product of experts); sentence_lm+frame_counts is what `lmcr complete` uses by default.",
