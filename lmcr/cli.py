@@ -2,36 +2,68 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
 from typing import Optional
 
+import click
 import duckdb
 import typer
+import typer.core
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from lmcr.config import paths_from_env
-from lmcr.ingest import IngestError, expand_inputs
+from lmcr.ingest import expand_inputs
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
-from lmcr.store import ContractViolation, MigrationError, check_contracts, connect
+from lmcr.store import check_contracts, connect
 
-app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
-                  no_args_is_help=True, pretty_exceptions_enable=False)
 console = Console(stderr=True)
 
 
 def fail(message: str) -> None:
     """Exit non-zero with a one-line reason (the CLI contract)."""
-    console.print(f"[red]error:[/red] {message}", highlight=False, soft_wrap=True)
+    console.print(f"[red]error:[/red] {escape(_one_line(message))}", highlight=False, soft_wrap=True)
     raise typer.Exit(code=1)
 
 
-def _one_line(exc: Exception) -> str:
+def _one_line(exc: Exception | str) -> str:
     """An exception as the CLI contract's one-line reason (DuckDB adds hints on further lines)."""
     return " ".join(str(exc).split())
+
+
+def _reason(exc: Exception) -> str:
+    """The one-line reason for an exception that reached the command line. LMCR's own errors (all
+    ValueError or RuntimeError subclasses) already name file, line and reason; an OSError names its
+    path; anything else is a defect of LMCR, said so in one line (LMCR_DEBUG=1 re-raises it)."""
+    if isinstance(exc, OSError) and exc.filename:
+        return f"{exc.filename}: {exc.strerror or _one_line(exc)}"
+    if isinstance(exc, (ValueError, RuntimeError, OSError, EOFError, duckdb.Error)):
+        return _one_line(exc)
+    return f"internal error ({type(exc).__name__}: {_one_line(exc)[:200]}); please report it"
+
+
+class OneLineErrors(typer.core.TyperGroup):
+    """Every command's errors end as the contract's one line on stderr and exit status 1: a command
+    never shows a traceback, whatever it raised."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, typer.Exit):
+            raise
+        except Exception as exc:
+            if os.environ.get("LMCR_DEBUG"):
+                raise
+            fail(_reason(exc))
+
+
+app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
+                  no_args_is_help=True, pretty_exceptions_enable=False, cls=OneLineErrors)
 
 
 def print_rows(title: str, rows: list[dict]) -> None:
@@ -60,21 +92,18 @@ def ingest(
         fail("nothing to ingest: give --youcook2 PATH and/or --recipes PATH")
     paths = paths_from_env(db=db)
     started = time.perf_counter()
-    try:
-        sources = expand_inputs(youcook2, "youcook2", fmt, encoding) + expand_inputs(recipes, "recipes", fmt, encoding)
-        con = connect(paths.db, paths.sql_dir)
-        columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
-        with Progress(*columns, console=console) as progress:
-            bar = progress.add_task("ingesting sources", total=len(sources))
-            loaded, skipped = ingest_sources(
-                con, sources, paths.staging, workers,
-                on_loaded=lambda s: progress.advance(bar) or progress.console.print(
-                    f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"),
-            )
-            progress.advance(bar, len(skipped))
-        summary = corpus_summary(con, paths.sql_dir)
-    except (IngestError, MigrationError, ContractViolation, ValueError) as exc:
-        fail(str(exc))
+    sources = expand_inputs(youcook2, "youcook2", fmt, encoding) + expand_inputs(recipes, "recipes", fmt, encoding)
+    con = connect(paths.db, paths.sql_dir)
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        bar = progress.add_task("ingesting sources", total=len(sources))
+        loaded, skipped = ingest_sources(
+            con, sources, paths.staging, workers,
+            on_loaded=lambda s: progress.advance(bar) or progress.console.print(
+                f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"),
+        )
+        progress.advance(bar, len(skipped))
+    summary = corpus_summary(con, paths.sql_dir)
     elapsed = time.perf_counter() - started
     print_rows(f"corpus in {paths.db}", summary)
     words = sum(s.words for s in loaded)
@@ -86,10 +115,7 @@ def ingest(
 def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store.")) -> None:
     """Apply pending `sql/NNN_*.sql` migrations to the store."""
     paths = paths_from_env(db=db)
-    try:
-        connect(paths.db, paths.sql_dir).close()
-    except MigrationError as exc:
-        fail(str(exc))
+    connect(paths.db, paths.sql_dir).close()
     console.print(f"{paths.db} is up to date")
 
 
@@ -108,19 +134,16 @@ def frames(
     paths = paths_from_env(db=db)
     config = FrameCorpusConfig(kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
                                shard_size=shard_size, model=model)
-    try:
-        con = connect(paths.db, paths.sql_dir)
-        total = -(-con.execute("select count(*) from sentences where list_contains(?, kind)",
-                               [list(config.kinds)]).fetchone()[0] // shard_size)
-        columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
-        with Progress(*columns, console=console) as progress:
-            bar = progress.add_task("parsing shards", total=total)
-            build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers,
-                                       on_shard=lambda r: progress.advance(bar))
-        check_contracts(con, paths.sql_dir, prefix="frames_")
-        rows = query_dicts(con, named_query(paths.sql_dir, "frame_counts"))
-    except (MigrationError, ContractViolation, RuntimeError) as exc:
-        fail(str(exc))
+    con = connect(paths.db, paths.sql_dir)
+    total = -(-con.execute("select count(*) from sentences where list_contains(?, kind)",
+                           [list(config.kinds)]).fetchone()[0] // shard_size)
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        bar = progress.add_task("parsing shards", total=total)
+        build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers,
+                                   on_shard=lambda r: progress.advance(bar))
+    check_contracts(con, paths.sql_dir, prefix="frames_")
+    rows = query_dicts(con, named_query(paths.sql_dir, "frame_counts"))
     print_rows(f"robot-predicate frames in {paths.db}", rows)
     if build is None:
         console.print("frame corpus unchanged (skipped)")
@@ -158,18 +181,15 @@ def train(
                       f"val ppl {row['val_ppl']:.1f}, "
                       f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']}, {row['precision']} ({row['seconds']:.0f}s)")
 
-    try:
-        path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
-                             LMConfig(0, embedding, layers, dropout),
-                             TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes, precision=precision,
-                                         **{k: v for k, v in (("lr", lr), ("batch_tokens", batch_tokens)) if v}),
-                             min_freq=min_freq, on_epoch=show)
-    except (MigrationError, ValueError) as exc:
-        fail(str(exc))
+    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+                         LMConfig(0, embedding, layers, dropout),
+                         TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes, precision=precision,
+                                     **{k: v for k, v in (("lr", lr), ("batch_tokens", batch_tokens)) if v}),
+                         min_freq=min_freq, on_epoch=show)
     console.print(f"published {path}")
 
 
-VECTORS_HELP = "word2vec vectors (GloVe/word2vec text, .bin or .kv); default: trained on the corpus, cached."
+VECTORS_HELP = "word2vec vectors (GloVe/word2vec text, word2vec .bin, or .npy + .words.txt); default: trained on the corpus, cached."
 CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions CSV) or a Numberbatch file."
 
 
@@ -186,18 +206,13 @@ def score(
     conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Score complete frames with each method (higher = more plausible)."""
-    from lmcr.jsonl import InputError
-    from lmcr.lm.checkpoint import CheckpointError
     from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
 
     res = resources_from_env(checkpoint, corpus, vectors, conceptnet)
-    try:
-        columns, rows = read_frames_csv(frames_csv)
-        frames = [r.frame for r in rows]
-        started = time.perf_counter()
-        scores = {m: make_scorer(m, res)(frames) for m in _split(methods)}
-    except (InputError, CheckpointError, ValueError, FileNotFoundError, duckdb.Error) as exc:
-        fail(_one_line(exc))
+    columns, rows = read_frames_csv(frames_csv)
+    frames = [r.frame for r in rows]
+    started = time.perf_counter()
+    scores = {m: make_scorer(m, res)(frames) for m in _split(methods)}
     elapsed = time.perf_counter() - started
     write_scores_csv(out, columns, rows, scores)
     console.print(f"{len(rows):,} frames x {len(scores)} methods -> {out} ({elapsed:.2f}s)")
@@ -222,20 +237,18 @@ def evaluate(
     from lmcr.evaluate.protocol import EvalConfig
     from lmcr.evaluate.ratings import load_ratings
     from lmcr.evaluate.run import run_evaluation
-    from lmcr.jsonl import InputError
+    from lmcr.files import check_output_dir
     from lmcr.srl.lexicon import load_lexicon
 
     paths = paths_from_env()
     res = resources_from_env(checkpoint, "all", vectors, conceptnet, seed)
-    try:
-        rated = load_ratings(ratings, paths.sql_dir, set(load_lexicon().predicates))
-        if not rated:
-            fail(f"{ratings}: no rated frames of the robot's predicates")
-        results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
-                                 out, paths.data_dir / "calibration" if calibrate else None,
-                                 log=lambda m: console.print(m, highlight=False))
-    except (InputError, FileNotFoundError, MigrationError, duckdb.Error) as exc:
-        fail(_one_line(exc))
+    check_output_dir(out)  # before the work: a user's folder is refused at once, not after the evaluation
+    rated = load_ratings(ratings, paths.sql_dir, set(load_lexicon().predicates))
+    if not rated:
+        fail(f"{ratings}: no rated frames of the robot's predicates")
+    results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
+                             out, paths.data_dir / "calibration" if calibrate else None,
+                             log=lambda m: console.print(m, highlight=False))
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
@@ -258,26 +271,30 @@ def complete(
 ) -> None:
     """Fill the missing roles of instructions with the detected objects (CLI contract format)."""
     from lmcr.complete import CompletionError, completion_scorer, complete as complete_one
+    from lmcr.files import check_output_file
     from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
-    from lmcr.lm.checkpoint import CheckpointError
     from lmcr.srl.parser import NoPredicateError
 
-    res = resources_from_env(checkpoint, corpus, vectors, conceptnet)
-    try:
-        records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
-        scorer, config = completion_scorer(method, res, paths_from_env().data_dir / "calibration")
-    except (InputError, CheckpointError, ValueError, FileNotFoundError, duckdb.Error) as exc:
-        fail(_one_line(exc))
+    check_output_file(output)
+    records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
+    for line, rec in records:
+        if not all(isinstance(o, str) for o in rec["objects"]):
+            fail(f"{input}:{line}: field 'objects' must be a list of strings")
+    scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus, vectors, conceptnet),
+                                       paths_from_env().data_dir / "calibration")
     parser = _srl_parser(model, None)
     out = []
-    for line, rec in records:
+    for line, rec in records:  # a line that cannot be completed gets an error field; the run goes on
         try:
             out.append({"id": rec["id"], **complete_one(parser, scorer, rec["instruction"], rec["objects"], config)})
-        except (NoPredicateError, CompletionError) as exc:
-            fail(f"{input}:{line}: {exc}")
+        except (NoPredicateError, CompletionError, InputError) as exc:
+            out.append({"id": rec["id"], "error": _one_line(exc)})
+            console.print(escape(f"{input}:{line}: {_one_line(exc)}"), highlight=False, soft_wrap=True)
     write_jsonl_atomic(output, out)
-    asked = sum(1 for r in out if r["question"])
-    console.print(f"{len(out):,} instructions -> {output} ({asked} clarifying questions; {config.source})")
+    asked = sum(1 for r in out if r.get("question"))
+    errors = sum(1 for r in out if "error" in r)
+    console.print(f"{len(out):,} instructions -> {output} ({asked} clarifying questions, {errors} not completed; "
+                  f"{config.source})")
 
 
 annotate_app = typer.Typer(help="Crowd plausibility ratings: MTurk results in, aggregates in DuckDB.",
@@ -292,15 +309,11 @@ def annotate_ingest(
 ) -> None:
     """Load MTurk batch results (single- or multi-item layout); defects are quarantined or flagged."""
     from lmcr.annotate.results import ingest_ratings
-    from lmcr.jsonl import InputError
 
     paths = paths_from_env(db=db)
-    try:
-        con = connect(paths.db, paths.sql_dir)
-        rows = [ingest_ratings(con, path) for path in results]
-        check_contracts(con, paths.sql_dir, "ratings")
-    except (InputError, MigrationError, ContractViolation) as exc:
-        fail(str(exc))
+    con = connect(paths.db, paths.sql_dir)
+    rows = [ingest_ratings(con, path) for path in results]
+    check_contracts(con, paths.sql_dir, "ratings")
     for r in rows:
         if r.get("skipped"):
             console.print(f"{r['source_file']}: already loaded (same sha256), nothing changed")
@@ -326,17 +339,13 @@ def annotate_tasks(
 ) -> None:
     """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
     from lmcr.annotate.tasks import TaskConfig, generate_tasks
-    from lmcr.lm.checkpoint import CheckpointError
     from lmcr.methods import make_scorer
 
     paths = paths_from_env(db=db)
     config = TaskConfig(mode=mode, per_hit=per_hit, gold_per_hit=gold_per_hit, n_frames=n_frames, seed=seed, batch=batch)
-    try:
-        scorers = ({m: make_scorer(m, resources_from_env()) for m in _split(methods)} if mode == "disagreement" else None)
-        con = connect(paths.db, paths.sql_dir)
-        meta = generate_tasks(con, out, config, scorers)
-    except (ValueError, CheckpointError, MigrationError) as exc:
-        fail(str(exc))
+    scorers = ({m: make_scorer(m, resources_from_env()) for m in _split(methods)} if mode == "disagreement" else None)
+    con = connect(paths.db, paths.sql_dir)
+    meta = generate_tasks(con, out, config, scorers)
     console.print(f"{meta['frames']:,} frames in {meta['hits']:,} HITs ({meta['gold_items']} gold items of "
                   f"{meta['gold_available']} available) -> {out / 'batch.csv'}; check {out / 'preview.html'}")
 
@@ -387,23 +396,21 @@ def execute(
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless)."""
     import json
 
-    from lmcr.complete import CompletionError, completion_scorer
-    from lmcr.executor.execute import ExecutionError, execute as run_instruction, save_render
+    from lmcr.complete import completion_scorer
+    from lmcr.executor.execute import execute as run_instruction, save_render
     from lmcr.executor.scene import load_scene
-    from lmcr.jsonl import InputError
-    from lmcr.lm.checkpoint import CheckpointError
-    from lmcr.srl.parser import NoPredicateError
+    from lmcr.files import OutputError, check_output_file
 
     paths = paths_from_env()
-    try:
-        layout = load_scene(scene)
-        scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus), paths.data_dir / "calibration")
-        parser = _srl_parser(model, None)
-        frames: list | None = [] if render else None
-        result = run_instruction(instruction, layout, parser, scorer, config, paths.data_dir / "robot", frames)
-    except (InputError, CheckpointError, ValueError, FileNotFoundError, NoPredicateError, CompletionError,
-            ExecutionError) as exc:
-        fail(str(exc))
+    if render:  # checked before the simulation, so a bad path does not cost its result
+        check_output_file(render)
+        if render.suffix.lower() not in (".png", ".gif"):
+            raise OutputError(f"{render}: --render takes a .png or .gif file name")
+    layout = load_scene(scene)
+    scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus), paths.data_dir / "calibration")
+    parser = _srl_parser(model, None)
+    frames: list | None = [] if render else None
+    result = run_instruction(instruction, layout, parser, scorer, config, paths.data_dir / "robot", frames)
     if render:
         result["render"] = str(save_render(frames, render))
     if not json_out:
@@ -417,10 +424,15 @@ def execute(
 def _srl_parser(model: str | None, resources: Path | None):
     from lmcr.srl.parser import load_parser
 
-    try:
-        return load_parser(model, resources or paths_from_env().srl_dir)
-    except RuntimeError as exc:
-        fail(str(exc))
+    return load_parser(model, resources or paths_from_env().srl_dir)
+
+
+def check_record_text(line: int, record: dict, field: str, path: Path) -> dict:
+    """A batch record whose text field the parser can take (length cap), else the one-line error."""
+    from lmcr.jsonl import check_text
+
+    check_text(record[field], f"{path}:{line}")
+    return record
 
 
 def _frame_line(frame) -> str:
@@ -438,23 +450,23 @@ def srl(
     resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
 ) -> None:
     """Parse text into verb frames: one instruction shown, or a JSONL batch (see the CLI contract)."""
-    from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
+    from lmcr.files import check_output_file
+    from lmcr.jsonl import check_text, read_jsonl, write_jsonl_atomic
 
     if (input is None) != (output is None) or (text is None) == (input is None):
         fail('give either "TEXT" or both --input IN.jsonl and --output OUT.jsonl')
-    parser = _srl_parser(model, resources)
     if text is not None:
-        frames = parser.parse(text)
+        parser = _srl_parser(model, resources)
+        frames = parser.parse(check_text(text, "text"))
         for frame in frames if all_predicates else [f for f in frames if f.known]:
             Console().print(_frame_line(frame), highlight=False)
         if not any(f.known for f in frames):
-            fail(f"no known predicate in {text!r}: the robot can {', '.join(sorted(parser.lex.predicates))}")
+            verbs = ", ".join(sorted(parser.lex.predicates))
+            fail(f"no known predicate in {text!r}: the robot can {verbs}")
         return
-    try:
-        records = [r for _, r in read_jsonl(input, {"id": (str, int), "text": str})]
-    except InputError as exc:
-        fail(str(exc))
-    frames = parser.pipe(r["text"] for r in records)
+    check_output_file(output)
+    records = [check_record_text(line, r, "text", input) for line, r in read_jsonl(input, {"id": (str, int), "text": str})]
+    frames = _srl_parser(model, resources).pipe(r["text"] for r in records)
     rows = ({"id": r["id"], "text": r["text"],
              "frames": [f.to_json() for f in found if all_predicates or f.known]}
             for r, found in zip(records, frames))
@@ -470,16 +482,13 @@ def srl_eval(
     resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
 ) -> None:
     """Predicate and role precision/recall/F1 against gold frames, per predicate and overall."""
-    from lmcr.jsonl import InputError, read_jsonl
+    from lmcr.jsonl import read_jsonl
     from lmcr.srl.evaluate import instruction_correct, score_frames
     from lmcr.srl.parser import NoPredicateError, parse_instruction
 
+    records = [check_record_text(line, r, "text", gold) for line, r in read_jsonl(gold, {"text": str, "frames": list})]
+    tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
     parser = _srl_parser(model, resources)
-    try:
-        records = [r for _, r in read_jsonl(gold, {"text": str, "frames": list})]
-        tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
-    except InputError as exc:
-        fail(str(exc))
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
     scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
     print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())

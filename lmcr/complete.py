@@ -82,6 +82,9 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     """The completion of one instruction in the CLI contract's output format (without the id)."""
     frame = parse_instruction(parser, instruction)
     pool = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
+    # A detection the robot has no vocabulary for is never chosen: nothing learned says what it is.
+    ignored = [o for o in pool if parser.lex.objects and o not in parser.lex.objects]
+    pool = [o for o in pool if o not in ignored]
     pronouns = parser.lex.object_pronouns
     roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
     unresolved = _unresolved(roles, parser.lex.objects, pool)
@@ -89,12 +92,14 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     missing = [r for r, v in roles.items() if v is None]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "unresolved": {}, "candidates": [], "question": None}
+                "unresolved": {}, "ignored_objects": ignored, "candidates": [], "question": None}
     stated = {v for v in roles.values() if v}
     pool = [o for o in pool if o not in stated]
     if len(pool) < len(missing):
+        unknown = f" ({', '.join(ignored)}: not in the robot's object vocabulary)" if ignored else ""
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
-                              f"{'no detected objects' if not pool else 'too few detected objects'} besides {sorted(stated) or 'none'}")
+                              f"{'no usable objects' if not pool else 'too few usable objects'} besides "
+                              f"{sorted(stated) or 'none'}{unknown}")
     fillings = _candidate_frames(missing, pool)
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
@@ -113,7 +118,8 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "unresolved": unresolved, "candidates": candidates, "question": question}
+            "missing_roles": missing, "unresolved": unresolved, "ignored_objects": ignored, "candidates": candidates,
+            "question": question}
 
 
 def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str = "") -> CompletionConfig:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import shutil
 from contextlib import contextmanager
@@ -10,11 +11,21 @@ from pathlib import Path
 from typing import Iterator
 
 
+# Written into every folder LMCR publishes, listing the files it wrote: a folder is replaced only when
+# everything in it is LMCR's own, so a user's files are never deleted.
+OUTPUT_MARKER = ".lmcr-output.json"
+
+
+class OutputError(ValueError):
+    """An output path LMCR must not write to (a user's folder, a folder where a file is expected)."""
+
+
 @contextmanager
 def atomic_path(path: Path) -> Iterator[Path]:
     """A temporary path beside `path` to write to; renamed onto `path` when the block succeeds and
     removed when it fails, so readers never see a partial file."""
     path = Path(path)
+    check_output_file(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
@@ -24,16 +35,58 @@ def atomic_path(path: Path) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
+def check_output_file(path: Path) -> None:
+    """Refuse an output file path that is a folder or lies under a file: checked before the work, so a
+    bad `--out` does not cost the result."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError(f"{path}: is a folder; give a file name")
+    parent = next((p for p in path.parents if p.exists()), None)
+    if parent is not None and not parent.is_dir():
+        raise OutputError(f"{path}: {parent} is a file, not a folder")
+
+
+def check_output_dir(path: Path) -> None:
+    """Refuse to replace `path` unless it is absent, empty, or an LMCR output folder that holds only the
+    files LMCR wrote there (its marker lists them)."""
+    path = Path(path)
+    if not path.exists():
+        return
+    if not path.is_dir():
+        raise OutputError(f"{path}: exists and is not a folder")
+    present = {p.relative_to(path).as_posix() for p in path.rglob("*") if not p.is_dir()}
+    if not present:
+        return
+    marker = path / OUTPUT_MARKER
+    if not marker.is_file():
+        raise OutputError(f"{path}: folder is not empty and is not an LMCR output (no {OUTPUT_MARKER}); "
+                          "choose a new or empty folder")
+    try:
+        ours = set(json.loads(marker.read_text(encoding="utf-8"))["files"]) | {OUTPUT_MARKER}
+    except (ValueError, KeyError, TypeError, OSError) as exc:
+        raise OutputError(f"{marker}: unreadable output marker; choose a new or empty folder") from exc
+    foreign = sorted(present - ours)
+    if foreign:
+        raise OutputError(f"{path}: holds files LMCR did not write ({', '.join(foreign[:3])}"
+                          f"{', ...' if len(foreign) > 3 else ''}); move them or choose another folder")
+
+
 @contextmanager
 def atomic_dir(path: Path) -> Iterator[Path]:
-    """A temporary folder beside `path` to fill; when the block succeeds it replaces `path` whole (the
-    old folder is moved aside first, then removed), and when it fails it is removed."""
+    """A temporary folder beside `path` to fill; when the block succeeds it replaces `path` whole, and
+    when it fails it is removed. The folder gets a marker listing its files; an existing `path` is
+    replaced only if `check_output_dir` allows it (checked before and again just before the swap)."""
     path = Path(path)
+    check_output_dir(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
     try:
         yield tmp
+        files = sorted(p.relative_to(tmp).as_posix() for p in tmp.rglob("*") if not p.is_dir())
+        (tmp / OUTPUT_MARKER).write_text(json.dumps({"files": files}, indent=1), encoding="utf-8")
+        check_output_dir(path)
         if path.exists():
             old = path.with_name(f".{path.name}.{os.getpid()}.old")
             shutil.rmtree(old, ignore_errors=True)

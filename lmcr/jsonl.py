@@ -1,4 +1,6 @@
-"""JSON Lines in and out for the batch commands: line-numbered errors in, atomic files out."""
+"""Text inputs of the batch commands, read so that every defect is an InputError naming file and line
+(undecodable bytes, lone surrogates, invalid JSON, missing or mistyped fields), and JSON Lines out
+through atomic files."""
 
 from __future__ import annotations
 
@@ -7,6 +9,8 @@ from pathlib import Path
 from typing import Iterable, Iterator, TextIO
 
 from lmcr.files import atomic_path
+
+MAX_TEXT_CHARS = 1_000  # an instruction or sentence longer than this is refused (the tokenizer is superlinear)
 
 
 class InputError(ValueError):
@@ -21,23 +25,62 @@ def open_input(path: Path, newline: str | None = None, encoding: str = "utf-8") 
         raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
 
 
+def read_bytes(path: Path) -> bytes:
+    """A whole input file's bytes; a missing, unreadable or folder path raises InputError."""
+    try:
+        return Path(path).read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
+
+
+def decode_utf8(raw: bytes, path: Path) -> str:
+    """UTF-8 text (a BOM is dropped); undecodable bytes raise InputError with their line and column."""
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError(f"{path}:{line}: not UTF-8 (byte 0x{raw[exc.start]:02x} at column {column})") from exc
+
+
+def read_lines(path: Path) -> list[str]:
+    """The decoded lines of a UTF-8 text file, line endings kept (what the csv module wants)."""
+    return decode_utf8(read_bytes(path), path).splitlines(keepends=True)
+
+
+def check_text(value: str, where: str, max_chars: int | None = MAX_TEXT_CHARS) -> str:
+    """A text field fit for the parser: no unpaired surrogates (they cannot be encoded, and spaCy fails
+    on them) and, with `max_chars`, no longer than that."""
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise InputError(f"{where}: text has an unpaired surrogate at character {exc.start + 1}") from exc
+    if max_chars is not None and len(value) > max_chars:
+        raise InputError(f"{where}: text is {len(value):,} characters; the limit is {max_chars:,}")
+    return value
+
+
 def read_jsonl(path: Path, required: dict[str, type | tuple[type, ...]]) -> Iterator[tuple[int, dict]]:
     """(line number, record) for each non-blank line; a line that is not a JSON object with the
-    required fields of the required types raises InputError naming file and line."""
-    with open_input(path) as handle:
-        for line_no, line in enumerate(handle, start=1):
-            if not line.strip():
-                continue
-            try:
-                record = json.loads(line)
-            except json.JSONDecodeError as exc:
-                raise InputError(f"{path}:{line_no}: not valid JSON: {exc.msg}") from exc
-            if not isinstance(record, dict):
-                raise InputError(f"{path}:{line_no}: expected a JSON object")
-            for key, kind in required.items():
-                if not isinstance(record.get(key), kind):
-                    raise InputError(f"{path}:{line_no}: field {key!r} missing or not {_name(kind)}")
-            yield line_no, record
+    required fields of the required types, or holds a string that cannot be encoded (a lone
+    surrogate), raises InputError naming file and line."""
+    for line_no, line in enumerate(read_lines(path), start=1):
+        if not line.strip():
+            continue
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{path}:{line_no}: not valid JSON: {exc.msg}") from exc
+        except RecursionError as exc:
+            raise InputError(f"{path}:{line_no}: JSON nested too deeply") from exc
+        if not isinstance(record, dict):
+            raise InputError(f"{path}:{line_no}: expected a JSON object")
+        for key, kind in required.items():
+            value = record.get(key)
+            if not isinstance(value, kind) or isinstance(value, bool):
+                raise InputError(f"{path}:{line_no}: field {key!r} missing or not {_name(kind)}")
+        check_text(json.dumps(record, ensure_ascii=False), f"{path}:{line_no}", max_chars=None)
+        yield line_no, record
 
 
 def _name(kind: type | tuple[type, ...]) -> str:

@@ -17,7 +17,7 @@ from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
 from lmcr.config import paths_from_env
 from lmcr.counts import FrameCountScorer
 from lmcr.files import atomic_path, file_sha256
-from lmcr.jsonl import InputError, open_input
+from lmcr.jsonl import InputError, read_lines
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
 from lmcr.lm.score import LMScorer
@@ -164,7 +164,7 @@ def corpus_word2vec(res: MethodResources) -> Path:
         digest = corpus_hash(con, "sentence")[:12]
     finally:
         con.close()
-    path = Path(res.cache_dir or Path(res.db).parent / "baselines") / f"word2vec-{res.corpus}-{digest}.kv"
+    path = Path(res.cache_dir or Path(res.db).parent / "baselines") / f"word2vec-{res.corpus}-{digest}.bin"
     if not path.exists():
         train_word2vec(corpus_sentences(res), path, seed=res.seed + 1)
     return path
@@ -174,27 +174,37 @@ def read_frames_csv(path: Path) -> tuple[list[str], list[FrameRow]]:
     """Rows of a frames CSV (`verb, role1, arg1, role2, arg2`, other columns kept), validated against the
     lexicon: a bad row fails with file, line and reason."""
     lex = load_lexicon()
-    with open_input(path, newline="") as handle:
-        reader = csv.DictReader(handle)
+    reader = csv.DictReader(read_lines(path))
+    try:
         columns = reader.fieldnames or []
         missing = [c for c in REQUIRED_COLUMNS if c not in columns]
         if missing:
             raise InputError(f"{path}:1: missing columns {missing}")
-        rows = []
-        for row in reader:
-            line = reader.line_num
-            verb = (row["verb"] or "").strip().lower()
-            spec = lex.predicates.get(verb)
-            if spec is None:
-                raise InputError(f"{path}:{line}: unknown verb {row['verb']!r} (one of {', '.join(sorted(lex.predicates))})")
-            roles = {(row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
-                     (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower()}
-            if set(roles) != set(spec.roles):
-                raise InputError(f"{path}:{line}: roles {sorted(roles)} are not {verb}'s {list(spec.roles)}")
-            if not all(roles.values()):
-                raise InputError(f"{path}:{line}: empty argument")
-            rows.append(FrameRow(line, (verb, roles), row))
+        taken = [c for c in columns if c in METHODS or "+" in c]
+        if taken:  # the scores would silently replace them
+            raise InputError(f"{path}:1: column {taken[0]!r} is named like a method; rename it")
+        rows = [FrameRow(reader.line_num, _frame_of(row, path, reader.line_num, lex, len(columns)), row)
+                for row in reader]
+    except csv.Error as exc:
+        raise InputError(f"{path}:{reader.line_num}: not CSV: {exc}") from exc
     return columns, rows
+
+
+def _frame_of(row: dict, path: Path, line: int, lex, n_columns: int) -> Frame:
+    """The frame of one frames-CSV row, validated against the lexicon."""
+    if None in row:
+        raise InputError(f"{path}:{line}: {n_columns + len(row[None])} fields, the header has {n_columns}")
+    verb = (row["verb"] or "").strip().lower()
+    spec = lex.predicates.get(verb)
+    if spec is None:
+        raise InputError(f"{path}:{line}: unknown verb {row['verb']!r} (one of {', '.join(sorted(lex.predicates))})")
+    roles = {(row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
+             (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower()}
+    if set(roles) != set(spec.roles):
+        raise InputError(f"{path}:{line}: roles {sorted(roles)} are not {verb}'s {list(spec.roles)}")
+    if not all(roles.values()):
+        raise InputError(f"{path}:{line}: empty argument")
+    return verb, roles
 
 
 def write_scores_csv(path: Path, columns: list[str], rows: list[FrameRow], scores: dict[str, list[float]]) -> None:

@@ -68,7 +68,6 @@ def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, r
     cand_acc = checkpoint_accuracy(candidate, rated, config)
     cur_acc = checkpoint_accuracy(current, rated, config) if current and current != candidate else None
     if cur_acc is None or cand_acc >= cur_acc:
-        ckpt.set_latest(checkpoints, config.setting, candidate.name)
         decision = "promoted"
         reason = "no current checkpoint" if cur_acc is None else f"not worse: {cand_acc:.3f} >= {cur_acc:.3f}"
     else:
@@ -76,7 +75,9 @@ def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, r
     row = {"setting": config.setting, "inputs_sha256": inputs, "decision": decision, "reason": reason,
            "candidate": str(candidate), "current": str(current) if current else None,
            "candidate_accuracy": cand_acc, "current_accuracy": cur_acc}
-    record(con, row)
+    record(con, row)  # recorded first: LATEST never moves without its decision on record
+    if decision == "promoted":
+        ckpt.set_latest(checkpoints, config.setting, candidate.name)
     return row
 
 

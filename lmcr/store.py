@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import hashlib
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import duckdb
 
@@ -18,6 +20,35 @@ class MigrationError(RuntimeError):
 
 class ContractViolation(RuntimeError):
     """A table contract query returned offending rows."""
+
+
+class StoreBusyError(RuntimeError):
+    """Another process holds the store's write lock."""
+
+
+def _open(db: str | Path, read_only: bool) -> duckdb.DuckDBPyConnection:
+    """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
+    try:
+        return duckdb.connect(str(db), read_only=read_only)
+    except duckdb.IOException as exc:
+        if "lock" in str(exc).lower():
+            raise StoreBusyError(f"store busy: another lmcr process is writing {db}; try again when it finishes") from exc
+        raise MigrationError(f"{db}: cannot open the store: {' '.join(str(exc).split())[:200]}") from exc
+    except duckdb.Error as exc:  # not a DuckDB file, a newer storage version, ...
+        raise MigrationError(f"{db}: cannot open the store: {' '.join(str(exc).split())[:200]}") from exc
+
+
+@contextmanager
+def transaction(con: duckdb.DuckDBPyConnection) -> Iterator[duckdb.DuckDBPyConnection]:
+    """One all-or-nothing unit of writes (as sqlite-utils' `db.atomic()`): committed when the block
+    ends, rolled back when it raises anything, KeyboardInterrupt included."""
+    con.execute("begin transaction")
+    try:
+        yield con
+    except BaseException:
+        con.execute("rollback")
+        raise
+    con.execute("commit")
 
 
 @dataclass(frozen=True)
@@ -35,7 +66,7 @@ def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.Du
     """Open the store (creating its folder) and bring its schema up to date unless read-only."""
     if str(db) != ":memory:":
         Path(db).parent.mkdir(parents=True, exist_ok=True)
-    con = duckdb.connect(str(db), read_only=read_only)
+    con = _open(db, read_only)
     con.execute("set enable_progress_bar = false")  # library calls report progress their own way
     if not read_only:
         migrate(con, sql_dir)
@@ -46,9 +77,9 @@ def read_connection(db: str | Path) -> duckdb.DuckDBPyConnection:
     """A connection for reading: read-only, unless this process already has the file open read-write
     (DuckDB refuses a second configuration of one file within a process; then share its mode)."""
     try:
-        con = duckdb.connect(str(db), read_only=True)
-    except duckdb.ConnectionException:
-        con = duckdb.connect(str(db))
+        con = _open(db, read_only=True)
+    except (duckdb.ConnectionException, MigrationError):
+        con = _open(db, read_only=False)
     con.execute("set enable_progress_bar = false")
     return con
 

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from lmcr.baselines.conceptnet import ConceptNetScorer, read_edges
 from lmcr.baselines.cooccur import CooccurrenceScorer
 from lmcr.baselines.terms import TermMatcher
-from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
+from lmcr.baselines.vectors import VectorFileError, VectorScorer, load_vectors, train_word2vec
 
 CORPUS = ["Pour the water into the cups.", "Pour water into a cup and stir.", "Poured the milk into the glass.",
           "Cut the bell peppers with scissors.", "Cut paper with the scissors.", "Chop one bell pepper."] * 5
@@ -46,10 +47,10 @@ def test_vectors_from_a_glove_file_with_oov_policy(tmp_path):
 
 
 def test_word2vec_trained_on_the_corpus_is_saved_atomically(tmp_path):
-    out = train_word2vec(lambda: iter(CORPUS * 4), tmp_path / "w2v.kv", dim=8, min_count=1, epochs=3, workers=1)
+    out = train_word2vec(lambda: iter(CORPUS * 4), tmp_path / "w2v.bin", dim=8, min_count=1, epochs=3, workers=1)
     kv = load_vectors(out)
     assert {"pour", "water", "scissors"} <= set(kv.key_to_index) and kv.vector_size == 8
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["w2v.kv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w2v.bin"]
 
 
 def test_conceptnet_relatedness_from_an_edge_list(tmp_path):
@@ -69,3 +70,36 @@ def test_conceptnet_without_english_edges_is_an_error(tmp_path):
     (tmp_path / "train.txt").write_text("only one column\n")
     with pytest.raises(ValueError, match="no English ConceptNet edges"):
         read_edges(tmp_path)
+
+
+def test_pickled_vector_files_are_refused_without_being_opened(tmp_path):
+    # A .kv file is a pickle: loading it would run whatever it holds. It is refused by format, unread.
+    marker = tmp_path / "ran"
+    evil = tmp_path / "vectors.kv"
+    import pickle
+
+    class Payload:
+        def __reduce__(self):
+            return (marker.write_text, ("pwned",))
+
+    evil.write_bytes(pickle.dumps(Payload()))
+    with pytest.raises(VectorFileError, match="pickle-based"):
+        load_vectors(evil)
+    assert not marker.exists()
+
+
+def test_npy_vectors_with_a_word_list_load_without_pickle(tmp_path):
+    np.save(tmp_path / "glove.npy", np.array([[1.0, 0.0], [0.9, 0.1], [0.0, 1.0]], dtype=np.float32))
+    (tmp_path / "glove.words.txt").write_text("water\ncup\nscissors\n", encoding="utf-8")
+    kv = load_vectors(tmp_path / "glove.npy")
+    assert kv.index_to_key == ["water", "cup", "scissors"] and kv.vector_size == 2
+    (tmp_path / "glove.words.txt").write_text("water\ncup\n", encoding="utf-8")
+    with pytest.raises(VectorFileError, match="does not match 2 words"):
+        load_vectors(tmp_path / "glove.npy")
+
+
+def test_a_malformed_vector_file_is_a_vector_file_error(tmp_path):
+    bad = tmp_path / "v.txt"
+    bad.write_bytes(b"pour 1 0\nwater 1 nope\n")
+    with pytest.raises(VectorFileError, match="v.txt"):
+        load_vectors(bad)

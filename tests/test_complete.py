@@ -44,7 +44,8 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "unresolved": {}, "candidates": [], "question": None}
+                   "missing": None, "missing_roles": [], "unresolved": {}, "ignored_objects": [], "candidates": [],
+                   "question": None}
 
 
 def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
@@ -66,9 +67,9 @@ def test_two_missing_roles_score_object_pairs(parser):
 
 
 def test_empty_objects_and_unknown_verbs_are_clear_errors(parser):
-    with pytest.raises(CompletionError, match="no detected objects"):
+    with pytest.raises(CompletionError, match="no usable objects"):
         complete(parser, scorer, "pour me some water", [])
-    with pytest.raises(CompletionError, match="no detected objects"):
+    with pytest.raises(CompletionError, match="no usable objects"):
         complete(parser, scorer, "pour me some water", ["water"])
     with pytest.raises(NoPredicateError, match="no known predicate"):
         complete(parser, scorer, "juggle the oranges", ["cup"])

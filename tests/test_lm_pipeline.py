@@ -78,7 +78,7 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     assert baselines.exit_code == 0, baselines.output
     rows = list(csv.DictReader(out.open()))
     assert float(rows[0]["cooccur"]) > 0 and -3 <= float(rows[0]["word2vec"]) <= 0  # the sample pours water into cups
-    assert list((paths.data_dir / "baselines").glob("word2vec-all-*.kv"))  # cached by corpus hash
+    assert list((paths.data_dir / "baselines").glob("word2vec-all-*.bin"))  # cached by corpus hash
     complete_contract(tmp_path)
 
 
@@ -97,9 +97,21 @@ def complete_contract(tmp_path):
     assert a["frame"]["roles"]["Destination"] in {"cup", "scissors"} and len(a["candidates"]) == 2
     assert {"object", "score", "probability"} <= set(a["candidates"][0]) and "question" in a
     assert b["missing"] is None and b["candidates"] == []
-    given.write_text(json.dumps({"id": "c", "instruction": "juggle the oranges", "objects": ["cup"]}) + "\n")
+    # A well-formed line that cannot be completed, in the middle: its own error, the run goes on.
+    lines = [{"id": "c", "instruction": "pour me some water", "objects": ["cup"]},
+             {"id": "d", "instruction": "juggle the oranges", "objects": ["cup"]},
+             {"id": "e", "instruction": "pour me some water", "objects": ["water"]},
+             {"id": "f", "instruction": "fill the pot", "objects": ["water", "cup"]}]
+    given.write_text("".join(json.dumps(line) + "\n" for line in lines))
+    mixed = runner.invoke(app, ["complete", "--input", str(given), "--output", str(out)])
+    assert mixed.exit_code == 0 and "in.jsonl:2: no known predicate" in mixed.output
+    c, d, e, f = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [c["id"], d["id"], e["id"], f["id"]] == ["c", "d", "e", "f"]
+    assert d == {"id": "d", "error": d["error"]} and "no known predicate" in d["error"] and "no usable objects" in e["error"]
+    assert c["frame"]["roles"]["Destination"] == "cup" and f["frame"]["roles"]["Theme"] == "water"
+    given.write_text(json.dumps({"id": "g", "instruction": 5, "objects": ["cup"]}) + "\n")  # malformed: whole run fails
     bad = runner.invoke(app, ["complete", "--input", str(given), "--output", str(tmp_path / "none.jsonl")])
-    assert bad.exit_code == 1 and "in.jsonl:1: no known predicate" in bad.output
+    assert bad.exit_code == 1 and "in.jsonl:1: field 'instruction' missing or not str" in bad.output
     assert not (tmp_path / "none.jsonl").exists()
 
 

@@ -22,11 +22,17 @@ import duckdb
 import pyarrow as pa
 
 from lmcr.files import file_sha256
-from lmcr.jsonl import InputError, open_input
+from lmcr.jsonl import InputError, read_lines
 
 META = ("HITId", "AssignmentId", "WorkerId", "AssignmentStatus")
 ITEM_FIELDS = ("verb", "role1", "arg1", "role2", "arg2")
 OPTIONAL_FIELDS = ("frame_id", "sentence")
+RATINGS = frozenset("12345")  # exactly these ASCII digits: str.isdigit() also accepts "٣" and "²"
+
+
+def _count(value: str | None) -> int | None:
+    """An ASCII decimal count column (WorkTimeInSeconds, MaxAssignments), else None."""
+    return int(value) if value and value.isascii() and value.isdigit() else None
 
 
 @dataclass
@@ -67,8 +73,9 @@ def _slots(columns: list[str], path: Path) -> tuple[str, list[str]]:
         raise InputError(f"{path}:1: not an MTurk batch-results file, missing columns {missing}")
     if "Input.verb" in columns:
         return "single", [""]
-    suffixes = sorted((c.removeprefix("Input.verb") for c in columns if c.startswith("Input.verb_")),
-                      key=lambda s: int(s[1:]) if s[1:].isdigit() else 0)
+    # Slot columns are Input.verb_1 .. Input.verb_N (ASCII digits); other Input.verb_* columns are not slots.
+    suffixes = sorted((s for s in (c.removeprefix("Input.verb") for c in columns if c.startswith("Input.verb_"))
+                       if _count(s[1:]) is not None), key=lambda s: int(s[1:]))
     if not suffixes:
         raise InputError(f"{path}:1: no Input.verb or Input.verb_1 column")
     return "multi", suffixes
@@ -87,7 +94,7 @@ def _item(row: dict, suffix: str) -> tuple[dict | None, str | None]:
     empty = [f"Input.{f}{suffix}" for f in ITEM_FIELDS if not fields[f]]
     if empty:
         return item, f"missing required input {', '.join(empty)}"
-    if not answer.isdigit() or not 1 <= int(answer) <= 5:
+    if answer not in RATINGS:
         return item, f"Answer.rating{suffix} = {answer!r} is not an integer rating 1-5"
     item["rating"] = int(answer)
     return item, None
@@ -96,25 +103,34 @@ def _item(row: dict, suffix: str) -> tuple[dict | None, str | None]:
 def parse_results(path: Path) -> ParsedResults:
     """Every assignment row of a results file with its valid and defective items."""
     path = Path(path)
-    with open_input(path, newline="", encoding="utf-8-sig") as handle:
-        reader = csv.DictReader(handle)
+    reader = csv.DictReader(read_lines(path))
+    try:
         layout, suffixes = _slots(reader.fieldnames or [], path)
         assignments, rows = [], 0
         for row in reader:
             rows += 1
-            a = Assignment({k: (v or "").strip() for k, v in row.items() if k}, reader.line_num)
-            empty_meta = [c for c in META if not a.row.get(c)]
-            for suffix in suffixes:
-                item, reason = _item(row, suffix)
-                if item is None:
-                    continue
-                reason = reason or (f"row has no {', '.join(empty_meta)}" if empty_meta else None)
-                if reason:
-                    a.bad.append((item["item"], reason, item))
-                else:
-                    a.items.append(item)
-            assignments.append(a)
+            assignments.append(_assignment(row, reader.line_num, suffixes, len(reader.fieldnames)))
+    except csv.Error as exc:
+        raise InputError(f"{path}:{reader.line_num}: not CSV: {exc}") from exc
     return ParsedResults(path, file_sha256(path), layout, rows, assignments)
+
+
+def _assignment(row: dict, line: int, suffixes: list[str], n_columns: int) -> Assignment:
+    """One results row: its valid items, and its defective ones with the reason."""
+    a = Assignment({k: (v or "").strip() for k, v in row.items() if k}, line)
+    empty_meta = [c for c in META if not a.row.get(c)]
+    # csv puts the fields of a row longer than the header under None: its columns are shifted.
+    extra = f"row has {n_columns + len(row[None])} fields, the header {n_columns}" if None in row else None
+    for suffix in suffixes:
+        item, reason = _item(row, suffix)
+        if item is None:
+            continue
+        reason = extra or reason or (f"row has no {', '.join(empty_meta)}" if empty_meta else None)
+        if reason:
+            a.bad.append((item["item"], reason, item))
+        else:
+            a.items.append(item)
+    return a
 
 
 def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
@@ -150,14 +166,12 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
         counts["items_loaded"] += len(a.items)
         row = a.row
         new.append({"assignment_id": aid, "hit_id": row["HITId"], "worker_id": row["WorkerId"],
-                    "status": row["AssignmentStatus"], "work_seconds": int(row["WorkTimeInSeconds"])
-                    if row.get("WorkTimeInSeconds", "").isdigit() else None,
+                    "status": row["AssignmentStatus"], "work_seconds": _count(row.get("WorkTimeInSeconds")),
                     "submit_time": row.get("SubmitTime") or None, "source_file": source, "line": a.line,
                     "content_sha256": a.content_sha256, "conflict": None})
         hits.setdefault(row["HITId"], {"hit_id": row["HITId"], "hit_type_id": row.get("HITTypeId") or None,
                                        "title": row.get("Title") or None, "reward": row.get("Reward") or None,
-                                       "max_assignments": int(row["MaxAssignments"])
-                                       if row.get("MaxAssignments", "").isdigit() else None,
+                                       "max_assignments": _count(row.get("MaxAssignments")),
                                        "source_file": source})
         workers.setdefault(row["WorkerId"], {"worker_id": row["WorkerId"], "first_file": source})
         ratings += [{"assignment_id": aid, **item} for item in a.items]

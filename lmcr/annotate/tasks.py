@@ -26,7 +26,7 @@ from typing import Callable
 import duckdb
 import numpy as np
 
-from lmcr.files import atomic_dir
+from lmcr.files import atomic_dir, check_output_dir
 from lmcr.lm.linearize import sentence_text
 from lmcr.srl.lexicon import load_lexicon
 
@@ -171,6 +171,7 @@ def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskCo
     """Choose frames, build HITs, record the gold items in the store, write the batch folder."""
     if config.mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, not {config.mode!r}")
+    check_output_dir(out_dir)  # before the gold items are recorded: a refused folder changes nothing
     pool = protocol_frames(config.seed, config.fixed_per_role)
     if config.mode == "corpus":
         pool = corpus_frames(con, config.n_frames or len(pool), config.seed)

@@ -1,9 +1,11 @@
 """Word-vector baseline: g = -(dist(v, a1) + dist(v, a2) + dist(a1, a2)), cosine distance.
 
 The paper used pretrained GloVe as g = -(dist(v, a2) + dist(a1, a2)); the added dist(v, a1) is the
-same for every candidate of a scenario (see `cooccur`). Vectors come from a file (GloVe text,
-word2vec text/binary, or a gensim `.kv`), e.g. the 10k-word GloVe subset, or are trained with gensim
-word2vec on our own corpus sentences (`train_word2vec`), because that subset misses many cooking words.
+same for every candidate of a scenario (see `cooccur`). Vectors come from a file in a data format
+(GloVe text, word2vec text or binary, or a `.npy` matrix beside a word list), e.g. the 10k-word GloVe
+subset, or are trained with gensim word2vec on our own corpus sentences (`train_word2vec`), because
+that subset misses many cooking words. Pickle-based files (gensim's `.kv`/`.model`) are refused: loading
+one can run code.
 
 OOV policy: a multiword term ("bell pepper") is the mean of its known words; a term with no known
 word has no vector, and its distance to anything is 1.0, what two unrelated (orthogonal) words get.
@@ -24,19 +26,47 @@ from lmcr.lm.linearize import tokens
 UNRELATED = 1.0
 
 
+PICKLED = (".kv", ".model", ".pkl", ".pickle")
+
+
+class VectorFileError(ValueError):
+    """A vector file that is missing, not in a data format, or malformed."""
+
+
 def load_vectors(path: Path) -> KeyedVectors:
-    """GloVe text (no header), word2vec text or binary (`.bin`), or gensim KeyedVectors (`.kv`)."""
+    """GloVe text (no header), word2vec text or binary (`.bin`), or a `.npy` matrix with its word list
+    beside it (`NAME.npy` + `NAME.words.txt`, one word per line). Nothing is unpickled."""
     path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"{path}: no such vector file")
-    if path.suffix == ".kv":
-        return KeyedVectors.load(str(path))
-    if path.suffix == ".bin":
-        return KeyedVectors.load_word2vec_format(str(path), binary=True)
-    with open(path, encoding="utf-8") as handle:
-        first = handle.readline().split()
-    has_header = len(first) == 2 and all(x.isdigit() for x in first)
-    return KeyedVectors.load_word2vec_format(str(path), binary=False, no_header=not has_header)
+    if path.suffix.lower() in PICKLED:
+        raise VectorFileError(f"{path}: pickle-based vector files are not loaded (they can run code); "
+                              "give GloVe/word2vec text, word2vec .bin, or .npy with a .words.txt list")
+    if not path.is_file():
+        raise VectorFileError(f"{path}: no such vector file")
+    try:
+        if path.suffix.lower() == ".npy":
+            return _load_npy(path)
+        if path.suffix.lower() == ".bin":
+            return KeyedVectors.load_word2vec_format(str(path), binary=True)
+        with open(path, encoding="utf-8") as handle:
+            first = handle.readline().split()
+        has_header = len(first) == 2 and all(x.isdigit() for x in first)
+        return KeyedVectors.load_word2vec_format(str(path), binary=False, no_header=not has_header)
+    except (ValueError, UnicodeDecodeError, EOFError, OSError, IndexError) as exc:
+        raise VectorFileError(f"{path}: not a readable vector file: {' '.join(str(exc).split())[:200]}") from exc
+
+
+def _load_npy(path: Path) -> KeyedVectors:
+    words_file = path.with_suffix(".words.txt")
+    if not words_file.is_file():
+        raise VectorFileError(f"{path}: no word list {words_file.name} beside it")
+    matrix = np.load(path, allow_pickle=False)
+    words = words_file.read_text(encoding="utf-8").split("\n")
+    words = words[:-1] if words and words[-1] == "" else words
+    if matrix.ndim != 2 or len(words) != matrix.shape[0]:
+        raise VectorFileError(f"{path}: {matrix.shape} matrix does not match {len(words)} words in {words_file.name}")
+    kv = KeyedVectors(matrix.shape[1])
+    kv.add_vectors(words, matrix.astype(np.float32))
+    return kv
 
 
 class _Sentences:
@@ -52,11 +82,12 @@ class _Sentences:
 
 def train_word2vec(texts, out: Path, dim: int = 100, window: int = 5, min_count: int = 5, epochs: int = 5,
                    workers: int = 2, seed: int = 1) -> Path:
-    """Skip-gram word2vec on the corpus sentences (`texts()` yields strings), saved atomically as `.kv`."""
+    """Skip-gram word2vec on the corpus sentences (`texts()` yields strings), saved atomically in word2vec
+    binary format (a data format: nothing in the cache can run code when loaded)."""
     model = Word2Vec(sentences=_Sentences(texts), vector_size=dim, window=window, min_count=min_count, sg=1,
                      epochs=epochs, workers=workers, seed=seed)
     with atomic_path(Path(out)) as tmp:
-        model.wv.save(str(tmp), separately=[])  # one file, so the rename publishes all of it
+        model.wv.save_word2vec_format(str(tmp), binary=True)
     return Path(out)
 
 

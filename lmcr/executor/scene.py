@@ -10,6 +10,7 @@ sphere or cylinder.
 from __future__ import annotations
 
 import json
+import math
 import random
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +18,7 @@ from pathlib import Path
 import pybullet as p
 
 from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
-from lmcr.jsonl import InputError, open_input
+from lmcr.jsonl import InputError, decode_utf8, read_bytes
 from lmcr.srl.lexicon import load_lexicon
 
 TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
@@ -111,27 +112,51 @@ def _overlap(a: str, axy, b: str, bxy) -> bool:
 
 def load_scene(path: Path) -> Scene:
     """Read and validate a scene file; objects without `xy` are placed at random (seeded)."""
+    text = decode_utf8(read_bytes(path), path)
     try:
-        with open_input(path) as handle:
-            data = json.load(handle)
+        data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputError(f"{path}:{exc.lineno}: not JSON: {exc.msg}") from exc
+    except RecursionError as exc:
+        raise InputError(f"{path}: JSON nested too deeply") from exc
+    return scene_from_json(data, str(path))
+
+
+def scene_from_json(data: object, where: str) -> Scene:
+    """A scene from the scene format's decoded JSON (a file's, or a batch line's `scene`)."""
     if not isinstance(data, dict) or not isinstance(data.get("objects"), list):
-        raise InputError(f"{path}: a scene is an object with an 'objects' list")
-    return make_scene([(o.get("label"), o.get("xy")) for o in data["objects"]], int(data.get("seed", 0)), str(path))
+        raise InputError(f"{where}: a scene is an object with an 'objects' list")
+    seed = data.get("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool):
+        raise InputError(f"{where}: 'seed' must be an integer, not {seed!r:.40}")
+    items = []
+    for k, obj in enumerate(data["objects"]):
+        if not isinstance(obj, dict):
+            raise InputError(f"{where}: object {k} is not a JSON object")
+        items.append((obj.get("label"), obj.get("xy")))
+    return make_scene(items, seed, where)
+
+
+def _valid_xy(xy: object) -> bool:
+    return (isinstance(xy, list) and len(xy) == 2
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in xy))
 
 
 def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str = "scene") -> Scene:
+    """Validated objects (known labels, finite on-table positions that do not overlap), the ones
+    without a position placed at random with `seed`."""
     vocabulary = set(load_lexicon().objects)
     placed: list[SceneObject] = []
     for k, (label, xy) in enumerate(items):
-        if label not in vocabulary:
-            raise InputError(f"{where}: object {k}: unknown label {label!r}")
+        if not isinstance(label, str) or label not in vocabulary:
+            raise InputError(f"{where}: object {k}: unknown label {label!r:.60}")
         if xy is not None:
-            if len(xy) != 2 or abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
+            if not _valid_xy(xy):
+                raise InputError(f"{where}: object {k} ({label}): xy must be two finite numbers [x, y], not {xy!r:.60}")
+            if abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
                 raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
             for other in placed:
-                if _overlap(label, xy, other.label, other.xy):
+                if other.xy is not None and _overlap(label, xy, other.label, other.xy):
                     raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
     rng = random.Random(seed)

@@ -7,47 +7,59 @@ from __future__ import annotations
 
 import gzip
 import json
+import zlib
 from pathlib import Path
 from typing import Iterator
 
-from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.ingest.records import IngestError, ParsedFile, has_surrogates
 
 
 def _recipe_problem(recipe: object) -> str | None:
     if not isinstance(recipe, dict):
         return "record is not a JSON object"
+    if has_surrogates(recipe):
+        return "text has an unpaired surrogate"
     for key in ("ingredients", "directions"):
         value = recipe.get(key, [])
         if not isinstance(value, list) or not all(isinstance(x, str) for x in value):
             return f"{key!r} is not a list of strings"
     if not recipe.get("directions") and not recipe.get("ingredients"):
         return "no ingredients and no directions"
-    if recipe.get("title") is not None and not isinstance(recipe["title"], str):
-        return "'title' is not a string"
+    for key in ("title", "url", "source"):
+        if recipe.get(key) is not None and not isinstance(recipe[key], str):
+            return f"{key!r} is not a string"
     return None
 
 
-def _lines(path: Path) -> Iterator[tuple[int, str]]:
+def _lines(path: Path) -> Iterator[tuple[int, bytes]]:
     opener = gzip.open if path.suffix == ".gz" else open
     try:
-        with opener(path, "rt", encoding="utf-8") as handle:
+        with opener(path, "rb") as handle:
             yield from enumerate(handle, start=1)
-    except (OSError, UnicodeDecodeError, EOFError) as exc:
-        raise IngestError(str(path), None, f"cannot read as UTF-8 JSON Lines: {exc}") from exc
+    except (OSError, EOFError, zlib.error) as exc:
+        raise IngestError(str(path), None, f"cannot read: {' '.join(str(exc).split())}") from exc
 
 
 def _records(path: Path) -> Iterator[tuple[int, str, str]]:
-    """(position, doc key, raw JSON text) for each record of a JSONL file or a folder of JSON files."""
+    """(position, doc key, raw JSON text) for each record of a JSONL file or a folder of JSON files;
+    undecodable text comes as UNDECODABLE + the reason, to be quarantined."""
     if path.is_dir():
         for position, file in enumerate(sorted(path.rglob("*.json")), start=1):
-            try:
-                yield position, file.relative_to(path).with_suffix("").as_posix(), file.read_text("utf-8")
-            except UnicodeDecodeError as exc:
-                yield position, file.name, f"\x00undecodable: {exc}"
+            yield position, file.relative_to(path).with_suffix("").as_posix(), _decode(file.read_bytes())
         return
     for line_no, line in _lines(path):
         if line.strip():
-            yield line_no, str(line_no), line
+            yield line_no, str(line_no), _decode(line)
+
+
+UNDECODABLE = "\x00undecodable: "
+
+
+def _decode(raw: bytes) -> str:
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        return f"{UNDECODABLE}not UTF-8 (byte 0x{raw[exc.start]:02x} at column {exc.start + 1})"
 
 
 def _stem(path: Path) -> str:
@@ -62,10 +74,16 @@ def parse_recipe_json(path: Path, corpus: str = "recipes") -> ParsedFile:
     parsed = ParsedFile(str(path), "recipe_json", corpus)
     stem = _stem(path)
     for position, key, raw in _records(path):
+        if raw.startswith(UNDECODABLE):
+            parsed.reject(position, raw.removeprefix(UNDECODABLE), "")
+            continue
         try:
             recipe = json.loads(raw)
         except json.JSONDecodeError as exc:
             parsed.reject(position, f"not valid JSON: {exc.msg} at column {exc.colno}", raw)
+            continue
+        except RecursionError:
+            parsed.reject(position, "JSON nested too deeply", raw[:200])
             continue
         problem = _recipe_problem(recipe)
         if problem:

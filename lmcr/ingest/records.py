@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from typing import Iterable
 
@@ -13,6 +14,16 @@ KINDS = ("instruction", "ingredient", "title", "comment")
 PROSE_KINDS = frozenset({"instruction", "comment"})
 
 
+def has_surrogates(value: object) -> bool:
+    """True when a decoded JSON value holds an unpaired surrogate ("\\ud800"): such text cannot be
+    stored or parsed, so its record is quarantined."""
+    try:
+        json.dumps(value, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
+
+
 class IngestError(RuntimeError):
     """An input file cannot be read at all (missing, undecodable, not the format it claims)."""
 
@@ -20,6 +31,9 @@ class IngestError(RuntimeError):
         where = f"{source_file}:{position}" if position else source_file
         super().__init__(f"{where}: {reason}")
         self.source_file, self.position, self.reason = source_file, position, reason
+
+    def __reduce__(self):  # raised in parser processes: must unpickle with its three arguments
+        return IngestError, (self.source_file, self.position, self.reason)
 
 
 @dataclass
@@ -44,7 +58,8 @@ class ParsedFile:
         self.records_in += 1
         self.rejects.append({
             "stage": "ingest", "corpus": self.corpus, "source_file": self.source_file,
-            "position": position, "reason": reason, "record": str(record)[:2000],
+            "position": position, "reason": reason,
+            "record": str(record)[:2000].encode("utf-8", "backslashreplace").decode("utf-8"),
         })
 
     def add_document(

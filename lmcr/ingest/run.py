@@ -14,14 +14,17 @@ from lmcr.store import check_contracts, named_query, query_dicts
 
 
 def plan(con: duckdb.DuckDBPyConnection, sources: list[Source]) -> tuple[list[tuple[Source, str]], list[Source]]:
-    """Split sources into (source, sha256) to ingest and the ones already loaded with this content."""
-    todo, skipped = [], []
+    """Split sources into (source, sha256) to ingest and the ones to skip: already loaded with this
+    content, or a copy of content loaded from another path (or listed earlier in this call)."""
+    todo, skipped, seen = [], [], set()
     for source in sources:
         sha = source.sha256()
-        if already_loaded(con, source, sha):
+        identity = (sha, source.format, source.encoding or "")
+        if identity in seen or already_loaded(con, source, sha):
             skipped.append(source)
         else:
             todo.append((source, sha))
+        seen.add(identity)
     return todo, skipped
 
 

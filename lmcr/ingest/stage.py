@@ -38,6 +38,7 @@ class StagedFile:
     sha256: str
     format: str
     corpus: str
+    encoding: str
     parquet: dict[str, str]
     records_in: int
     records_loaded: int
@@ -62,20 +63,30 @@ def stage(source: Source, parsed: ParsedFile, sha256: str, staging_dir: Path) ->
         write_parquet_atomic(rows[table], schema, path)
         paths[table] = str(path)
     return StagedFile(
-        source_file=source.key, sha256=sha256, format=source.format, corpus=source.corpus, parquet=paths,
+        source_file=source.key, sha256=sha256, format=source.format, corpus=source.corpus,
+        encoding=source.encoding or "", parquet=paths,
         records_in=parsed.records_in, records_loaded=parsed.records_loaded,
         records_quarantined=len(parsed.rejects), documents=len(parsed.documents),
         sentences=len(parsed.sentences), words=parsed.words,
     )
 
 
-def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) -> bool:
-    """True when this exact content was loaded for this source and corpus: re-ingesting is a no-op."""
+def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) -> str | None:
+    """Where this exact content (same bytes, adapter and encoding) is already loaded from: this source
+    itself when re-ingesting is a no-op, or another path holding a copy of it (loading it again would
+    count every sentence twice); None when it must be loaded. A path already loaded into another
+    corpus is an IngestError: re-ingesting it must not silently move its rows."""
+    other = con.execute("select corpus from ingested_files where source_file = ? and corpus <> ?",
+                        [source.key, source.corpus]).fetchone()
+    if other:
+        raise IngestError(source.key, None, f"already loaded into corpus {other[0]!r}, not {source.corpus!r}; "
+                                            "its rows stay there (ingest it with the same flag)")
     row = con.execute(
-        "select 1 from ingested_files where source_file = ? and sha256 = ? and corpus = ? and format = ?",
-        [source.key, sha256, source.corpus, source.format],
+        "select source_file from ingested_files where sha256 = ? and format = ? and encoding = ?"
+        " order by source_file <> ? limit 1",
+        [sha256, source.format, source.encoding or "", source.key],
     ).fetchone()
-    return row is not None
+    return row[0] if row else None
 
 
 def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
@@ -95,9 +106,9 @@ def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
         con.execute(f"insert into {table} ({columns}) select {columns} from read_parquet(?)",
                     [staged.parquet[table]])
     con.execute(
-        "insert into ingested_files (source_file, sha256, format, corpus, records_in, records_loaded,"
-        " records_quarantined, documents, sentences, words) values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-        [staged.source_file, staged.sha256, staged.format, staged.corpus, staged.records_in,
+        "insert into ingested_files (source_file, sha256, format, corpus, encoding, records_in, records_loaded,"
+        " records_quarantined, documents, sentences, words) values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+        [staged.source_file, staged.sha256, staged.format, staged.corpus, staged.encoding, staged.records_in,
          staged.records_loaded, staged.records_quarantined, staged.documents, staged.sentences, staged.words],
     )
 

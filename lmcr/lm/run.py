@@ -18,6 +18,7 @@ from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
+from lmcr.store import transaction
 
 
 def code_version() -> str:
@@ -69,10 +70,15 @@ def train_setting(
                "val_sequences": len(text.val)}
     provenance = {**text.provenance, "code_version": code_version(), "train_config": train_config.to_json(),
                   "min_freq": min_freq, "run_id": run_id}
-    path = ckpt.publish(checkpoints, f"{linearization}-{corpus}", model.cpu(), vocab, linearization, metrics,
-                        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote)
+    # Publish unpromoted, record the run, then promote: LATEST never names a version without its
+    # lm_runs row, whatever fails or is killed in between.
+    setting = f"{linearization}-{corpus}"
+    path = ckpt.publish(checkpoints, setting, model.cpu(), vocab, linearization, metrics,
+                        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote=False)
     with open_store() as con:
         record_run(con, run_id, text, len(vocab), history, path)
+    if promote:
+        ckpt.set_latest(checkpoints, setting, path.name)
     return path
 
 
@@ -92,13 +98,12 @@ def up_to_date(setting_dir: Path, corpus_sha256: str, model_config: LMConfig, tr
 def record_run(con: duckdb.DuckDBPyConnection, run_id: str, text: TrainingText, vocab_size: int,
                history: list[dict], path: Path) -> None:
     """One lm_runs row and its lm_epochs rows, in one transaction."""
-    con.execute("begin transaction")
-    con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size,"
-                " best_val_ppl, checkpoint) values (?, ?, ?, ?, ?, ?, ?, ?)",
-                [run_id, text.provenance["linearization"], text.provenance["corpus"], len(text.train), len(text.val),
-                 vocab_size, min(r["val_ppl"] for r in history), str(path)])
-    con.executemany("insert into lm_epochs (run_id, epoch, train_ppl, val_ppl, tokens_per_s, seconds, device,"
-                    " objective, precision) values (?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    [[run_id, r["epoch"], r["train_ppl"], r["val_ppl"], r["tokens_per_s"], r["seconds"], r["device"],
-                      r["objective"], r["precision"]] for r in history])
-    con.execute("commit")
+    with transaction(con):
+        con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size,"
+                    " best_val_ppl, checkpoint) values (?, ?, ?, ?, ?, ?, ?, ?)",
+                    [run_id, text.provenance["linearization"], text.provenance["corpus"], len(text.train),
+                     len(text.val), vocab_size, min(r["val_ppl"] for r in history), str(path)])
+        con.executemany("insert into lm_epochs (run_id, epoch, train_ppl, val_ppl, tokens_per_s, seconds, device,"
+                        " objective, precision) values (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                        [[run_id, r["epoch"], r["train_ppl"], r["val_ppl"], r["tokens_per_s"], r["seconds"],
+                          r["device"], r["objective"], r["precision"]] for r in history])

@@ -21,6 +21,7 @@ import spacy
 from spacy.language import Language
 from spacy.tokens import Doc, Span, Token
 
+from lmcr.jsonl import check_text
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import Frame, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
@@ -246,8 +247,9 @@ def load_parser(model: str | None = None, resources: Path | None = None) -> Fram
 
 
 def parse_instruction(parser: FrameParser, text: str) -> Frame:
-    """The first frame of a robot predicate in a spoken instruction; missing roles are None."""
-    known = [f for f in parser.parse(text) if f.known]
+    """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
+    parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
+    known = [f for f in parser.parse(check_text(text, "instruction")) if f.known]
     if not known:
         verbs = ", ".join(sorted(parser.lex.predicates))
         raise NoPredicateError(f"no known predicate in {text!r}: the robot can {verbs}")
