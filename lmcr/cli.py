@@ -384,8 +384,10 @@ def annotate_quality(
 
 @app.command()
 def execute(
-    instruction: str = typer.Argument(..., help="The spoken instruction, e.g. \"pour me some water\"."),
-    scene: Path = typer.Option(..., help="Scene JSON: objects with labels and table positions."),
+    instruction: Optional[str] = typer.Argument(None, help="The spoken instruction, e.g. \"pour me some water\"."),
+    scene: Optional[Path] = typer.Option(None, help="Scene JSON: objects with labels and table positions."),
+    input: Optional[Path] = typer.Option(None, "--input", help="Batch JSONL: {id, instruction, scene | scene_file}."),
+    output: Optional[Path] = typer.Option(None, "--output", help="Batch JSONL: {id, ...result} or {id, error}."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
     corpus: str = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
@@ -393,22 +395,42 @@ def execute(
     render: Optional[Path] = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
     model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
 ) -> None:
-    """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless)."""
+    """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
+    with --input/--output, a batch of instructions and scenes with the models loaded once."""
     import json
 
     from lmcr.complete import completion_scorer
-    from lmcr.executor.execute import execute as run_instruction, save_render
+    from lmcr.executor.execute import execute as run_instruction, execute_batch, save_render
     from lmcr.executor.scene import load_scene
     from lmcr.files import OutputError, check_output_file
+    from lmcr.jsonl import check_text, read_bytes, write_jsonl_atomic
 
     paths = paths_from_env()
+    batch = input is not None or output is not None
+    if batch and (input is None or output is None or instruction is not None or scene is not None or render):
+        fail("the batch form takes --input IN.jsonl and --output OUT.jsonl (no instruction, --scene or --render)")
+    if not batch and (instruction is None or scene is None):
+        fail('give "INSTRUCTION" and --scene SCENE.json, or --input IN.jsonl and --output OUT.jsonl')
     if render:  # checked before the simulation, so a bad path does not cost its result
         check_output_file(render)
         if render.suffix.lower() not in (".png", ".gif"):
             raise OutputError(f"{render}: --render takes a .png or .gif file name")
-    layout = load_scene(scene)
+    if batch:
+        check_output_file(output)
+        read_bytes(input)  # an unreadable input fails before the models load
+    else:
+        layout = load_scene(scene)
+        check_text(instruction, "instruction")
     scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus), paths.data_dir / "calibration")
     parser = _srl_parser(model, None)
+    if batch:
+        run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, paths.data_dir / "robot")  # noqa: E731
+        results = list(execute_batch(input, run))
+        write_jsonl_atomic(output, results)
+        ok = sum(1 for r in results if r.get("success"))
+        errors = sum(1 for r in results if "error" in r)
+        console.print(f"{len(results):,} lines -> {output}: {ok} succeeded, {errors} errors")
+        return
     frames: list | None = [] if render else None
     result = run_instruction(instruction, layout, parser, scorer, config, paths.data_dir / "robot", frames)
     if render:

@@ -33,19 +33,21 @@ def read_bytes(path: Path) -> bytes:
         raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
 
 
-def decode_utf8(raw: bytes, path: Path) -> str:
-    """UTF-8 text (a BOM is dropped); undecodable bytes raise InputError with their line and column."""
+def decode_utf8(raw: bytes, where: Path | str) -> str:
+    """UTF-8 text (a BOM is dropped); undecodable bytes raise InputError naming `where` and the byte's
+    line and column (`where` may already name the line: then only the column is added)."""
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
-        raise InputError(f"{path}:{line}: not UTF-8 (byte 0x{raw[exc.start]:02x} at column {column})") from exc
+        place = f"{where}:{line}" if isinstance(where, Path) else str(where)
+        raise InputError(f"{place}: not UTF-8 (byte 0x{raw[exc.start]:02x} at column {column})") from exc
 
 
 def read_lines(path: Path) -> list[str]:
     """The decoded lines of a UTF-8 text file, line endings kept (what the csv module wants)."""
-    return decode_utf8(read_bytes(path), path).splitlines(keepends=True)
+    return decode_utf8(read_bytes(path), Path(path)).splitlines(keepends=True)
 
 
 def check_text(value: str, where: str, max_chars: int | None = MAX_TEXT_CHARS) -> str:
@@ -64,23 +66,52 @@ def read_jsonl(path: Path, required: dict[str, type | tuple[type, ...]]) -> Iter
     """(line number, record) for each non-blank line; a line that is not a JSON object with the
     required fields of the required types, or holds a string that cannot be encoded (a lone
     surrogate), raises InputError naming file and line."""
-    for line_no, line in enumerate(read_lines(path), start=1):
+    for line_no, record, error in read_jsonl_lines(path, required):
+        if error is not None:
+            raise error
+        yield line_no, record
+
+
+def read_jsonl_lines(path: Path, required: dict[str, type | tuple[type, ...]]
+                     ) -> Iterator[tuple[int, dict | None, InputError | None]]:
+    """(line number, record, None) for each good non-blank line and (line number, the decoded object or
+    None, InputError) for each bad one, so a batch can report a bad line and go on. Only a file that
+    cannot be read at all raises."""
+    raw = read_bytes(path)
+    for line_no, line in enumerate(raw.split(b"\n"), start=1):
         if not line.strip():
             continue
         try:
-            record = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"{path}:{line_no}: not valid JSON: {exc.msg}") from exc
-        except RecursionError as exc:
-            raise InputError(f"{path}:{line_no}: JSON nested too deeply") from exc
-        if not isinstance(record, dict):
-            raise InputError(f"{path}:{line_no}: expected a JSON object")
-        for key, kind in required.items():
-            value = record.get(key)
-            if not isinstance(value, kind) or isinstance(value, bool):
-                raise InputError(f"{path}:{line_no}: field {key!r} missing or not {_name(kind)}")
-        check_text(json.dumps(record, ensure_ascii=False), f"{path}:{line_no}", max_chars=None)
-        yield line_no, record
+            yield line_no, _record(line, required, f"{path}:{line_no}"), None
+        except InputError as exc:
+            yield line_no, _partial(line), exc
+
+
+def _record(line: bytes, required: dict[str, type | tuple[type, ...]], where: str) -> dict:
+    text = decode_utf8(line, where)
+    try:
+        record = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{where}: not valid JSON: {exc.msg}") from exc
+    except RecursionError as exc:
+        raise InputError(f"{where}: JSON nested too deeply") from exc
+    if not isinstance(record, dict):
+        raise InputError(f"{where}: expected a JSON object")
+    for key, kind in required.items():
+        value = record.get(key)
+        if not isinstance(value, kind) or isinstance(value, bool):
+            raise InputError(f"{where}: field {key!r} missing or not {_name(kind)}")
+    check_text(json.dumps(record, ensure_ascii=False), where, max_chars=None)
+    return record
+
+
+def _partial(line: bytes) -> dict | None:
+    """What can be read of a bad line (for its id), or None."""
+    try:
+        record = json.loads(line.decode("utf-8"))
+    except (ValueError, RecursionError):
+        return None
+    return record if isinstance(record, dict) else None
 
 
 def _name(kind: type | tuple[type, ...]) -> str:

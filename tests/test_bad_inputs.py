@@ -367,3 +367,43 @@ def test_ingest_feeding_america_never_tracebacks(inner, tag, garbage):
                          + f"</p></recipe></{tag}>".encode())
         _ingest_and_check(tmp, path, "--recipes")
     _count("Feeding America XML")
+
+
+# --- batch execute: a bad line is reported in its output line, the run goes on ------------------
+
+BAD_EXECUTE_LINES = st.one_of(
+    st.binary(min_size=1, max_size=8).map(lambda b: b'{"id": "x\xff' + b.replace(b"\n", b"")),
+    st.text(max_size=10).map(lambda t: ('{"id": ' + t.replace("\n", "")).encode("utf-8", "surrogatepass")),
+    ANY_JSON.filter(lambda v: not isinstance(v, dict)).map(lambda v: json.dumps(v).encode()),
+    st.fixed_dictionaries({"id": st.just("s"), "instruction": st.just("pour me some water"),
+                           "scene": ANY_JSON.filter(lambda v: not isinstance(v, dict) or "objects" not in v)}
+                          ).map(lambda r: json.dumps(r).encode()),
+    st.fixed_dictionaries({"id": st.just("f"), "instruction": st.just("pour me some water"),
+                           "scene_file": st.sampled_from(["missing.json", ".", "in.jsonl"])}).map(lambda r: json.dumps(r).encode()),
+    st.fixed_dictionaries({"id": st.just("i"), "instruction": ANY_JSON.filter(lambda v: not isinstance(v, str)),
+                           "scene": st.just({"objects": []})}).map(lambda r: json.dumps(r).encode()),
+)
+
+
+@FUZZ
+@given(lines=st.lists(BAD_EXECUTE_LINES, min_size=1, max_size=4))
+def test_batch_execute_reports_every_bad_line(lines, monkeypatch):
+    import lmcr.cli
+    import lmcr.complete
+
+    monkeypatch.setattr(lmcr.complete, "completion_scorer", lambda *a: (None, None))
+    monkeypatch.setattr(lmcr.cli, "_srl_parser", lambda *a: None)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "in.jsonl").write_bytes(b"\n".join(lines) + b"\n")
+        result = invoke(["execute", "--input", str(tmp / "in.jsonl"), "--output", str(tmp / "out.jsonl")], tmp)
+        assert result.exit_code == 0 and "Traceback" not in result.output, result.output
+        out = [json.loads(line) for line in (tmp / "out.jsonl").read_text().splitlines()]
+        assert len(out) == sum(1 for line in lines if line.strip()) and all("error" in r for r in out)
+    _count("execute JSONL")
+
+
+def test_batch_execute_with_an_unreadable_input_is_one_line(tmp_path):
+    result = invoke(["execute", "--input", str(tmp_path), "--output", str(tmp_path / "o.jsonl")], tmp_path)
+    assert_one_line_error(result, tmp_path)
+    assert not (tmp_path / "o.jsonl").exists()

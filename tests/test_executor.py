@@ -122,3 +122,28 @@ def test_each_predicate_executes_from_the_completion(sim, completer, predicate):
     assert out["frame"]["predicate"] == predicate and out["chosen_object"] == other
     assert out["success"], out
     assert all(w["error_m"] <= 0.02 for w in out["waypoints"]) and out["checks"]["verb_check"]
+
+
+def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
+    from lmcr.executor.execute import execute, execute_batch
+
+    parser, scorer, config, data_dir = completer
+    scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
+    (tmp_path / "scenes").mkdir()
+    (tmp_path / "scenes" / "s.json").write_text(json.dumps(scene))
+    lines = [json.dumps({"id": "inline", "instruction": "pour me some water", "scene": scene}),
+             '{"id": "broken", "instruction": ',
+             json.dumps({"id": "nan", "instruction": "pour me some water",
+                         "scene": {"objects": [{"label": "cup", "xy": [float("nan"), 0]}]}}),
+             json.dumps({"id": "verb", "instruction": "juggle the cup", "scene_file": "scenes/s.json"}),
+             json.dumps({"id": 7, "instruction": "pour me some water", "scene_file": "scenes/s.json"})]
+    path = tmp_path / "in.jsonl"
+    path.write_text("\n".join(lines) + "\n")
+    run = lambda text, layout: execute(text, layout, parser, scorer, config, data_dir)  # noqa: E731
+    out = list(execute_batch(path, run))
+    assert [r["id"] for r in out] == ["inline", None, "nan", "verb", 7]
+    assert out[0]["success"] and out[4]["success"] and out[4]["chosen_object"] == "cup"
+    assert f"{path}:2: not valid JSON" in out[1]["error"] and "xy must be two finite numbers" in out[2]["error"]
+    assert "no known predicate" in out[3]["error"] and out[3]["line"] == 4
+    with pytest.raises(InputError, match="cannot read"):
+        list(execute_batch(tmp_path / "missing.jsonl", run))

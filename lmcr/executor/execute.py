@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import pybullet as p
 
 from lmcr.complete import CompletionConfig, complete
 from lmcr.executor.detect import capture, detect
 from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
-from lmcr.executor.scene import Scene, build_world
+from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
+from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 
 
 class ExecutionError(ValueError):
@@ -55,6 +56,33 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
             "detections": [{"label": d.label, "position": [round(v, 3) for v in d.position]} for d in seen],
             "seconds": {"perceive_and_complete": round(planned - started, 3),
                         "plan_and_execute": round(time.perf_counter() - planned, 3)}}
+
+
+BATCH_FIELDS = {"id": (str, int), "instruction": str}
+
+
+def execute_batch(path: Path, run: Callable[[str, Scene], dict]) -> Iterator[dict]:
+    """The batch form of the CLI contract: one output line per input line, in order. Each line gives an
+    instruction and a `scene` object or a `scene_file` (relative to the input's folder); `run` executes
+    one. A bad line (not JSON, a bad scene, an instruction that cannot be completed or acted on) gets
+    `{"id", "error"}` and the rest go on; only an unreadable input file raises."""
+    for line_no, record, error in read_jsonl_lines(path, BATCH_FIELDS):
+        ident = record.get("id") if isinstance(record, dict) else None
+        try:
+            if error is not None:
+                raise error
+            scene = _batch_scene(record, Path(path).parent, f"{path}:{line_no}")
+            yield {"id": ident, **run(check_text(record["instruction"], f"{path}:{line_no}"), scene)}
+        except (ValueError, KeyError, RuntimeError) as exc:  # every LMCR error is a ValueError/RuntimeError
+            yield {"id": ident, "line": line_no, "error": " ".join(str(exc).split())}
+
+
+def _batch_scene(record: dict, base: Path, where: str) -> Scene:
+    if "scene" in record:
+        return scene_from_json(record["scene"], f"{where}: scene")
+    if isinstance(record.get("scene_file"), str):
+        return load_scene(base / record["scene_file"])
+    raise InputError(f"{where}: needs a 'scene' object or a 'scene_file' path")
 
 
 def save_render(frames: list, path: Path) -> Path:

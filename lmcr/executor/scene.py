@@ -112,7 +112,7 @@ def _overlap(a: str, axy, b: str, bxy) -> bool:
 
 def load_scene(path: Path) -> Scene:
     """Read and validate a scene file; objects without `xy` are placed at random (seeded)."""
-    text = decode_utf8(read_bytes(path), path)
+    text = decode_utf8(read_bytes(path), Path(path))
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
