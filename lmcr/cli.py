@@ -6,12 +6,12 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Optional
+from typing import Literal, Optional
 
-import click
 import duckdb
 import typer
 import typer.core
+import typer.exceptions
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -23,6 +23,7 @@ from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
 from lmcr.store import check_contracts, connect
 
 console = Console(stderr=True)
+CorpusSetting = Literal["youcook2", "recipes", "all"]
 
 
 def fail(message: str) -> None:
@@ -54,7 +55,7 @@ class OneLineErrors(typer.core.TyperGroup):
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
-        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, typer.Exit):
+        except (typer.exceptions.TyperException, typer.Exit, typer.Abort):  # usage errors, exits: typer's own
             raise
         except Exception as exc:
             if os.environ.get("LMCR_DEBUG"):
@@ -64,6 +65,22 @@ class OneLineErrors(typer.core.TyperGroup):
 
 app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
                   no_args_is_help=True, pretty_exceptions_enable=False, cls=OneLineErrors)
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        import lmcr
+
+        print(f"lmcr {lmcr.__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", callback=_show_version, is_eager=True,
+                                       help="Print the version and exit.")) -> None:
+    """LMCR: complete incomplete robot instructions with commonsense learned from recipes."""
+
+
 
 
 def print_rows(title: str, rows: list[dict]) -> None:
@@ -80,7 +97,8 @@ def print_rows(title: str, rows: list[dict]) -> None:
 def ingest(
     youcook2: list[Path] = typer.Option([], "--youcook2", help="YouCook2 annotations JSON."),
     recipes: list[Path] = typer.Option([], "--recipes", help="Recipe JSONL(.gz)/folder, Meal-Master/NYC text, Feeding America XML (file or folder)."),
-    fmt: Optional[str] = typer.Option(None, "--format", help="Force the adapter: youcook2|recipe_json|mealmaster|feeding_america."),
+    fmt: Optional[Literal["youcook2", "recipe_json", "mealmaster", "feeding_america"]] = typer.Option(
+        None, "--format", help="Force the adapter."),
     encoding: Optional[str] = typer.Option(None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
     workers: int = typer.Option(2, help="Parallel parser processes."),
     db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
@@ -155,8 +173,8 @@ def frames(
 
 @app.command()
 def train(
-    linearization: str = typer.Option("sentence", help="sentence | frame"),
-    corpus: str = typer.Option("all", help="youcook2 | recipes | all"),
+    linearization: Literal["sentence", "frame"] = typer.Option("sentence", help="Linearisation of the training text."),
+    corpus: CorpusSetting = typer.Option("all", help="Corpus setting."),
     embedding: int = typer.Option(256, help="Embedding = hidden size."),
     layers: int = typer.Option(2),
     dropout: float = typer.Option(0.3),
@@ -166,7 +184,7 @@ def train(
     lr: Optional[float] = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 3e-3)."),
     min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
     device: Optional[str] = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
-    precision: str = typer.Option("auto", help="auto | bf16 | fp32 (auto: bf16 autocast where the hardware has it)."),
+    precision: Literal["auto", "bf16", "fp32"] = typer.Option("auto", help="auto: bf16 autocast where the hardware has it."),
     db: Optional[Path] = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Train a language model on a corpus setting and publish its checkpoint."""
@@ -200,7 +218,7 @@ def score(
     methods: str = typer.Option("sentence_lm,frame_lm",
                                 help="Comma-separated: sentence_lm, frame_lm, frame_counts, cooccur, word2vec, "
                                      "conceptnet, random; a+b sums the scores of a and b."),
-    corpus: str = typer.Option("all", help="Training setting of the LM checkpoints: youcook2 | recipes | all."),
+    corpus: CorpusSetting = typer.Option("all", help="Training setting of the LM checkpoints."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
     conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
@@ -263,7 +281,7 @@ def complete(
     input: Path = typer.Option(..., "--input", help="JSONL: {id, instruction, objects}."),
     output: Path = typer.Option(..., "--output", help="JSONL: {id, frame, missing, candidates, question}."),
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer (methods as in `lmcr score`; a+b sums two)."),
-    corpus: str = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
+    corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder."),
     model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
@@ -328,7 +346,7 @@ def annotate_ingest(
 @annotate_app.command("tasks")
 def annotate_tasks(
     out: Path = typer.Option(..., help="Folder for batch.csv, hit_template.html, preview.html, tasks.json."),
-    mode: str = typer.Option("protocol", help="protocol | corpus | disagreement"),
+    mode: Literal["protocol", "corpus", "disagreement"] = typer.Option("protocol", help="Which frames to ask about."),
     per_hit: int = typer.Option(10, help="Sentences per HIT."),
     gold_per_hit: int = typer.Option(1, help="Gold check items per HIT (from near-unanimous past ratings)."),
     n_frames: Optional[int] = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
@@ -390,7 +408,7 @@ def execute(
     output: Optional[Path] = typer.Option(None, "--output", help="Batch JSONL: {id, ...result} or {id, error}."),
     checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
-    corpus: str = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
+    corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
     render: Optional[Path] = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
     model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),

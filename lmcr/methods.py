@@ -10,19 +10,14 @@ from pathlib import Path
 from typing import Callable, Iterator
 
 
-from lmcr.baselines.conceptnet import ConceptNetScorer
-from lmcr.baselines.cooccur import CooccurrenceScorer
-from lmcr.baselines.terms import default_lemmatizer
-from lmcr.baselines.vectors import VectorScorer, load_vectors, train_word2vec
 from lmcr.config import paths_from_env
-from lmcr.counts import FrameCountScorer
 from lmcr.files import atomic_path, file_sha256
 from lmcr.jsonl import InputError, read_lines
-from lmcr.lm import checkpoint as ckpt
-from lmcr.lm.corpus import corpus_hash
-from lmcr.lm.score import LMScorer
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
+
+# The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
+# command line and light commands start fast (`bench/bench_cli.py`).
 
 Frame = tuple[str, dict[str, str]]
 LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
@@ -65,7 +60,9 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
         return setting
     if (checkpoints / "LATEST").exists() or (checkpoints / "manifest.json").exists():
         return checkpoints
-    raise ckpt.CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
+    from lmcr.lm.checkpoint import CheckpointError
+
+    raise CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
                                f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
 
 
@@ -86,6 +83,14 @@ def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vect
 def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], list[float]]:
     """A function scoring a list of complete frames with `method`; 'a+b' sums the scores of methods a
     and b (for log-probability methods, a product of experts)."""
+    from lmcr.baselines.conceptnet import ConceptNetScorer
+    from lmcr.baselines.cooccur import CooccurrenceScorer
+    from lmcr.baselines.terms import default_lemmatizer
+    from lmcr.baselines.vectors import VectorScorer, load_vectors
+    from lmcr.counts import FrameCountScorer
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.lm.score import LMScorer
+
     if "+" in method:
         parts = [make_scorer(m, res) for m in method.split("+")]
         return lambda frames: [sum(scores) for scores in zip(*(part(frames) for part in parts))]
@@ -117,6 +122,9 @@ def scorer_fingerprint(method: str, res: MethodResources) -> str | None:
     """What a completion calibration of `method` is valid for: the sha256 of each LM checkpoint
     manifest it uses and the store's frame corpus hash for frame_counts; None for methods whose
     completion is not calibrated (the baselines)."""
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.lm.corpus import corpus_hash
+
     parts = []
     for part in method.split("+"):
         if part in LM_METHODS:
@@ -159,6 +167,9 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
 
 def corpus_word2vec(res: MethodResources) -> Path:
     """word2vec vectors trained on the setting's sentences, cached by the corpus content hash."""
+    from lmcr.baselines.vectors import train_word2vec
+    from lmcr.lm.corpus import corpus_hash
+
     con = read_connection(res.db)
     try:
         digest = corpus_hash(con, "sentence")[:12]

@@ -85,7 +85,7 @@ def _jsonl_case(fields: dict[str, object], text_field: str, list_field: str | No
     required = list(fields)
     mutations = st.one_of(
         st.tuples(st.just("undecodable"), st.binary(min_size=1, max_size=6).map(lambda b: b"\xff" + b)),
-        st.tuples(st.just("not json"), st.text(max_size=12).map(lambda t: '{"id": "x", ' + t)),
+        st.tuples(st.just("not json"), st.text(max_size=12).map(lambda t: '{"id": "x", ' + t.replace("\n", " "))),
         st.tuples(st.just("not an object"), ANY_JSON.filter(lambda v: not isinstance(v, dict)).map(json.dumps)),
         st.tuples(st.just("missing field"), st.sampled_from(required)),
         st.tuples(st.just("wrong type"), st.tuples(st.sampled_from(required), ANY_JSON)),

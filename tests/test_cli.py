@@ -31,3 +31,20 @@ def test_ingest_errors_are_one_line(sample_dir, tmp_path, monkeypatch):
     assert broken.exit_code == 1 and "bad.xml:3: malformed XML" in broken.output
     nothing = runner.invoke(app, ["ingest"])
     assert nothing.exit_code == 1 and "nothing to ingest" in nothing.output
+
+
+def test_version_and_fixed_choices():
+    import lmcr
+
+    assert runner.invoke(app, ["--version"]).stdout.strip() == f"lmcr {lmcr.__version__}"
+    typo = runner.invoke(app, ["train", "--corpus", "recipe"])
+    assert typo.exit_code == 2 and "'youcook2', 'recipes', 'all'" in typo.output
+
+
+def test_light_commands_do_not_import_the_heavy_libraries():
+    import subprocess
+    import sys
+
+    code = "import sys, lmcr.cli; print(','.join(m for m in ('torch', 'gensim', 'scipy', 'spacy') if m in sys.modules))"
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert loaded == ""
