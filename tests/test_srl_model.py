@@ -39,6 +39,8 @@ def test_misread_imperatives_are_repaired(parser):
     assert {"predicate": "season", "roles": {"Theme": None, "Instrument": "salt"}} in frames
     spans = parser.parse("Season the chicken with salt.")
     assert spans[0].start == 0 and spans[0].spans["Theme"] == (11, 18)  # offsets in the original text
+    bare = parse_instruction(parser, "fry the chicken")  # tagged fry/IN at the root: no verb at all
+    assert bare.to_json() == {"predicate": "fry", "roles": {"Theme": "chicken", "Instrument": None}}
 
 
 @pytest.mark.shared

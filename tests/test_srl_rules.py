@@ -137,6 +137,11 @@ def test_imperative_repair_triggers():
     assert not needs_reparse(declarative[:])
     verb_first = make_doc("pour/VB/ROOT/0 water/NN/dobj/0")
     assert not needs_reparse(verb_first[:])
+    # How the tagger reads a bare "fry the chicken": a preposition heading a sentence with no verb.
+    preposition_root = make_doc("fry/IN/ROOT/0 the/DT/det/2 chicken/NN/dobj/0")
+    assert needs_reparse(preposition_root[:])
+    leading_prep = make_doc("In/IN/prep/3 a/DT/det/2 bowl/NN/pobj/0 mix/VB/ROOT/3 flour/NN/dobj/3")
+    assert not needs_reparse(leading_prep[:])
     clause = make_doc("brush/VB/ROOT/0 bread/NN/dobj/0 and/CC/cc/1 season/NN/conj/1 with/IN/prep/3 salt/NN/pobj/4")
     assert find_split(clause[:], LEX).text == "season"
     assert find_split(make_doc("add/VB/ROOT/0 salt/NN/dobj/0 and/CC/cc/1 pepper/NN/conj/1")[:], LEX) is None

@@ -57,10 +57,15 @@ def load_nlp(model: str | None = None) -> Language:
 
 
 def needs_reparse(sent: Span) -> bool:
-    """True when the sentence's first word is tagged as a noun/adjective, as misread imperatives are,
-    and is not the subject of a verb ("Chicken should be fried" is a real declarative)."""
+    """True when the sentence's first word looks like a misread imperative verb and is not the subject
+    of a verb ("Chicken should be fried" is a real declarative): tagged as a noun/adjective, or tagged
+    as anything but a verb while heading the whole sentence (the tagger reads a bare "fry the chicken"
+    as a preposition at the root, a sentence without any verb)."""
     first = next((t for t in sent if t.is_alpha), None)
-    if first is None or first.tag_ not in NOUNISH_TAGS or first.i != sent.start + (sent[0].is_punct):
+    if first is None or first.i != sent.start + (sent[0].is_punct):
+        return False
+    misread_root = first.dep_ == "ROOT" and not first.tag_.startswith(("VB", "MD"))
+    if first.tag_ not in NOUNISH_TAGS and not misread_root:
         return False
     phrase_head = first.head if first.dep_ in ("compound", "amod") else first
     # A real declarative's subject hangs on a verb; "Heat oil in a pan, then season..." can come out
