@@ -87,14 +87,19 @@ def read_jsonl_lines(path: Path, required: dict[str, type | tuple[type, ...]]
             yield line_no, _partial(line), exc
 
 
-def _record(line: bytes, required: dict[str, type | tuple[type, ...]], where: str) -> dict:
-    text = decode_utf8(line, where)
+def parse_json(text: str, where: str, multiline: bool = False) -> object:
+    """Decoded JSON; invalid or too deeply nested JSON raises InputError naming `where` (and, for a
+    `multiline` document, the line of the defect)."""
     try:
-        record = json.loads(text)
+        return json.loads(text)
     except json.JSONDecodeError as exc:
-        raise InputError(f"{where}: not valid JSON: {exc.msg}") from exc
+        raise InputError(f"{where}{f':{exc.lineno}' if multiline else ''}: not valid JSON: {exc.msg}") from exc
     except RecursionError as exc:
         raise InputError(f"{where}: JSON nested too deeply") from exc
+
+
+def _record(line: bytes, required: dict[str, type | tuple[type, ...]], where: str) -> dict:
+    record = parse_json(decode_utf8(line, where), where)
     if not isinstance(record, dict):
         raise InputError(f"{where}: expected a JSON object")
     for key, kind in required.items():

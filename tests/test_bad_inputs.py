@@ -131,36 +131,33 @@ SRL_FIELDS = {"id": "a", "text": "pour the water into the cup"}
 COMPLETE_FIELDS = {"id": "a", "instruction": "pour me some water", "objects": ["cup", "plate"]}
 
 
-@FUZZ
-@given(case=_jsonl_case(SRL_FIELDS, "text", None))
-def test_srl_batch_rejects_malformed_jsonl(case):
+def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case) -> bool:
+    """Run `lmcr COMMAND --input --output` on one generated case; False when the mutation was valid."""
     valid, at, (kind, arg) = case
-    bad = _mutated_line(SRL_FIELDS, "text", None, kind, arg)
+    bad = _mutated_line(fields, text_field, list_field, kind, arg)
     if bad is None:
-        return
+        return False
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         _write_jsonl(tmp / "in.jsonl", valid, at, bad)
-        result = invoke(["srl", "--input", str(tmp / "in.jsonl"), "--output", str(tmp / "out.jsonl")], tmp)
+        result = invoke([command, "--input", str(tmp / "in.jsonl"), "--output", str(tmp / "out.jsonl")], tmp)
         assert_one_line_error(result, tmp / "in.jsonl", at)
         assert not (tmp / "out.jsonl").exists()
-    _count("srl JSONL")
+    return True
+
+
+@FUZZ
+@given(case=_jsonl_case(SRL_FIELDS, "text", None))
+def test_srl_batch_rejects_malformed_jsonl(case):
+    if _check_rejected("srl", SRL_FIELDS, "text", None, case):
+        _count("srl JSONL")
 
 
 @FUZZ
 @given(case=_jsonl_case(COMPLETE_FIELDS, "instruction", "objects"))
 def test_complete_batch_rejects_malformed_jsonl(case):
-    valid, at, (kind, arg) = case
-    bad = _mutated_line(COMPLETE_FIELDS, "instruction", "objects", kind, arg)
-    if bad is None:
-        return
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        _write_jsonl(tmp / "in.jsonl", valid, at, bad)
-        result = invoke(["complete", "--input", str(tmp / "in.jsonl"), "--output", str(tmp / "out.jsonl")], tmp)
-        assert_one_line_error(result, tmp / "in.jsonl", at)
-        assert not (tmp / "out.jsonl").exists()
-    _count("complete JSONL")
+    if _check_rejected("complete", COMPLETE_FIELDS, "instruction", "objects", case):
+        _count("complete JSONL")
 
 
 def test_srl_batch_text_over_the_length_cap_is_one_line(tmp_path):

@@ -67,7 +67,7 @@ def test_scene_validation(tmp_path):
         with pytest.raises(InputError, match=message):
             load_scene(bad)
     bad.write_text('{"objects": [}')
-    with pytest.raises(InputError, match=r"s.json:1: not JSON"):
+    with pytest.raises(InputError, match=r"s.json:1: not valid JSON"):
         load_scene(bad)
     a = make_scene([("cup", None), ("water", None), ("plate", None)], seed=4)
     b = make_scene([("cup", None), ("water", None), ("plate", None)], seed=4)

@@ -9,7 +9,6 @@ sphere or cylinder.
 
 from __future__ import annotations
 
-import json
 import math
 import random
 from dataclasses import dataclass, field
@@ -18,7 +17,7 @@ from pathlib import Path
 import pybullet as p
 
 from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
-from lmcr.jsonl import InputError, decode_utf8, read_bytes
+from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
 from lmcr.srl.lexicon import load_lexicon
 
 TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
@@ -112,13 +111,7 @@ def _overlap(a: str, axy, b: str, bxy) -> bool:
 
 def load_scene(path: Path) -> Scene:
     """Read and validate a scene file; objects without `xy` are placed at random (seeded)."""
-    text = decode_utf8(read_bytes(path), Path(path))
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}:{exc.lineno}: not JSON: {exc.msg}") from exc
-    except RecursionError as exc:
-        raise InputError(f"{path}: JSON nested too deeply") from exc
+    data = parse_json(decode_utf8(read_bytes(path), Path(path)), str(path), multiline=True)
     return scene_from_json(data, str(path))
 
 
