@@ -122,16 +122,12 @@ def migrate(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[str]:
             if applied[mig.version] != mig.sha256:
                 raise MigrationError(f"{mig.path}: edited after it was applied; add a new migration instead")
             continue
-        con.execute("begin transaction")
         try:
-            con.execute(mig.path.read_text(encoding="utf-8"))
-            con.execute(
-                "insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
-                [mig.version, mig.name, mig.sha256],
-            )
-            con.execute("commit")
+            with transaction(con):
+                con.execute(mig.path.read_text(encoding="utf-8"))
+                con.execute("insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
+                            [mig.version, mig.name, mig.sha256])
         except duckdb.Error as exc:
-            con.execute("rollback")
             reason = " ".join(str(exc).split())  # one line: DuckDB adds "Did you mean" hints
             raise MigrationError(f"{mig.path}: {reason}; rolled back, still pending") from exc
         done.append(mig.name)

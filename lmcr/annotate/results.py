@@ -23,6 +23,7 @@ import pyarrow as pa
 
 from lmcr.files import file_sha256
 from lmcr.jsonl import InputError, read_lines
+from lmcr.store import transaction
 
 META = ("HITId", "AssignmentId", "WorkerId", "AssignmentStatus")
 ITEM_FIELDS = ("verb", "role1", "arg1", "role2", "arg2")
@@ -175,8 +176,7 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
                                        "source_file": source})
         workers.setdefault(row["WorkerId"], {"worker_id": row["WorkerId"], "first_file": source})
         ratings += [{"assignment_id": aid, **item} for item in a.items]
-    con.execute("begin transaction")
-    try:
+    with transaction(con):
         _insert(con, "hits", list(hits.values()), "hit_id")
         _insert(con, "workers", list(workers.values()), "worker_id")
         _insert(con, "assignments", new)
@@ -188,10 +188,6 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
                 con.executemany(sql, params)
         con.execute(f"insert into rating_files (sha256, source_file, layout, {', '.join(counts)}) values "
                     f"(?, ?, ?, {', '.join('?' * len(counts))})", [parsed.sha256, source, parsed.layout, *counts.values()])
-        con.execute("commit")
-    except Exception:
-        con.execute("rollback")
-        raise
     return {"source_file": source, "layout": parsed.layout, **counts}
 
 

@@ -12,6 +12,7 @@ import pyarrow.parquet as pq
 from lmcr.files import atomic_path
 from lmcr.ingest.detect import Source
 from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.store import transaction
 
 DOCUMENT_SCHEMA = pa.schema([
     ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("title", pa.string()),
@@ -115,10 +116,5 @@ def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
 
 def load_staged(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
     """Replace a source's rows with its staged Parquet in one transaction (all or nothing)."""
-    con.execute("begin transaction")
-    try:
+    with transaction(con):
         _replace_rows(con, staged)
-    except BaseException:
-        con.execute("rollback")
-        raise
-    con.execute("commit")

@@ -28,6 +28,7 @@ from lmcr.srl.frames import Frame
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import COMPOUNDS_FILE, PRIORS_FILE, FrameParser, load_nlp
 from lmcr.srl.priors import RolePriors
+from lmcr.store import transaction
 
 SRL_CODE = Path(__file__).parent
 FRAME_SCHEMA = pa.schema([
@@ -222,8 +223,7 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
 def load_frames(con: duckdb.DuckDBPyConnection, results: list[ShardResult], build: dict) -> RolePriors:
     """Replace the frame tables with the parsed shards, resolve ambiguous objects, record the build:
     one transaction, so a failure leaves the previous corpus in place."""
-    con.execute("begin transaction")
-    try:
+    with transaction(con):
         con.execute("delete from frame_roles")
         con.execute("delete from frames")
         if results:
@@ -239,10 +239,6 @@ def load_frames(con: duckdb.DuckDBPyConnection, results: list[ShardResult], buil
             [build["fingerprint"], ",".join(build["kinds"]), len(results), build["sentences"], build["words"],
              known[1], known[0], build["reparsed"], build["kept"], build["wall_s"], build["words_per_s"]],
         )
-    except BaseException:
-        con.execute("rollback")
-        raise
-    con.execute("commit")
     return priors
 
 
