@@ -137,6 +137,57 @@ def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store.")) -> No
     console.print(f"{paths.db} is up to date")
 
 
+@app.command("sql")
+def sql_command(
+    statement: str = typer.Argument(..., help="One SQL statement, run read-only against the store."),
+    param: list[str] = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter (repeatable)."),
+    fmt: Literal["table", "csv", "json"] = typer.Option("table", "--format", help="Output format."),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
+) -> None:
+    """Run SQL on the store (read-only) and print the result as a table, CSV or JSON lines."""
+    from lmcr.store import run_query
+
+    _print_result(*run_query(paths_from_env(db=db).db, statement, _params(param)), fmt)
+
+
+@app.command("query")
+def query_command(
+    name: str = typer.Argument(..., help="A named query: sql/queries/NAME.sql."),
+    param: list[str] = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter, e.g. corpus=all."),
+    fmt: Literal["table", "csv", "json"] = typer.Option("table", "--format", help="Output format."),
+    db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
+) -> None:
+    """Run a named query of sql/queries/ (read-only) and print the result."""
+    from lmcr.store import named_query, run_query
+
+    paths = paths_from_env(db=db)
+    _print_result(*run_query(paths.db, named_query(paths.sql_dir, name), _params(param)), fmt)
+
+
+def _params(items: list[str]) -> dict[str, str]:
+    pairs = [item.partition("=") for item in items]
+    bad = [item for item, (_, eq, _) in zip(items, pairs) if not eq]
+    if bad:
+        fail(f"--param takes NAME=VALUE, not {bad[0]!r}")
+    return {key.strip(): value for key, _, value in pairs}
+
+
+def _print_result(columns: list[str], rows: list[tuple], fmt: str) -> None:
+    """A query result on stdout: a rich table, CSV with a header, or one JSON object per row."""
+    import csv
+    import json
+
+    if fmt == "csv":
+        writer = csv.writer(sys.stdout)
+        writer.writerow(columns)
+        writer.writerows(rows)
+    elif fmt == "json":
+        for row in rows:
+            print(json.dumps(dict(zip(columns, row)), default=str, ensure_ascii=False))
+    else:
+        print_rows(f"{len(rows):,} rows", [dict(zip(columns, row)) for row in rows])
+
+
 @app.command()
 def frames(
     kinds: str = typer.Option("instruction,comment", help="Sentence kinds to parse."),

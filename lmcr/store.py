@@ -137,9 +137,38 @@ def migrate(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[str]:
 def named_query(sql_dir: Path, name: str) -> str:
     """The text of `sql/queries/<name>.sql`."""
     path = sql_dir / "queries" / f"{name}.sql"
-    if not path.exists():
-        raise FileNotFoundError(f"no named query {name!r} ({path})")
+    if not path.is_file():
+        available = ", ".join(sorted(p.stem for p in (sql_dir / "queries").glob("*.sql")))
+        raise FileNotFoundError(f"no named query {name!r} (available: {available})")
     return path.read_text(encoding="utf-8")
+
+
+def query_params(sql: str) -> list[str]:
+    """The `$name` parameters a query binds."""
+    return sorted(set(re.findall(r"\$([A-Za-z_][A-Za-z0-9_]*)", sql)))
+
+
+def run_query(db: str | Path, sql: str, params: dict[str, str] | None = None) -> tuple[list[str], list[tuple]]:
+    """(column names, rows) of one statement on a read-only connection: a query never writes.
+    Missing or unknown `$name` parameters and SQL errors raise ValueError with a one-line reason."""
+    if not Path(db).is_file():
+        raise ValueError(f"no store at {db}: run `lmcr ingest` (or `make demo`) first")
+    params = dict(params or {})
+    wanted = query_params(sql)
+    missing, unknown = sorted(set(wanted) - set(params)), sorted(set(params) - set(wanted))
+    if missing or unknown:
+        raise ValueError(f"query parameters: missing {missing or 'none'}, unknown {unknown or 'none'} "
+                         f"(this query takes {wanted or 'none'}; give --param NAME=VALUE)")
+    con = _open(db, read_only=True)
+    try:
+        cursor = con.execute(sql, params or None)
+        if cursor.description is None:
+            return [], []
+        return [d[0] for d in cursor.description], cursor.fetchall()
+    except duckdb.Error as exc:
+        raise ValueError(" ".join(str(exc).split())) from exc
+    finally:
+        con.close()
 
 
 def query_dicts(con: duckdb.DuckDBPyConnection, sql: str, params: list | None = None) -> list[dict]:
