@@ -38,7 +38,8 @@ def decide_task(candidate: str, config: RetrainConfig, inputs: str, db: str | No
     paths = paths_from_env(data_dir=data_dir, db=db)
     with connect(paths.db, paths.sql_dir) as con:
         rated = rated_frames(con, set(load_lexicon().predicates))
-        return decide(con, paths.checkpoints, Path(candidate), rated, config, inputs)
+        return decide(con, paths.checkpoints, Path(candidate), rated, config, inputs, paths.db,
+                      paths.data_dir / "calibration")
 
 
 @flow(name="retrain")

@@ -10,6 +10,7 @@ silent guess. A complete instruction comes back unchanged.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from dataclasses import asdict, dataclass
@@ -167,7 +168,11 @@ def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str
     reads), and the fingerprint it must carry; None for a method that is not calibrated."""
     from lmcr.methods import scorer_fingerprint
 
-    return calibration_dir / f"{method}-{res.corpus}.json", scorer_fingerprint(method, res)
+    # Named by the fingerprint too, so the calibration of a retrain candidate can be written before it
+    # is promoted without disturbing the one the current checkpoint uses.
+    fingerprint = scorer_fingerprint(method, res)
+    tag = hashlib.sha256(fingerprint.encode()).hexdigest()[:12] if fingerprint else "none"
+    return calibration_dir / f"{method}-{res.corpus}-{tag}.json", fingerprint
 
 
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:

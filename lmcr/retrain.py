@@ -10,17 +10,20 @@ becomes LATEST only if it is not worse. Every decision and both scores go to `re
 from __future__ import annotations
 
 import hashlib
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
 import duckdb
 
-from lmcr.evaluate.protocol import score_rated
+from lmcr.complete import calibration_file, load_config
+from lmcr.evaluate.protocol import EvalConfig, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.scenarios import accuracy, build_scenarios
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
-from lmcr.methods import LM_METHODS, MethodResources, make_scorer
+from lmcr.evaluate.run import calibrate_completion
+from lmcr.methods import COMPLETION_METHOD, LM_METHODS, MethodResources, make_scorer
 
 METHOD_OF = {lin: method for method, lin in LM_METHODS.items()}
 
@@ -60,9 +63,42 @@ def checkpoint_accuracy(version: Path, rated: list[RatedFrame], config: RetrainC
     return accuracy(scenarios, scores[method])["all"]
 
 
+def completion_methods(linearization: str) -> list[str]:
+    """The calibrated completion methods built on a linearisation's LM: the LM alone and the default
+    completion method when it includes that LM."""
+    method = METHOD_OF[linearization]
+    return [method] + ([COMPLETION_METHOD] if method in COMPLETION_METHOD.split("+") else [])
+
+
+def recalibrate(candidate: Path, rated: list[RatedFrame], config: RetrainConfig, db: Path,
+                calibration_dir: Path) -> dict:
+    """Calibrate completion with `candidate` as the setting's LM, as `lmcr evaluate` does, and save it
+    under the candidate's fingerprint (the current checkpoint's calibration stays); method -> summary."""
+    corpus = config.setting.split("-", 1)[1]
+    res = MethodResources(checkpoints=candidate, corpus=corpus, db=db)
+    scorers, summary = {}, {}
+    for method in completion_methods(config.linearization):
+        try:
+            scorers[method] = make_scorer(method, res)
+        except ValueError as exc:  # e.g. frame_counts before any frame corpus was built
+            summary[method] = {"not_calibrated": " ".join(str(exc).split())}
+    methods = list(scorers)
+    scores = score_rated(rated, scorers)
+    eval_config = EvalConfig(lam=config.lam, k=config.k, per_verb=config.per_verb, seed=config.seed)
+    calibrate_completion(rated, scores, methods, res, eval_config, calibration_dir, log=lambda message: None)
+    for method in methods:
+        path, fingerprint = calibration_file(method, res, calibration_dir)
+        saved = load_config(path, fingerprint)
+        summary[method] = {"temperature": saved.temperature, "set_threshold": saved.set_threshold,
+                           "fingerprint": fingerprint, "file": path.name}
+    return summary
+
+
 def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, rated: list[RatedFrame],
-           config: RetrainConfig, inputs: str) -> dict:
-    """Promote `candidate` if it scores at least as well as the current LATEST; record the decision."""
+           config: RetrainConfig, inputs: str, db: Path | None = None, calibration_dir: Path | None = None) -> dict:
+    """Promote `candidate` if it scores at least as well as the current LATEST; record the decision.
+    With `db` and `calibration_dir`, a promoted candidate is first calibrated for completion on the
+    same rated frames, so completion never falls back to uncalibrated defaults after a promotion."""
     setting_dir = checkpoints / config.setting
     current = ckpt.resolve(setting_dir) if (setting_dir / "LATEST").exists() else None
     cand_acc = checkpoint_accuracy(candidate, rated, config)
@@ -75,6 +111,8 @@ def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, r
     row = {"setting": config.setting, "inputs_sha256": inputs, "decision": decision, "reason": reason,
            "candidate": str(candidate), "current": str(current) if current else None,
            "candidate_accuracy": cand_acc, "current_accuracy": cur_acc}
+    if decision == "promoted" and db is not None and calibration_dir is not None:
+        row["calibration"] = json.dumps(recalibrate(candidate, rated, config, db, calibration_dir), sort_keys=True)
     record(con, row)  # recorded first: LATEST never moves without its decision on record
     if decision == "promoted":
         ckpt.set_latest(checkpoints, config.setting, candidate.name)
@@ -83,6 +121,6 @@ def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, r
 
 def record(con: duckdb.DuckDBPyConnection, row: dict) -> None:
     cols = ["setting", "inputs_sha256", "decision", "reason", "candidate", "current", "candidate_accuracy",
-            "current_accuracy"]
+            "current_accuracy", "calibration"]
     con.execute(f"insert into retrain_decisions ({', '.join(cols)}) values ({', '.join('?' * len(cols))})",
                 [row.get(c) for c in cols])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 
 import pytest
@@ -28,6 +29,15 @@ def run(tmp_path, ratings):
                         data_dir=str(tmp_path))
 
 
+def assert_completion_is_calibrated(data_dir):
+    """What `lmcr complete` loads after the promotion is a calibration of the promoted checkpoint."""
+    from lmcr.complete import completion_scorer
+    from lmcr.methods import resources_from_env
+
+    _, config = completion_scorer("sentence_lm", resources_from_env(data_dir=data_dir), data_dir / "calibration")
+    assert config.source.startswith("calibrated on"), config.source
+
+
 def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
     import duckdb
 
@@ -36,6 +46,7 @@ def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
     ratings = str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")
     first = run(tmp_path, [ratings])
     assert first["decision"] == "promoted" and first["reason"] == "no current checkpoint"
+    assert_completion_is_calibrated(tmp_path)
     latest = (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text()
     assert run(tmp_path, [ratings])["decision"] == "unchanged"
 
@@ -59,8 +70,12 @@ def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
     promoted = run(tmp_path, [str(more)])
     assert promoted["decision"] == "promoted" and promoted["reason"] == "not worse: 0.900 >= 0.900"
     assert (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text() != latest
+    assert_completion_is_calibrated(tmp_path)  # for the newly promoted checkpoint, not the old one
     con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
     decisions = con.execute("select decision, candidate_accuracy, current_accuracy from retrain_decisions "
                             "order by decided_at").fetchall()
     assert [d[0] for d in decisions] == ["promoted", "unchanged", "kept", "promoted"]
     assert decisions[2][1:] == (0.5, 0.9)
+    calibration = json.loads(con.execute("select calibration from retrain_decisions where decision = 'promoted' "
+                                         "order by decided_at desc limit 1").fetchone()[0])
+    assert calibration["sentence_lm"]["temperature"] > 0
