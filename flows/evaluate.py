@@ -1,22 +1,52 @@
 """Evaluate flow: ratings from the store (or an MTurk CSV) -> scores of every method -> Table I and
-Fig. 4 report, published as Prefect artifacts (the Table I table and a link to the report)."""
+Fig. 4 report, published as Prefect artifacts (the Table I table, the report's markdown and a link to
+its HTML). The evaluation task is cached on what it reads (LM versions, ratings, frame builds and its
+parameters), so an unchanged re-run of the pipeline costs nothing."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
+from prefect.cache_policies import TASK_SOURCE, CacheKeyFnPolicy
 
 from lmcr.config import paths_from_env
+from lmcr.files import file_sha256
+from lmcr.lm import checkpoint as ckpt
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.methods import EVALUATED, MethodResources, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
+from lmcr.store import read_connection
 
 
-@task(name="evaluate", retries=0)
+def evaluation_key(context, parameters: dict) -> str:
+    """Cache key of an evaluation: the LM versions in use, the ratings (the store's rating files or the
+    CSV's content), the frame builds (frame_counts), the parameters, and whether the report is still
+    there (a deleted report is written again)."""
+    res: MethodResources = parameters["res"]
+    versions = [str(ckpt.resolve(p.parent)) for p in sorted(Path(res.checkpoints).glob("*/LATEST"))]
+    ratings = Path(parameters["ratings"])
+    if res.db is not None and ratings.resolve() == Path(res.db).resolve():
+        with read_connection(res.db) as con:
+            rating_files = con.execute("select sha256 from rating_files order by 1").fetchall()
+    else:
+        rating_files = file_sha256(ratings) if ratings.is_file() else str(ratings)
+    frames = []
+    if res.db is not None and Path(res.db).exists():
+        with read_connection(res.db) as con:
+            frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()
+    report_there = (Path(parameters["out"]) / "report.md").exists()
+    blob = json.dumps([versions, rating_files, frames, report_there, parameters], default=str, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+@task(name="evaluate", retries=0, persist_result=True,
+      cache_policy=TASK_SOURCE + CacheKeyFnPolicy(cache_key_fn=evaluation_key))
 def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
                   per_verb: int, seed: int, calibration_dir: str | None) -> dict:
     logger = get_run_logger()

@@ -29,9 +29,11 @@ def server(tmp_path_factory):
     home = tmp_path_factory.mktemp("prefect_home")
     port = free_port()
     env = {**os.environ, "PREFECT_HOME": str(home), "PREFECT_SERVER_ANALYTICS_ENABLED": "false", "COLUMNS": "250",
-           "PREFECT_API_URL": f"http://127.0.0.1:{port}/api"}
+           "PREFECT_API_URL": f"http://127.0.0.1:{port}/api", "PREFECT_SERVER_SERVICES_SCHEDULER_LOOP_SECONDS": "2"}
+    log = open(home / "server.log", "w")
     proc = subprocess.Popen([PREFECT, "server", "start", "--host", "127.0.0.1", "--port", str(port)], env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                            stdout=log, stderr=subprocess.STDOUT)
+    env["LMCR_TEST_SERVER_LOG"] = str(home / "server.log")
     try:
         for _ in range(120):
             try:
@@ -45,6 +47,7 @@ def server(tmp_path_factory):
     finally:
         proc.terminate()
         proc.wait(timeout=30)
+        log.close()
 
 
 def prefect(env, *args, timeout=300) -> str:
@@ -59,6 +62,15 @@ def test_deploy_run_by_name_and_artifacts(server, tmp_path):
     assert "annotate/annotate" in out and "retrain/retrain" in out
     schedules = prefect(server, "deployment", "inspect", "retrain/retrain")
     assert "0 3 * * 1" in schedules  # the weekly retrain schedule is registered
+    # ... and the server's scheduler creates its runs (it failed every loop with SQLAlchemy 2.1)
+    for _ in range(60):
+        if "retrain" in prefect(server, "flow-run", "ls", "--state", "SCHEDULED"):
+            break
+        time.sleep(1)
+    else:
+        pytest.fail("the scheduler created no retrain runs in 60 s")
+    log = Path(server["LMCR_TEST_SERVER_LOG"]).read_text(encoding="utf-8", errors="replace")
+    assert "InvalidRequestError" not in log and "Traceback" not in log
     prefect(server, "deployment", "run", "annotate/annotate", "--param", f"data_dir={tmp_path}")
     prefect(server, "worker", "start", "--pool", "lmcr-process", "--run-once")
     runs = prefect(server, "flow-run", "ls", "--state", "COMPLETED")

@@ -125,3 +125,17 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     second = pipeline_flow(params)
     assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
     assert second["table1"] == first["table1"]
+    # What a Prefect UI user sees of the run: Table I, the report and the executor check as artifacts.
+    assert {"table-i", "evaluation-report", "evaluation-report-html", "executor-check"} <= artifact_keys()
+
+
+def artifact_keys() -> set[str]:
+    import asyncio
+
+    from prefect.client.orchestration import get_client
+
+    async def read() -> set[str]:
+        async with get_client() as client:
+            return {a.key for a in await client.read_artifacts()}
+
+    return asyncio.run(read())
