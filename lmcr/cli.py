@@ -137,12 +137,16 @@ def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store.")) -> No
     console.print(f"{paths.db} is up to date")
 
 
+PARAM_OPTION = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter (repeatable), e.g. corpus=all.")
+FORMAT_OPTION = typer.Option("table", "--format", help="Output format.")
+DB_OPTION = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb).")
+QueryFormat = Literal["table", "csv", "json"]
+
+
 @app.command("sql")
 def sql_command(
     statement: str = typer.Argument(..., help="One SQL statement, run read-only against the store."),
-    param: list[str] = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter (repeatable)."),
-    fmt: Literal["table", "csv", "json"] = typer.Option("table", "--format", help="Output format."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
+    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Optional[Path] = DB_OPTION,
 ) -> None:
     """Run SQL on the store (read-only) and print the result as a table, CSV or JSON lines."""
     from lmcr.store import run_query
@@ -153,9 +157,7 @@ def sql_command(
 @app.command("query")
 def query_command(
     name: str = typer.Argument(..., help="A named query: sql/queries/NAME.sql."),
-    param: list[str] = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter, e.g. corpus=all."),
-    fmt: Literal["table", "csv", "json"] = typer.Option("table", "--format", help="Output format."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
+    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Optional[Path] = DB_OPTION,
 ) -> None:
     """Run a named query of sql/queries/ (read-only) and print the result."""
     from lmcr.store import named_query, run_query
