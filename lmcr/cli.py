@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from lmcr.config import paths_from_env
+from lmcr.errors import one_line
 from lmcr.ingest import expand_inputs
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
 from lmcr.store import check_contracts, connect
@@ -28,13 +29,8 @@ CorpusSetting = Literal["youcook2", "recipes", "all"]
 
 def fail(message: str) -> None:
     """Exit non-zero with a one-line reason (the CLI contract)."""
-    console.print(f"[red]error:[/red] {escape(_one_line(message))}", highlight=False, soft_wrap=True)
+    console.print(f"[red]error:[/red] {escape(one_line(message))}", highlight=False, soft_wrap=True)
     raise typer.Exit(code=1)
-
-
-def _one_line(exc: Exception | str) -> str:
-    """An exception as the CLI contract's one-line reason (DuckDB adds hints on further lines)."""
-    return " ".join(str(exc).split())
 
 
 def _reason(exc: Exception) -> str:
@@ -42,10 +38,10 @@ def _reason(exc: Exception) -> str:
     ValueError or RuntimeError subclasses) already name file, line and reason; an OSError names its
     path; anything else is a defect of LMCR, said so in one line (LMCR_DEBUG=1 re-raises it)."""
     if isinstance(exc, OSError) and exc.filename:
-        return f"{exc.filename}: {exc.strerror or _one_line(exc)}"
+        return f"{exc.filename}: {exc.strerror or one_line(exc)}"
     if isinstance(exc, (ValueError, RuntimeError, OSError, EOFError, duckdb.Error)):
-        return _one_line(exc)
-    return f"internal error ({type(exc).__name__}: {_one_line(exc)[:200]}); please report it"
+        return one_line(exc)
+    return f"internal error ({type(exc).__name__}: {one_line(exc, 200)}); please report it"
 
 
 class OneLineErrors(typer.core.TyperGroup):
@@ -359,8 +355,8 @@ def complete(
         try:
             out.append({"id": rec["id"], **complete_one(parser, scorer, rec["instruction"], rec["objects"], config)})
         except (NoPredicateError, CompletionError, InputError) as exc:
-            out.append({"id": rec["id"], "error": _one_line(exc)})
-            console.print(escape(f"{input}:{line}: {_one_line(exc)}"), highlight=False, soft_wrap=True)
+            out.append({"id": rec["id"], "error": one_line(exc)})
+            console.print(escape(f"{input}:{line}: {one_line(exc)}"), highlight=False, soft_wrap=True)
     write_jsonl_atomic(output, out)
     asked = sum(1 for r in out if r.get("question"))
     errors = sum(1 for r in out if "error" in r)

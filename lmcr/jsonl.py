@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterable, Iterator, TextIO
+from typing import Iterable, Iterator
 
 from lmcr.files import atomic_path
 
@@ -15,14 +15,6 @@ MAX_TEXT_CHARS = 1_000  # an instruction or sentence longer than this is refused
 
 class InputError(ValueError):
     """Bad input: names the file and line."""
-
-
-def open_input(path: Path, newline: str | None = None, encoding: str = "utf-8") -> TextIO:
-    """Open an input text file; an unreadable one raises InputError naming it and why."""
-    try:
-        return open(path, newline=newline, encoding=encoding)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from exc
 
 
 def read_bytes(path: Path) -> bytes:
@@ -48,6 +40,16 @@ def decode_utf8(raw: bytes, where: Path | str) -> str:
 def read_lines(path: Path) -> list[str]:
     """The decoded lines of a UTF-8 text file, line endings kept (what the csv module wants)."""
     return decode_utf8(read_bytes(path), Path(path)).splitlines(keepends=True)
+
+
+def has_surrogates(value: object) -> bool:
+    """True when a decoded JSON value holds an unpaired surrogate ("\\ud800"): such text cannot be
+    encoded, stored or parsed."""
+    try:
+        json.dumps(value, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
 
 
 def check_text(value: str, where: str, max_chars: int | None = MAX_TEXT_CHARS) -> str:
@@ -106,7 +108,8 @@ def _record(line: bytes, required: dict[str, type | tuple[type, ...]], where: st
         value = record.get(key)
         if not isinstance(value, kind) or isinstance(value, bool):
             raise InputError(f"{where}: field {key!r} missing or not {_name(kind)}")
-    check_text(json.dumps(record, ensure_ascii=False), where, max_chars=None)
+    if has_surrogates(record):
+        raise InputError(f"{where}: text has an unpaired surrogate")
     return record
 
 

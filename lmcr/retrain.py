@@ -16,13 +16,13 @@ from pathlib import Path
 
 import duckdb
 
-from lmcr.complete import calibration_file, load_config
+from lmcr.errors import one_line
 from lmcr.evaluate.protocol import EvalConfig, score_rated
 from lmcr.evaluate.ratings import RatedFrame
+from lmcr.evaluate.run import calibrate_completion
 from lmcr.evaluate.scenarios import accuracy, build_scenarios
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
-from lmcr.evaluate.run import calibrate_completion
 from lmcr.methods import COMPLETION_METHOD, LM_METHODS, MethodResources, make_scorer
 
 METHOD_OF = {lin: method for method, lin in LM_METHODS.items()}
@@ -81,15 +81,13 @@ def recalibrate(candidate: Path, rated: list[RatedFrame], config: RetrainConfig,
         try:
             scorers[method] = make_scorer(method, res)
         except ValueError as exc:  # e.g. frame_counts before any frame corpus was built
-            summary[method] = {"not_calibrated": " ".join(str(exc).split())}
-    methods = list(scorers)
+            summary[method] = {"not_calibrated": one_line(exc)}
     scores = score_rated(rated, scorers)
     eval_config = EvalConfig(lam=config.lam, k=config.k, per_verb=config.per_verb, seed=config.seed)
-    calibrate_completion(rated, scores, methods, res, eval_config, calibration_dir, log=lambda message: None)
-    for method in methods:
-        path, fingerprint = calibration_file(method, res, calibration_dir)
-        saved = load_config(path, fingerprint)
-        summary[method] = {"temperature": saved.temperature, "set_threshold": saved.set_threshold,
+    saved = calibrate_completion(rated, scores, list(scorers), res, eval_config, calibration_dir,
+                                 log=lambda message: None)
+    for method, (path, fingerprint, cal) in saved.items():
+        summary[method] = {"temperature": cal.temperature, "set_threshold": cal.set_threshold,
                            "fingerprint": fingerprint, "file": path.name}
     return summary
 

@@ -11,6 +11,8 @@ from typing import Iterator
 
 import duckdb
 
+from lmcr.errors import one_line
+
 MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
 
 
@@ -30,12 +32,10 @@ def _open(db: str | Path, read_only: bool) -> duckdb.DuckDBPyConnection:
     """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
     try:
         return duckdb.connect(str(db), read_only=read_only)
-    except duckdb.IOException as exc:
-        if "lock" in str(exc).lower():
+    except duckdb.Error as exc:  # a held lock; not a DuckDB file, a newer storage version, ...
+        if isinstance(exc, duckdb.IOException) and "lock" in str(exc).lower():
             raise StoreBusyError(f"store busy: another lmcr process is writing {db}; try again when it finishes") from exc
-        raise MigrationError(f"{db}: cannot open the store: {' '.join(str(exc).split())[:200]}") from exc
-    except duckdb.Error as exc:  # not a DuckDB file, a newer storage version, ...
-        raise MigrationError(f"{db}: cannot open the store: {' '.join(str(exc).split())[:200]}") from exc
+        raise MigrationError(f"{db}: cannot open the store: {one_line(exc, 200)}") from exc
 
 
 @contextmanager
@@ -128,8 +128,7 @@ def migrate(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[str]:
                 con.execute("insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
                             [mig.version, mig.name, mig.sha256])
         except duckdb.Error as exc:
-            reason = " ".join(str(exc).split())  # one line: DuckDB adds "Did you mean" hints
-            raise MigrationError(f"{mig.path}: {reason}; rolled back, still pending") from exc
+            raise MigrationError(f"{mig.path}: {one_line(exc)}; rolled back, still pending") from exc
         done.append(mig.name)
     return done
 
@@ -166,7 +165,7 @@ def run_query(db: str | Path, sql: str, params: dict[str, str] | None = None) ->
             return [], []
         return [d[0] for d in cursor.description], cursor.fetchall()
     except duckdb.Error as exc:
-        raise ValueError(" ".join(str(exc).split())) from exc
+        raise ValueError(one_line(exc)) from exc
     finally:
         con.close()
 

@@ -21,6 +21,7 @@ from gensim.models import KeyedVectors, Word2Vec
 
 from lmcr.baselines.cooccur import Frame, pair_sum
 from lmcr.files import atomic_path
+from lmcr.errors import one_line
 from lmcr.lm.linearize import tokens
 
 UNRELATED = 1.0
@@ -52,7 +53,7 @@ def load_vectors(path: Path) -> KeyedVectors:
         has_header = len(first) == 2 and all(x.isdigit() for x in first)
         return KeyedVectors.load_word2vec_format(str(path), binary=False, no_header=not has_header)
     except (ValueError, UnicodeDecodeError, EOFError, OSError, IndexError) as exc:
-        raise VectorFileError(f"{path}: not a readable vector file: {' '.join(str(exc).split())[:200]}") from exc
+        raise VectorFileError(f"{path}: not a readable vector file: {one_line(exc, 200)}") from exc
 
 
 def _load_npy(path: Path) -> KeyedVectors:

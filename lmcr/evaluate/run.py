@@ -8,7 +8,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
-from lmcr.complete import calibrate, calibration_file, save_config
+from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
 from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
@@ -50,21 +50,27 @@ def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], N
 
 
 def calibrate_completion(rated: list[RatedFrame], scores: dict, methods: list[str], res: MethodResources,
-                         config: EvalConfig, out_dir: Path, log: Callable[[str], None]) -> list[str]:
+                         config: EvalConfig, out_dir: Path, log: Callable[[str], None]
+                         ) -> dict[str, tuple[Path, str, CompletionConfig]]:
     """Completion temperature and conformal threshold of each calibrated method (LMs, frame_counts and
-    their sums), from the headline scenarios."""
+    their sums), from the headline scenarios; saved, and returned as method -> (file, fingerprint,
+    calibration)."""
     scenarios, _ = build_scenarios(rated, config.lam, config.k, config.per_verb, config.seed)
-    notes = []
+    saved = {}
     for method in (m for m in methods if m in scores):
         path, fingerprint = calibration_file(method, res, out_dir)
         if fingerprint is None:
             continue
         cal = calibrate([[scores[method][f.key] for f in sc.candidates] for sc in scenarios])
         save_config(cal, path, fingerprint)
-        notes.append(f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
-                     f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
-        log(notes[-1])
-    return notes
+        saved[method] = (path, fingerprint, cal)
+        log(calibration_note(method, cal))
+    return saved
+
+
+def calibration_note(method: str, cal: CompletionConfig) -> str:
+    return (f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
+            f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
 
 
 def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[str], settings: list[str],
@@ -79,7 +85,8 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
         log(f"scored {len(rated):,} rated frames with {name} in {time.perf_counter() - t:.1f}s")
     results = evaluate(rated, scores, config)
     if calibration_dir is not None:
-        notes += calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
+        saved = calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
+        notes += [calibration_note(method, cal) for method, (_, _, cal) in saved.items()]
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     write_report(results, [m for m in methods if m in scores], [s for s in settings if s in scores], out_dir, notes)
     return results

@@ -13,6 +13,7 @@ from lmcr.complete import CompletionConfig, complete
 from lmcr.executor.detect import capture, detect
 from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
 from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
+from lmcr.errors import one_line
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 
 
@@ -74,7 +75,7 @@ def execute_batch(path: Path, run: Callable[[str, Scene], dict]) -> Iterator[dic
             scene = _batch_scene(record, Path(path).parent, f"{path}:{line_no}")
             yield {"id": ident, **run(check_text(record["instruction"], f"{path}:{line_no}"), scene)}
         except (ValueError, KeyError, RuntimeError) as exc:  # every LMCR error is a ValueError/RuntimeError
-            yield {"id": ident, "line": line_no, "error": " ".join(str(exc).split())}
+            yield {"id": ident, "line": line_no, "error": one_line(exc)}
 
 
 def _batch_scene(record: dict, base: Path, where: str) -> Scene:

@@ -11,7 +11,9 @@ import zlib
 from pathlib import Path
 from typing import Iterator
 
-from lmcr.ingest.records import IngestError, ParsedFile, has_surrogates
+from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.jsonl import InputError, decode_utf8, has_surrogates
+from lmcr.errors import one_line
 
 
 def _recipe_problem(recipe: object) -> str | None:
@@ -37,29 +39,18 @@ def _lines(path: Path) -> Iterator[tuple[int, bytes]]:
         with opener(path, "rb") as handle:
             yield from enumerate(handle, start=1)
     except (OSError, EOFError, zlib.error) as exc:
-        raise IngestError(str(path), None, f"cannot read: {' '.join(str(exc).split())}") from exc
+        raise IngestError(str(path), None, f"cannot read: {one_line(exc)}") from exc
 
 
-def _records(path: Path) -> Iterator[tuple[int, str, str]]:
-    """(position, doc key, raw JSON text) for each record of a JSONL file or a folder of JSON files;
-    undecodable text comes as UNDECODABLE + the reason, to be quarantined."""
+def _records(path: Path) -> Iterator[tuple[int, str, bytes]]:
+    """(position, doc key, raw bytes) for each record of a JSONL file or a folder of JSON files."""
     if path.is_dir():
         for position, file in enumerate(sorted(path.rglob("*.json")), start=1):
-            yield position, file.relative_to(path).with_suffix("").as_posix(), _decode(file.read_bytes())
+            yield position, file.relative_to(path).with_suffix("").as_posix(), file.read_bytes()
         return
     for line_no, line in _lines(path):
         if line.strip():
-            yield line_no, str(line_no), _decode(line)
-
-
-UNDECODABLE = "\x00undecodable: "
-
-
-def _decode(raw: bytes) -> str:
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        return f"{UNDECODABLE}not UTF-8 (byte 0x{raw[exc.start]:02x} at column {exc.start + 1})"
+            yield line_no, str(line_no), line
 
 
 def _stem(path: Path) -> str:
@@ -73,9 +64,11 @@ def parse_recipe_json(path: Path, corpus: str = "recipes") -> ParsedFile:
     """Read recipes; a line that is not JSON or not a recipe is quarantined with its line number."""
     parsed = ParsedFile(str(path), "recipe_json", corpus)
     stem = _stem(path)
-    for position, key, raw in _records(path):
-        if raw.startswith(UNDECODABLE):
-            parsed.reject(position, raw.removeprefix(UNDECODABLE), "")
+    for position, key, data in _records(path):
+        try:
+            raw = decode_utf8(data, f"record {position}")
+        except InputError as exc:
+            parsed.reject(position, str(exc), "")
             continue
         try:
             recipe = json.loads(raw)

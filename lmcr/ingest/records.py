@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from typing import Iterable
 
@@ -12,16 +11,6 @@ KINDS = ("instruction", "ingredient", "title", "comment")
 # Instructions and comments are running prose and are split into sentences; titles and ingredient
 # lines are already one unit each.
 PROSE_KINDS = frozenset({"instruction", "comment"})
-
-
-def has_surrogates(value: object) -> bool:
-    """True when a decoded JSON value holds an unpaired surrogate ("\\ud800"): such text cannot be
-    stored or parsed, so its record is quarantined."""
-    try:
-        json.dumps(value, ensure_ascii=False).encode("utf-8")
-    except UnicodeEncodeError:
-        return True
-    return False
 
 
 class IngestError(RuntimeError):

@@ -72,22 +72,18 @@ def stage(source: Source, parsed: ParsedFile, sha256: str, staging_dir: Path) ->
     )
 
 
-def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) -> str | None:
-    """Where this exact content (same bytes, adapter and encoding) is already loaded from: this source
-    itself when re-ingesting is a no-op, or another path holding a copy of it (loading it again would
-    count every sentence twice); None when it must be loaded. A path already loaded into another
-    corpus is an IngestError: re-ingesting it must not silently move its rows."""
+def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) -> bool:
+    """True when this exact content (same bytes, adapter and encoding) is loaded, from this path (a
+    re-ingest is a no-op) or another (a copy: loading it again would count every sentence twice). A path
+    already loaded into another corpus is an IngestError: re-ingesting it must not move its rows."""
     other = con.execute("select corpus from ingested_files where source_file = ? and corpus <> ?",
                         [source.key, source.corpus]).fetchone()
     if other:
         raise IngestError(source.key, None, f"already loaded into corpus {other[0]!r}, not {source.corpus!r}; "
                                             "its rows stay there (ingest it with the same flag)")
-    row = con.execute(
-        "select source_file from ingested_files where sha256 = ? and format = ? and encoding = ?"
-        " order by source_file <> ? limit 1",
-        [sha256, source.format, source.encoding or "", source.key],
-    ).fetchone()
-    return row[0] if row else None
+    row = con.execute("select 1 from ingested_files where sha256 = ? and format = ? and encoding = ?",
+                      [sha256, source.format, source.encoding or ""]).fetchone()
+    return row is not None
 
 
 def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from lmcr.ingest.records import IngestError, ParsedFile, has_surrogates
+from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.jsonl import has_surrogates
 
 
 def _text(value: object) -> str | None:

@@ -20,6 +20,7 @@ from pathlib import Path
 import torch
 
 from lmcr.files import atomic_path, file_sha256
+from lmcr.errors import one_line
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
 
@@ -167,7 +168,7 @@ def load(path: Path, device: str = "cpu") -> Checkpoint:
         checkpoint = Checkpoint(path, model.eval(), Vocab.from_json(read("vocab.json")),
                                 read("linearization.json")["linearization"], read("metrics.json"), read("provenance.json"))
     except (ValueError, KeyError, TypeError, RuntimeError, EOFError, OSError) as exc:
-        raise CheckpointError(f"{path}: cannot load: {' '.join(str(exc).split())[:200]}") from exc
+        raise CheckpointError(f"{path}: cannot load: {one_line(exc, 200)}") from exc
     if not path.parent.name.startswith(f"{checkpoint.linearization}-"):
         raise CheckpointError(f"{path}: holds a {checkpoint.linearization} model, not one of {path.parent.name}")
     return checkpoint
