@@ -32,6 +32,8 @@ def _open(db: str | Path, read_only: bool) -> duckdb.DuckDBPyConnection:
     """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
     try:
         return duckdb.connect(str(db), read_only=read_only)
+    except duckdb.ConnectionException:  # open in this process in the other mode: `read_connection` decides
+        raise
     except duckdb.Error as exc:  # a held lock; not a DuckDB file, a newer storage version, ...
         if isinstance(exc, duckdb.IOException) and "lock" in str(exc).lower():
             raise StoreBusyError(f"store busy: another lmcr process is writing {db}; try again when it finishes") from exc
@@ -78,7 +80,7 @@ def read_connection(db: str | Path) -> duckdb.DuckDBPyConnection:
     (DuckDB refuses a second configuration of one file within a process; then share its mode)."""
     try:
         con = _open(db, read_only=True)
-    except (duckdb.ConnectionException, MigrationError):
+    except duckdb.ConnectionException:  # only then: never open a file that is not a store read-write
         con = _open(db, read_only=False)
     con.execute("set enable_progress_bar = false")
     return con

@@ -360,3 +360,13 @@ def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monke
     assert result.exit_code == 0, result.output
     line = json.loads((tmp_path / "o.jsonl").read_text())
     assert line["id"] == "long" and "the limit is 1,000" in line["error"]
+
+
+def test_ratings_that_are_neither_csv_nor_a_store_are_one_line_and_untouched(tmp_path):
+    """A read that fails on a non-store file must not fall back to opening it read-write."""
+    path = tmp_path / "ratings.txt"
+    path.write_text("hello\n")
+    result = runner.invoke(app, ["evaluate", "--ratings", str(path), "--out", str(tmp_path / "rep")],
+                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    assert str(path) in one_line_error(result)
+    assert path.read_text() == "hello\n" and not (tmp_path / "rep").exists()

@@ -49,5 +49,7 @@ def load_ratings(source: Path, sql_dir: Path, verbs: set[str] | None = None) -> 
         con = store.read_connection(source)
     try:
         return rated_frames(con, verbs)
+    except duckdb.CatalogException as exc:
+        raise ValueError(f"{source}: neither an MTurk results .csv nor an LMCR store with ratings") from exc
     finally:
         con.close()
