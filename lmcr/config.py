@@ -39,3 +39,8 @@ def paths_from_env(data_dir: str | Path | None = None, db: str | Path | None = N
     database = Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb")
     sql_dir = Path(os.environ.get("LMCR_SQL_DIR") or REPO_ROOT / "sql")
     return Paths(data_dir=data, db=database, sql_dir=sql_dir)
+
+
+def paper_from_env() -> Path | None:
+    """The paper's LaTeX source for the report's published Table I: `$LMCR_PAPER`, else none."""
+    return Path(os.environ["LMCR_PAPER"]) if os.environ.get("LMCR_PAPER") else None

@@ -144,3 +144,47 @@ def test_disagreement_picks_frames_the_scorers_rank_differently():
     b = lambda frames: [4.0, 2.1, 2.9, 1.0]  # noqa: E731 - agrees on glass and bowl
     picked = disagreement_frames(pool, {"a": a, "b": b}, 2)
     assert {f[1]["Destination"] for f in picked} == {"cup", "sink"}
+
+
+def _slots(hit: dict) -> list[str]:
+    return [hit[k] for k in sorted(hit, key=lambda k: int(k.rsplit("_", 1)[1])) if k.startswith("frame_id_")]
+
+
+@pytest.mark.parametrize("n_frames, gold_ratings", [(13, True), (13, False), (3, False)])
+def test_no_hit_has_blank_or_repeated_slots(con, tmp_path, n_frames, gold_ratings):
+    if gold_ratings:
+        seed_ratings(con, tmp_path / "past.csv")
+    meta = generate_tasks(con, tmp_path / "tasks", TaskConfig(per_hit=5, gold_per_hit=1, n_frames=n_frames, seed=2))
+    with open(tmp_path / "tasks" / "batch.csv", newline="") as handle:
+        hits = list(csv.DictReader(handle))
+    for hit in hits:
+        slots = _slots(hit)
+        assert all(value for value in hit.values()), hit  # nothing a worker would have to rate blank
+        assert len({s.removeprefix("gold-").removeprefix("f-") for s in slots}) == len(slots)
+    width = len(_slots(hits[0]))
+    assert width == min(5, n_frames + (2 if gold_ratings else 0))
+    asked = {s for hit in hits for s in _slots(hit) if s.startswith("f-")}
+    assert len(asked) == n_frames and meta["frames"] == n_frames  # every frame asked, the fill re-asks some
+
+
+def test_tasks_json_carries_the_hit_settings(con, tmp_path):
+    from typer.testing import CliRunner
+
+    from lmcr.cli import app
+
+    con.close()
+    db = tmp_path / "lmcr.duckdb"
+    args = ["annotate", "tasks", "--out", str(tmp_path / "t"), "--n-frames", "12", "--db", str(db),
+            "--reward", "0.45", "--assignments", "5", "--title", "Rate kitchen sentences", "--min-approved-hits", "0",
+            "--locale", "GB"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    hit = json.loads((tmp_path / "t" / "tasks.json").read_text())["hit"]
+    assert hit["Reward"] == "0.45" and hit["MaxAssignments"] == 5 and hit["Title"] == "Rate kitchen sentences"
+    assert hit["AssignmentDurationInSeconds"] == 1800 and hit["LifetimeInSeconds"] == 7 * 24 * 3600
+    quals = {q["QualificationTypeId"]: q for q in hit["QualificationRequirements"]}
+    assert quals["000000000000000000L0"]["IntegerValues"] == [95]
+    assert quals["00000000000000000071"]["LocaleValues"] == [{"Country": "GB"}]
+    assert "00000000000000000040" not in quals  # 0 approved HITs: no requirement
+    bad = CliRunner().invoke(app, args[:-6] + ["--reward", "$1", "--out", str(tmp_path / "u")])
+    assert bad.exit_code == 1 and "reward must be dollars and cents" in bad.output and not (tmp_path / "u").exists()

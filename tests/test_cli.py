@@ -48,3 +48,38 @@ def test_light_commands_do_not_import_the_heavy_libraries():
     code = "import sys, lmcr.cli; print(','.join(m for m in ('torch', 'gensim', 'scipy', 'spacy') if m in sys.modules))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert loaded == ""
+
+
+def _commands(group, prefix=()):
+    import typer.main
+
+    click_group = typer.main.get_group(group) if not hasattr(group, "commands") else group
+    for name, command in click_group.commands.items():
+        if hasattr(command, "commands"):
+            yield from _commands(command, prefix + (name,))
+        else:
+            yield prefix + (name,), command
+
+
+def test_every_option_and_argument_has_help():
+    import typer.main
+
+    missing = [f"{' '.join(path)} {param.name}" for path, command in _commands(typer.main.get_group(app))
+               for param in command.params if not getattr(param, "help", None)]
+    missing += [f"lmcr {param.name}" for param in typer.main.get_group(app).params if not param.help]
+    assert missing == []
+
+
+def test_data_dir_option_is_the_environment_variable(sample_dir, tmp_path, monkeypatch):
+    monkeypatch.delenv("LMCR_DATA_DIR", raising=False)
+    monkeypatch.delenv("LMCR_DB", raising=False)
+    data = tmp_path / "elsewhere"
+    result = runner.invoke(app, ["--data-dir", str(data), "ingest", "--recipes", str(sample_dir / "nyc"),
+                                 "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    assert (data / "lmcr.duckdb").exists()
+    listed = runner.invoke(app, ["--data-dir", str(data), "query", "corpus_summary", "--format", "json"])
+    import json
+
+    row = json.loads(listed.stdout.splitlines()[0])
+    assert row["corpus"] == "recipes" and all(isinstance(row[k], int) for k in row if k != "corpus")

@@ -79,6 +79,42 @@ def test_sweeps_skip_infeasible_k_and_the_report_is_complete(tmp_path):
 def test_paper_columns_only_for_the_papers_methods():
     results = Results(EvalConfig())
     results.table1 = {m: {"pour": 1.0, "all": 1.0} for m in ("sentence_lm", "frame_counts", "sentence_lm+frame_counts")}
-    head, rule, *rows = table1_markdown(results, list(results.table1)).splitlines()
-    assert head.endswith("| paper sentence_lm |") and "paper frame_counts" not in head and "paper sentence_lm+" not in head
-    assert rule.count("---") == 5 and rows[-1] == "| all | 1.000 | 1.000 | 1.000 | n/a |"
+    paper = {"sentence_lm": {"pour": 0.6, "all": 0.7}, "random": {"all": 0.15}}
+    head, rule, *rows = table1_markdown(results, list(results.table1), paper).splitlines()
+    assert head.endswith("| paper sentence_lm |") and "paper frame_counts" not in head and "paper random" not in head
+    assert rule.count("---") == 5 and rows[-1] == "| all | 1.000 | 1.000 | 1.000 | 0.700 |"
+    assert "paper" not in table1_markdown(results, list(results.table1), {}).splitlines()[0]
+
+
+def test_paper_table_read_from_latex(tmp_path):
+    from lmcr.evaluate.paper import PaperTableError, read_paper_table
+
+    tex = tmp_path / "paper.tex"
+    tex.write_text(r"""\begin{table}\caption{x}\label{tab:res}
+\begin{tabularx}{\linewidth}{l YYYYY}
+\toprule
+{} & \textbf{Random} & & \textbf{Word2Vec} & \multicolumn{2}{r}{\textbf{LMCR (Ours)}} \\
+{} & & \textbf{Cooccur} & & \multicolumn{1}{X}{\textbf{ConceptNet}} & \\
+\midrule
+pour & 0.08 & \textbf{0.74} & 0.56 & 0.52 & 0.60 \\
+\midrule
+Overall & 0.15 & 0.62 & 0.48 & 0.52 & \textbf{0.70} \\
+\bottomrule
+\end{tabularx}
+\end{table}""")
+    table = read_paper_table(tex)
+    assert table["cooccur"] == {"pour": 0.74, "all": 0.62} and table["conceptnet"]["pour"] == 0.52
+    assert table["sentence_lm"] == {"pour": 0.60, "all": 0.70} and table["random"]["all"] == 0.15
+    tex.write_text(r"\begin{table}\label{tab:other}\end{table}")
+    with pytest.raises(PaperTableError, match="no table labelled tab:res"):
+        read_paper_table(tex)
+
+
+@pytest.mark.shared
+def test_the_papers_own_table(shared_dir):
+    from lmcr.evaluate.paper import read_paper_table
+
+    table = read_paper_table(shared_dir / "paper" / "lmcr_icra2020.tex")
+    assert set(table) == {"random", "cooccur", "word2vec", "conceptnet", "sentence_lm"}
+    assert all(len(verbs) == 12 for verbs in table.values())  # 11 verbs and Overall
+    assert table["sentence_lm"]["all"] == 0.70 and table["cooccur"]["fry"] == 0.86

@@ -122,6 +122,14 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     assert (tmp_path / "report" / "report.html").exists() and set(first["checkpoints"]) == {"sentence-all", "frame-all"}
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
     assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
+    # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.
+    assert set(first["table1"]["sentence_lm"]) == {"all", "blend", "brush", "dip", "dump", "fill", "fry", "heat",
+                                                   "pour", "rub", "season", "sprinkle"}
+    report = (tmp_path / "report" / "report.md").read_text(encoding="utf-8")
+    assert "**Sample data.**" in report and "## Provenance" in report and "sample_ratings_mturk.csv" in report
+    assert "Checkpoint sentence-all: `v" in report and "paper " not in report.split("## Fig. 4A")[0]
+    page = (tmp_path / "report" / "report.html").read_text(encoding="utf-8")
+    assert '<div class="scroll"><table>' in page and "<blockquote>" in page and page.count("data:image/png") == 4
     second = pipeline_flow(params)
     assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
     assert second["table1"] == first["table1"]

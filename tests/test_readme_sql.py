@@ -50,3 +50,34 @@ def test_queries_never_write_and_name_missing_parameters(con, paths):
     assert missing.exit_code == 1 and "missing ['corpus']" in missing.stderr
     unknown = runner.invoke(app, ["query", "nope", "--db", str(paths.db)])
     assert unknown.exit_code == 1 and "available: corpus_summary" in unknown.stderr
+
+
+def test_schema_page_is_current_and_every_column_is_described():
+    from lmcr.catalog import schema_page
+
+    page = schema_page(REPO_ROOT / "sql")
+    assert (REPO_ROOT / "sql" / "SCHEMA.md").read_text(encoding="utf-8") == page, \
+        "sql/SCHEMA.md is stale: run `lmcr schema --out sql/SCHEMA.md`"
+    assert "(no comment)" not in page
+    rows = [line for line in page.splitlines() if line.startswith("| ") and not line.startswith("| column")]
+    assert len(rows) > 150 and all(not line.endswith("|  |") for line in rows)
+
+
+def test_mturk_times_and_rewards_are_typed(con, sample_dir, tmp_path):
+    import csv
+
+    source = sample_dir / "ratings" / "sample_ratings_mturk.csv"
+    with source.open(encoding="utf-8", newline="") as f:
+        rows = list(csv.DictReader(f))
+    for row, (time, reward) in zip(rows, [("Tue Nov 17 10:02:00 PST 2026", "$0.30"), ("garbage", "")]):
+        row.update({"SubmitTime": time, "Reward": reward})
+    path = tmp_path / "typed.csv"
+    with path.open("w", encoding="utf-8", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows[:2])
+    ingest_ratings(con, path)
+    got = con.execute("select a.submit_time::varchar, h.reward::varchar, typeof(a.submit_time), typeof(h.reward) "
+                      "from assignments a join hits h using (hit_id) order by a.line").fetchall()
+    assert got[0] == ("2026-11-17 18:02:00", "0.30", "TIMESTAMP", "DECIMAL(9,2)")
+    assert got[1][0] is None  # unreadable time: NULL, the row itself loads

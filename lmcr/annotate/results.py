@@ -191,6 +191,10 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
     return {"source_file": source, "layout": parsed.layout, **counts}
 
 
+# MTurk's text values converted on insert by the macros of migration 010 ('$0.30', 'Tue Nov 17 ... PST 2026').
+CONVERTED = {"reward": "mturk_reward(reward)", "submit_time": "mturk_time(submit_time)"}
+
+
 def _insert(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: str | None = None) -> None:
     """Insert dict rows by column name; with `key`, rows whose key already exists are left as they are."""
     if not rows:
@@ -200,8 +204,9 @@ def _insert(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: s
     con.register("batch", pa.Table.from_pylist([{n: r.get(n) for n in names} for r in rows]))
     try:
         cols = ", ".join(names)
+        values = ", ".join(CONVERTED.get(n, n) for n in names)
         where = f" where {key} not in (select {key} from {table})" if key else ""
-        con.execute(f"insert into {table} ({cols}) select {cols} from batch{where}")
+        con.execute(f"insert into {table} ({cols}) select {values} from batch{where}")
     finally:
         con.unregister("batch")
 

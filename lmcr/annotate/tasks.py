@@ -19,13 +19,14 @@ import html
 import json
 import random
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
 import duckdb
 import numpy as np
 
+from lmcr.annotate.hits import HitSettings
 from lmcr.files import atomic_dir, check_output_dir
 from lmcr.lm.linearize import sentence_text
 from lmcr.srl.lexicon import load_lexicon
@@ -121,6 +122,7 @@ def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: 
         items = [(f, None) for f in frames[start:start + real_per_hit]]
         for g in (rng.sample(gold, min(config.gold_per_hit, len(gold))) if gold else []):
             items.insert(rng.randrange(len(items) + 1), (g[0], g))
+        _fill_short_hit(items, frames, gold, config.per_hit, rng)
         row = {}
         for k, (frame, g) in enumerate(items, 1):
             verb, roles = frame
@@ -130,10 +132,24 @@ def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: 
                 used[fid] = {"frame_id": fid, "expected_min": g[1], "expected_max": g[2], "batch": config.batch}
             row.update({f"{name}_{k}": value for name, value in zip(
                 FIELDS, (fid, verb, role1, arg1, role2, arg2, render(frame)))})
-        for k in range(len(items) + 1, config.per_hit + 1):  # a short last HIT keeps every column
-            row.update({f"{name}_{k}": "" for name in FIELDS})
         rows.append(row)
     return rows, list(used.values())
+
+
+def _fill_short_hit(items: list, frames: list[Frame], gold: list, per_hit: int, rng: random.Random) -> None:
+    """Fill the free slots of a short (last) HIT, as every slot of the form must be rated: first with
+    more gold checks, then with frames of the earlier HITs (extra ratings from other workers), never
+    repeating an item of this HIT. The caller sizes the form so that enough distinct items exist."""
+    free = per_hit - len(items)
+    if free <= 0:
+        return
+    present = {frame_id(f) for f, _ in items}
+    spare_gold = [g for g in gold if frame_id(g[0]) not in present]
+    extra = [(g[0], g) for g in rng.sample(spare_gold, min(free, len(spare_gold)))]
+    spare = [f for f in frames if frame_id(f) not in present]
+    extra += [(f, None) for f in rng.sample(spare, min(free - len(extra), len(spare)))]
+    for item in extra:
+        items.insert(rng.randrange(len(items) + 1), item)
 
 
 def hit_template(per_hit: int) -> str:
@@ -151,7 +167,8 @@ def preview(template: str, row: dict) -> str:
     return f"<!doctype html><html><head><meta charset='utf-8'><title>HIT preview</title></head><body>{filled}</body></html>"
 
 
-def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict) -> Path:
+def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict,
+                settings: HitSettings = HitSettings()) -> Path:
     """batch.csv, hit_template.html, preview.html and tasks.json, published as one folder."""
     columns = [f"{name}_{k}" for k in range(1, config.per_hit + 1) for name in FIELDS]
     template = hit_template(config.per_hit)
@@ -162,12 +179,12 @@ def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict)
             writer.writerows(rows)
         (tmp / "hit_template.html").write_text(template, encoding="utf-8")
         (tmp / "preview.html").write_text(preview(template, rows[0] if rows else {}), encoding="utf-8")
-        (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__}, indent=2), encoding="utf-8")
+        (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__, "hit": settings.to_json()}, indent=2), encoding="utf-8")
     return Path(out_dir)
 
 
 def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskConfig,
-                   scorers: dict[str, Callable] | None = None) -> dict:
+                   scorers: dict[str, Callable] | None = None, settings: HitSettings = HitSettings()) -> dict:
     """Choose frames, build HITs, record the gold items in the store, write the batch folder."""
     if config.mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, not {config.mode!r}")
@@ -185,13 +202,15 @@ def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskCo
     if not pool:
         raise ValueError("no unrated frames to ask about")
     gold = gold_candidates(con) if config.gold_per_hit else []
+    # A batch smaller than one HIT gets a shorter form: no slot may be left blank or repeat an item.
+    config = replace(config, per_hit=min(config.per_hit, len(pool) + len(gold)))
     rows, used = build_hits(pool, gold, config)
     if used:  # gold answers live in the store, never in the CSV the workers' page could read
         con.executemany("insert or replace into gold_items values (?, ?, ?, ?)",
                         [[g["frame_id"], g["expected_min"], g["expected_max"], g["batch"]] for g in used])
     meta = {"batch": config.batch, "mode": config.mode, "frames": len(pool), "hits": len(rows),
             "gold_items": len(used), "gold_available": len(gold)}
-    write_tasks(out_dir, rows, config, meta)
+    write_tasks(out_dir, rows, config, meta, settings)
     return meta
 
 

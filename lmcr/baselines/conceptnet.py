@@ -115,7 +115,9 @@ class ConceptNetScorer:
 
     def rel(self, x: str, y: str) -> float:
         a, b = self.vector(x), self.vector(y)
-        return 0.0 if a is None or b is None else float(a @ b)
+        # Rounded: an SVD basis is unique only up to rotations inside degenerate subspaces, so cosines of
+        # two builds differ in the last bits, and a tie (credit 1/t) must not depend on those bits.
+        return 0.0 if a is None or b is None else round(float(a @ b), 9)
 
     def score_frames(self, frames: list[Frame]) -> list[float]:
         return [pair_sum(f, self.rel) for f in frames]

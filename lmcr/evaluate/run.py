@@ -9,12 +9,14 @@ from pathlib import Path
 from typing import Callable
 
 from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
+from lmcr.evaluate import provenance
+from lmcr.evaluate.paper import read_paper_table
 from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import LM_METHODS, MethodResources, make_scorer
+from lmcr.methods import LM_METHODS, MethodResources, lm_checkpoint_dir, make_scorer
 
 SETTINGS = tuple(f"{m}/{c}" for m in LM_METHODS for c in ("youcook2", "recipes", "all"))
 DEVIATIONS = [
@@ -27,9 +29,10 @@ DEVIATIONS = [
     "a term with no known word is at distance 1.0 (unrelated).",
     "conceptnet: the API is unreachable offline; relatedness is the cosine of PPMI+SVD embeddings of the "
     "cn100k edge list (Numberbatch's starting point, without its retrofitting), or of a Numberbatch file.",
-    "The paper (Chen, Tan, Kuntz, Bansal, Alterovitz: Enabling Robots to Understand Incomplete Natural "
-    "Language Instructions Using Commonsense Reasoning, ICRA 2020) is not available offline, nor its "
-    "numbers; its columns read n/a unless filled in lmcr/evaluate/report.py PAPER.",
+    "The paper: Chen, Tan, Kuntz, Bansal, Alterovitz, Enabling Robots to Understand Incomplete Natural "
+    "Language Instructions Using Commonsense Reasoning, ICRA 2020. Its Table I is read from its LaTeX source "
+    "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
+    "not a like-for-like comparison.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
     "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). 'a+b' sums two methods' log-probabilities "
     "(a product of experts); sentence_lm+frame_counts is what `lmcr complete` uses by default.",
@@ -73,10 +76,26 @@ def calibration_note(method: str, cal: CompletionConfig) -> str:
             f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
 
 
+def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, Path]:
+    """LM setting ('sentence-all') -> the checkpoint version folder each evaluated name uses."""
+    found = {}
+    for name in names:
+        method, _, corpus = name.partition("/")
+        for part in method.split("+"):
+            if part in LM_METHODS:
+                setting = f"{LM_METHODS[part]}-{corpus or res.corpus}"
+                found[setting] = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[part], corpus or res.corpus))
+    return found
+
+
 def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[str], settings: list[str],
                    config: EvalConfig, out_dir: Path, calibration_dir: Path | None = None,
-                   log: Callable[[str], None] = print) -> Results:
+                   log: Callable[[str], None] = print, ratings_source: Path | None = None,
+                   paper: Path | None = None) -> Results:
+    """Score, sweep, calibrate and write the report; `ratings_source` (CSV or store) goes into its
+    provenance and `paper` (the paper's LaTeX source) gives its published Table I columns."""
     started = time.perf_counter()
+    published = read_paper_table(paper) if paper else {}  # a bad file fails before the scoring
     scorers, notes = build_scorers(list(dict.fromkeys(methods + settings)), res, log)
     scores = {}
     for name, fn in scorers.items():
@@ -88,5 +107,8 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
         saved = calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
         notes += [calibration_note(method, cal) for method, (_, _, cal) in saved.items()]
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
-    write_report(results, [m for m in methods if m in scores], [s for s in settings if s in scores], out_dir, notes)
+    evaluated = [m for m in methods if m in scores], [s for s in settings if s in scores]
+    origin = (provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res))
+              if ratings_source is not None else {})
+    write_report(results, *evaluated, out_dir, notes, origin, published)
     return results

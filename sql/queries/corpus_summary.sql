@@ -1,12 +1,12 @@
 -- documents, sentences, words and quarantined records per corpus
 with files as (
     select corpus,
-           sum(records_in) as records_in,
-           sum(records_loaded) as records_loaded,
-           sum(records_quarantined) as quarantined,
-           sum(documents) as documents,
-           sum(sentences) as sentences,
-           sum(words) as words
+           sum(records_in)::bigint as records_in,
+           sum(records_loaded)::bigint as records_loaded,
+           sum(records_quarantined)::bigint as quarantined,
+           sum(documents)::bigint as documents,
+           sum(sentences)::bigint as sentences,
+           sum(words)::bigint as words
     from ingested_files
     group by corpus
 )
