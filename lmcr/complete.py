@@ -13,9 +13,9 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable
 
 from lmcr.files import atomic_path
 from lmcr.srl.parser import FrameParser, parse_instruction

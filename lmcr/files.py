@@ -6,10 +6,9 @@ import hashlib
 import json
 import os
 import shutil
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
-
 
 # Written into every folder LMCR publishes, listing the files it wrote: a folder is replaced only when
 # everything in it is LMCR's own, so a user's files are never deleted.
@@ -99,7 +98,7 @@ def atomic_dir(path: Path) -> Iterator[Path]:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def hash_file(digest: "hashlib._Hash", path: Path) -> None:
+def hash_file(digest: hashlib._Hash, path: Path) -> None:
     """Feed a file's bytes into `digest` in 1 MiB chunks."""
     with open(path, "rb") as handle:
         for chunk in iter(lambda: handle.read(1 << 20), b""):

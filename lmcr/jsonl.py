@@ -5,8 +5,8 @@ through atomic files."""
 from __future__ import annotations
 
 import json
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import Iterable, Iterator
 
 from lmcr.files import atomic_path
 

@@ -5,10 +5,9 @@ from __future__ import annotations
 import csv
 import os
 import random
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterator
-
 
 from lmcr.config import paths_from_env
 from lmcr.files import atomic_path, file_sha256

@@ -19,9 +19,9 @@ import html
 import json
 import random
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
 
 import duckdb
 import numpy as np

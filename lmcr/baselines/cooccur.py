@@ -9,8 +9,8 @@ A pair never seen together scores 0.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable, Iterable
 from itertools import combinations
-from typing import Callable, Iterable
 
 from lmcr.baselines.terms import Lemmatizer, TermMatcher
 from lmcr.lm.linearize import tokens

@@ -7,8 +7,8 @@ spaCy rule lemmatizer, asked for the token as a noun or as a verb, gives the ter
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from functools import lru_cache
-from typing import Iterable
 
 from lmcr.lm.linearize import tokens
 

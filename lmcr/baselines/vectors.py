@@ -13,15 +13,15 @@ word has no vector, and its distance to anything is 1.0, what two unrelated (ort
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 import numpy as np
 from gensim.models import KeyedVectors, Word2Vec
 
 from lmcr.baselines.cooccur import Frame, pair_sum
-from lmcr.files import atomic_path
 from lmcr.errors import one_line
+from lmcr.files import atomic_path
 from lmcr.lm.linearize import tokens
 
 UNRELATED = 1.0

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.scenarios import accuracy, build_scenarios

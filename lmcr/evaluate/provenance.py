@@ -65,7 +65,7 @@ def collect(ratings: Path, db: Path | None, checkpoints: dict[str, Path]) -> dic
     sample = sample_hashes()
     from_sample = [f["file"] for f in rating_files + corpus_files if f["sha256"] in sample]
     return {
-        "date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        "date": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
         "lmcr": __version__,
         "git_commit": git_commit(),
         "machine": machine(),

@@ -4,9 +4,9 @@ completion of the LM methods, and write the report."""
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Callable
 
 from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
 from lmcr.evaluate import provenance

@@ -4,16 +4,16 @@ the detected labels, plan and execute the predicate's motion, and check the outc
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Callable, Iterator
 
 import pybullet as p
 
 from lmcr.complete import CompletionConfig, complete
+from lmcr.errors import one_line
 from lmcr.executor.detect import capture, detect
 from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
 from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
-from lmcr.errors import one_line
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 
 

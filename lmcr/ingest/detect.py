@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 from lmcr.files import hash_file
 from lmcr.ingest.feeding_america import parse_feeding_america

@@ -8,12 +8,12 @@ from __future__ import annotations
 import gzip
 import json
 import zlib
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
+from lmcr.errors import one_line
 from lmcr.ingest.records import IngestError, ParsedFile
 from lmcr.jsonl import InputError, decode_utf8, has_surrogates
-from lmcr.errors import one_line
 
 
 def _recipe_problem(recipe: object) -> str | None:

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import torch
 
-from lmcr.files import atomic_path, file_sha256
 from lmcr.errors import one_line
+from lmcr.files import atomic_path, file_sha256
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
 
