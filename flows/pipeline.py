@@ -28,6 +28,7 @@ from flows.ingest import ingest_flow
 from flows.train import train_flow
 from lmcr.config import REPO_ROOT, paths_from_env
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
+from lmcr.setting import Setting
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 
@@ -82,8 +83,7 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     trained = train_flow(settings=params.settings, embedding=params.embedding, max_epochs=params.max_epochs,
                          max_minutes=params.max_minutes, skip_unchanged=True, data_dir=data_dir)
     annotate_flow(results=params.ratings, data_dir=data_dir)
-    lm_settings = [f"{'sentence_lm' if s.startswith('sentence') else 'frame_lm'}/{s.split('-', 1)[1]}"
-                   for s in params.settings]
+    lm_settings = [Setting.parse(s).label for s in params.settings]
     evaluation = evaluate_flow(methods=params.methods, settings=lm_settings, conceptnet=params.conceptnet,
                                vectors=params.vectors, per_verb=params.per_verb, seed=params.seed, data_dir=data_dir,
                                paper=params.paper)

@@ -4,6 +4,7 @@ promote it only if it is not worse. The decision is recorded in DuckDB and publi
 
 from __future__ import annotations
 
+from dataclasses import astuple
 from pathlib import Path
 
 from prefect import flow, get_run_logger, task
@@ -17,6 +18,7 @@ from lmcr.lm.model import LMConfig
 from lmcr.lm.run import train_setting
 from lmcr.lm.train import TrainConfig
 from lmcr.retrain import RetrainConfig, decide, inputs_sha256, last_inputs, record
+from lmcr.setting import Setting
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import connect
 
@@ -26,8 +28,7 @@ def candidate_task(setting: str, db: str | None, data_dir: str | None, embedding
                    max_minutes: float | None) -> str:
     """Train a new version of `setting` without making it LATEST."""
     paths = paths_from_env(data_dir=data_dir, db=db)
-    linearization, corpus = setting.split("-", 1)
-    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, *astuple(Setting.parse(setting)),
                          LMConfig(0, embedding), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
                          promote=False)
     return str(path)

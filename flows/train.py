@@ -5,18 +5,19 @@ Settings train one after another: each uses every core through torch's threads a
 
 from __future__ import annotations
 
+from dataclasses import astuple
+
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 
 from lmcr.config import paths_from_env
-from lmcr.lm.corpus import SETTINGS
-from lmcr.lm.linearize import LINEARIZATIONS
 from lmcr.lm.model import LMConfig
 from lmcr.lm.run import train_setting
 from lmcr.lm.train import TrainConfig
+from lmcr.setting import ALL_SETTINGS, Setting
 from lmcr.store import connect
 
-ALL_SETTINGS = [f"{lin}-{corpus}" for lin in LINEARIZATIONS for corpus in SETTINGS]
+SETTING_NAMES = [s.name for s in ALL_SETTINGS]  # Prefect parameters are JSON: names, not Settings
 
 
 @task(name="train-setting", task_run_name="train {setting}")
@@ -24,10 +25,9 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
                max_epochs: int, max_minutes: float | None, skip_unchanged: bool = False) -> dict:
     """Train and publish one setting; returns its best validation perplexity and checkpoint."""
     logger = get_run_logger()
-    linearization, corpus = setting.split("-", 1)
     paths = paths_from_env(data_dir=data_dir, db=db)
     path = train_setting(
-        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, *astuple(Setting.parse(setting)),
         LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
         on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
                                          row["val_ppl"], row["tokens_per_s"]),
@@ -40,7 +40,7 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
 
 @flow(name="train")
 def train_flow(
-    settings: list[str] = ALL_SETTINGS,  # noqa: B006 - Prefect parameters must be JSON
+    settings: list[str] = SETTING_NAMES,  # noqa: B006 - Prefect parameters must be JSON
     embedding: int = 256,
     layers: int = 2,
     max_epochs: int = 8,
@@ -51,9 +51,9 @@ def train_flow(
 ) -> list[dict]:
     """Train the requested settings (default: both linearisations x youcook2/recipes/all); with
     `skip_unchanged`, a setting whose latest checkpoint matches the corpus and configuration is kept."""
-    unknown = sorted(set(settings) - set(ALL_SETTINGS))
+    unknown = sorted(set(settings) - set(SETTING_NAMES))
     if unknown:
-        raise ValueError(f"unknown settings {unknown}; choose from {ALL_SETTINGS}")
+        raise ValueError(f"unknown settings {unknown}; choose from {SETTING_NAMES}")
     results = [train_task(s, db, data_dir, embedding, layers, max_epochs, max_minutes, skip_unchanged) for s in settings]
     create_table_artifact(key="lm-checkpoints", table=results, description="Published language models")
     return results

@@ -19,13 +19,14 @@ from rich.table import Table
 
 from lmcr.annotate.hits import HitSettings
 from lmcr.config import paper_from_env, paths_from_env
-from lmcr.errors import one_line
+from lmcr.errors import LMCRError, one_line
 from lmcr.ingest import expand_inputs
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
+from lmcr.setting import CORPORA, LINEARIZATIONS
 from lmcr.store import check_contracts, connect
 
 console = Console(stderr=True)
-CorpusSetting = Literal["youcook2", "recipes", "all"]
+CorpusSetting = Literal[CORPORA]  # the corpora of lmcr.setting, as typer choices
 
 
 def fail(message: str) -> None:
@@ -35,9 +36,12 @@ def fail(message: str) -> None:
 
 
 def _reason(exc: Exception) -> str:
-    """The one-line reason for an exception that reached the command line. LMCR's own errors (all
-    ValueError or RuntimeError subclasses) already name file, line and reason; an OSError names its
-    path; anything else is a defect of LMCR, said so in one line (LMCR_DEBUG=1 re-raises it)."""
+    """The one-line reason for an exception that reached the command line. LMCR's own errors (LMCRError)
+    already name file, line and reason; an OSError names its path; library errors on bad input (ValueError
+    from numpy or typer's parsing, DuckDB's) keep their message; anything else is a defect of LMCR, said
+    so in one line (LMCR_DEBUG=1 re-raises it)."""
+    if isinstance(exc, LMCRError):
+        return one_line(exc)
     if isinstance(exc, OSError) and exc.filename:
         return f"{exc.filename}: {exc.strerror or one_line(exc)}"
     if isinstance(exc, (ValueError, RuntimeError, OSError, EOFError, duckdb.Error)):
@@ -244,7 +248,7 @@ def frames(
 
 @app.command()
 def train(
-    linearization: Literal["sentence", "frame"] = typer.Option("sentence", help="Linearisation of the training text."),
+    linearization: Literal[LINEARIZATIONS] = typer.Option("sentence", help="Linearisation of the training text."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting."),
     embedding: int = typer.Option(256, help="Embedding = hidden size."),
     layers: int = typer.Option(2, help="LSTM layers."),

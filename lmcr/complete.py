@@ -17,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.srl.parser import FrameParser, parse_instruction
 
@@ -24,7 +25,7 @@ Frame = tuple[str, dict[str, str]]
 Scorer = Callable[[list[Frame]], list[float]]
 
 
-class CompletionError(ValueError):
+class CompletionError(LMCRError, ValueError):
     """The instruction cannot be completed: no objects, or too many combinations."""
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,3 +45,16 @@ def paths_from_env(data_dir: str | Path | None = None, db: str | Path | None = N
 def paper_from_env() -> Path | None:
     """The paper's LaTeX source for the report's published Table I: `$LMCR_PAPER`, else none."""
     return Path(os.environ["LMCR_PAPER"]) if os.environ.get("LMCR_PAPER") else None
+
+
+def git_commit(root: Path = REPO_ROOT) -> str:
+    """The checked-out commit (with '+changes' when the tree differs), or why there is none."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10)
+        if head.returncode != 0:
+            return "not a git checkout"
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               capture_output=True, text=True, timeout=10).stdout.strip()
+        return head.stdout.strip() + ("+changes" if dirty else "")
+    except (OSError, subprocess.TimeoutExpired):
+        return "git not available"

@@ -10,12 +10,14 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from lmcr.errors import LMCRError
+
 # Written into every folder LMCR publishes, listing the files it wrote: a folder is replaced only when
 # everything in it is LMCR's own, so a user's files are never deleted.
 OUTPUT_MARKER = ".lmcr-output.json"
 
 
-class OutputError(ValueError):
+class OutputError(LMCRError, ValueError):
     """An output path LMCR must not write to (a user's folder, a folder where a file is expected)."""
 
 

@@ -8,12 +8,13 @@ import json
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
+from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 
 MAX_TEXT_CHARS = 1_000  # an instruction or sentence longer than this is refused (the tokenizer is superlinear)
 
 
-class InputError(ValueError):
+class InputError(LMCRError, ValueError):
     """Bad input: names the file and line."""
 
 

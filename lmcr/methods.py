@@ -12,6 +12,7 @@ from pathlib import Path
 from lmcr.config import paths_from_env
 from lmcr.files import atomic_path, file_sha256
 from lmcr.jsonl import InputError, read_lines
+from lmcr.setting import LM_METHODS, Setting
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
 
@@ -19,7 +20,6 @@ from lmcr.store import read_connection
 # command line and light commands start fast (`bench/bench_cli.py`).
 
 Frame = tuple[str, dict[str, str]]
-LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
 METHODS = ("sentence_lm", "frame_lm", "frame_counts", "cooccur", "word2vec", "conceptnet", "random")
 # What completes instructions by default: the sentence LM times the frame counts, the most accurate
 # on the dev ratings (Table I) and the dev instructions (README, Completion).
@@ -54,7 +54,7 @@ class FrameRow:
 def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Path:
     """The setting folder `<checkpoints>/<linearization>-<corpus>`, or `checkpoints` itself when it is one
     checkpoint (a setting or version folder) of that linearisation."""
-    setting = checkpoints / f"{linearization}-{corpus}"
+    setting = checkpoints / Setting(linearization, corpus).name
     if setting.exists():
         return setting
     if (checkpoints / "LATEST").exists() or (checkpoints / "manifest.json").exists():

@@ -23,9 +23,8 @@ from lmcr.evaluate.run import calibrate_completion
 from lmcr.evaluate.scenarios import accuracy, build_scenarios
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
-from lmcr.methods import COMPLETION_METHOD, LM_METHODS, MethodResources, make_scorer
-
-METHOD_OF = {lin: method for method, lin in LM_METHODS.items()}
+from lmcr.methods import COMPLETION_METHOD, MethodResources, make_scorer
+from lmcr.setting import METHOD_OF, Setting
 
 
 @dataclass(frozen=True)
@@ -38,7 +37,7 @@ class RetrainConfig:
 
     @property
     def linearization(self) -> str:
-        return self.setting.split("-", 1)[0]
+        return Setting.parse(self.setting).linearization
 
 
 def inputs_sha256(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
@@ -74,7 +73,7 @@ def recalibrate(candidate: Path, rated: list[RatedFrame], config: RetrainConfig,
                 calibration_dir: Path) -> dict:
     """Calibrate completion with `candidate` as the setting's LM, as `lmcr evaluate` does, and save it
     under the candidate's fingerprint (the current checkpoint's calibration stays); method -> summary."""
-    corpus = config.setting.split("-", 1)[1]
+    corpus = Setting.parse(config.setting).corpus
     res = MethodResources(checkpoints=candidate, corpus=corpus, db=db)
     scorers, summary = {}, {}
     for method in completion_methods(config.linearization):

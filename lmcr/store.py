@@ -11,20 +11,20 @@ from pathlib import Path
 
 import duckdb
 
-from lmcr.errors import one_line
+from lmcr.errors import LMCRError, one_line
 
 MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
 
 
-class MigrationError(RuntimeError):
+class MigrationError(LMCRError, RuntimeError):
     """A migration failed (it was rolled back and stays pending) or an applied one was edited."""
 
 
-class ContractViolation(RuntimeError):
+class ContractViolation(LMCRError, RuntimeError):
     """A table contract query returned offending rows."""
 
 
-class StoreBusyError(RuntimeError):
+class StoreBusyError(LMCRError, RuntimeError):
     """Another process holds the store's write lock."""
 
 

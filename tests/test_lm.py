@@ -169,3 +169,15 @@ def test_tampered_checkpoint_is_refused(overfit, tmp_path):
     (path / "manifest.json").unlink()
     with pytest.raises(ckpt.CheckpointError, match="no manifest.json"):
         ckpt.load(path)
+
+
+def test_setting_reads_both_spellings():
+    from lmcr.setting import ALL_SETTINGS, Setting
+
+    assert Setting.parse("sentence-all") == Setting.parse("sentence_lm/all") == Setting("sentence", "all")
+    assert Setting.parse("frame_lm/recipes").name == "frame-recipes" and Setting.parse("frame").label == "frame_lm/all"
+    assert len(ALL_SETTINGS) == 6 and all(Setting.parse(s.name) == s == Setting.parse(s.label) for s in ALL_SETTINGS)
+    for bad, reason in (("nope-all", "unknown setting"), ("sentence-recipe", "corpus must be one of"),
+                        ("frame_lm/x", "corpus must be one of")):
+        with pytest.raises(ValueError, match=reason):
+            Setting.parse(bad)

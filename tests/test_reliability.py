@@ -370,3 +370,25 @@ def test_ratings_that_are_neither_csv_nor_a_store_are_one_line_and_untouched(tmp
                            env={"LMCR_DATA_DIR": str(tmp_path / "data")})
     assert str(path) in one_line_error(result)
     assert path.read_text() == "hello\n" and not (tmp_path / "rep").exists()
+
+
+def test_every_lmcr_error_is_one_lmcr_error():
+    """One base the command line knows, each error still the built-in kind its callers catch."""
+    import lmcr.baselines.vectors
+    import lmcr.complete
+    import lmcr.evaluate.paper
+    import lmcr.executor.execute
+    import lmcr.files
+    import lmcr.ingest.records
+    import lmcr.jsonl
+    import lmcr.lm.checkpoint
+    import lmcr.srl.parser
+    import lmcr.store
+    from lmcr.errors import LMCRError
+
+    modules = [lmcr.baselines.vectors, lmcr.complete, lmcr.evaluate.paper, lmcr.executor.execute, lmcr.files,
+               lmcr.ingest.records, lmcr.jsonl, lmcr.lm.checkpoint, lmcr.srl.parser, lmcr.store]
+    errors = {obj for m in modules for obj in vars(m).values()
+              if isinstance(obj, type) and issubclass(obj, Exception) and obj.__module__ == m.__name__}
+    assert len(errors) >= 12
+    assert all(issubclass(e, LMCRError) and issubclass(e, (ValueError, RuntimeError)) for e in errors), errors

@@ -20,7 +20,7 @@ import numpy as np
 from gensim.models import KeyedVectors, Word2Vec
 
 from lmcr.baselines.cooccur import Frame, pair_sum
-from lmcr.errors import one_line
+from lmcr.errors import LMCRError, one_line
 from lmcr.files import atomic_path
 from lmcr.lm.linearize import tokens
 
@@ -30,7 +30,7 @@ UNRELATED = 1.0
 PICKLED = (".kv", ".model", ".pkl", ".pickle")
 
 
-class VectorFileError(ValueError):
+class VectorFileError(LMCRError, ValueError):
     """A vector file that is missing, not in a data format, or malformed."""
 
 

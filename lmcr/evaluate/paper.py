@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from lmcr.errors import LMCRError
 from lmcr.jsonl import decode_utf8, read_bytes
 
 # The paper's column headings -> our method names. The paper's LMCR column is its language model over
@@ -14,7 +15,7 @@ PAPER_METHODS = {"random": "random", "cooccur": "cooccur", "word2vec": "word2vec
                  "lmcr": "sentence_lm"}
 
 
-class PaperTableError(ValueError):
+class PaperTableError(LMCRError, ValueError):
     """The file has no Table I the reader understands."""
 
 

@@ -7,28 +7,14 @@ from __future__ import annotations
 import datetime as dt
 import os
 import platform
-import subprocess
 from pathlib import Path
 
 from lmcr import __version__
-from lmcr.config import REPO_ROOT
+from lmcr.config import REPO_ROOT, git_commit
 from lmcr.files import file_sha256
 from lmcr.store import read_connection
 
 SAMPLE_DIR = REPO_ROOT / "data" / "sample"
-
-
-def git_commit(root: Path = REPO_ROOT) -> str:
-    """The checked-out commit (with '+changes' when the tree differs), or why there is none."""
-    try:
-        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10)
-        if head.returncode != 0:
-            return "not a git checkout"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
-                               capture_output=True, text=True, timeout=10).stdout.strip()
-        return head.stdout.strip() + ("+changes" if dirty else "")
-    except (OSError, subprocess.TimeoutExpired):
-        return "git not available"
 
 
 def machine() -> str:

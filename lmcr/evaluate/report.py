@@ -73,7 +73,7 @@ def distinct_settings(results: Results, methods: list[str], settings: list[str])
     """The LM settings that add a column to Table I: not a method already there under its own name
     ('sentence_lm/all' when Table I's sentence_lm is the all-corpora model: same figures)."""
     return [s for s in settings if s not in methods
-            and results.table1.get(s) != results.table1.get(s.split("/")[0], object())]
+            and results.table1.get(s) != results.table1.get(s.partition("/")[0], object())]
 
 
 def _grouped(reasons: dict[str, str]) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import astuple, replace
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
@@ -16,9 +16,10 @@ from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import LM_METHODS, MethodResources, lm_checkpoint_dir, make_scorer
+from lmcr.methods import MethodResources, lm_checkpoint_dir, make_scorer
+from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
 
-SETTINGS = tuple(f"{m}/{c}" for m in LM_METHODS for c in ("youcook2", "recipes", "all"))
+SETTINGS = tuple(s.label for s in ALL_SETTINGS)
 DEVIATIONS = [
     "Corpora: the shared web recipes and Feeding America stand in for 'Now You're Cooking!' (not available); "
     "YouCook2 is the real annotation set.",
@@ -83,8 +84,8 @@ def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, P
         method, _, corpus = name.partition("/")
         for part in method.split("+"):
             if part in LM_METHODS:
-                setting = f"{LM_METHODS[part]}-{corpus or res.corpus}"
-                found[setting] = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[part], corpus or res.corpus))
+                setting = Setting(LM_METHODS[part], corpus or res.corpus)
+                found[setting.name] = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, *astuple(setting)))
     return found
 
 

@@ -10,14 +10,14 @@ from pathlib import Path
 import pybullet as p
 
 from lmcr.complete import CompletionConfig, complete
-from lmcr.errors import one_line
+from lmcr.errors import LMCRError, one_line
 from lmcr.executor.detect import capture, detect
 from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
 from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 
 
-class ExecutionError(ValueError):
+class ExecutionError(LMCRError, ValueError):
     """The completed frame names something the robot cannot act on here."""
 
 

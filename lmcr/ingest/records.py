@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
+from lmcr.errors import LMCRError
 from lmcr.text import count_words, normalize, split_sentences
 
 KINDS = ("instruction", "ingredient", "title", "comment")
@@ -13,7 +14,7 @@ KINDS = ("instruction", "ingredient", "title", "comment")
 PROSE_KINDS = frozenset({"instruction", "comment"})
 
 
-class IngestError(RuntimeError):
+class IngestError(LMCRError, RuntimeError):
     """An input file cannot be read at all (missing, undecodable, not the format it claims)."""
 
     def __init__(self, source_file: str, position: int | None, reason: str):

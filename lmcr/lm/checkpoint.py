@@ -19,7 +19,7 @@ from pathlib import Path
 
 import torch
 
-from lmcr.errors import one_line
+from lmcr.errors import LMCRError, one_line
 from lmcr.files import atomic_path, file_sha256
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
@@ -31,7 +31,7 @@ VERSION_RE = re.compile(r"^v\d{8}-\d{6}-\d+$")
 TMP_RE = re.compile(r"^\.(v\d{8}-\d{6}-\d+)\.(\d+)\.tmp$")
 
 
-class CheckpointError(RuntimeError):
+class CheckpointError(LMCRError, RuntimeError):
     """A checkpoint is missing, incomplete or was modified after publishing."""
 
 

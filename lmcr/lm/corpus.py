@@ -8,10 +8,9 @@ from dataclasses import dataclass
 import duckdb
 
 from lmcr.lm.data import split_by_document
-from lmcr.lm.linearize import LINEARIZATIONS, frame_text, tokens
+from lmcr.lm.linearize import frame_text, tokens
+from lmcr.setting import Setting
 from lmcr.srl.lexicon import load_lexicon
-
-SETTINGS = ("youcook2", "recipes", "all")
 
 
 @dataclass
@@ -23,10 +22,9 @@ class TrainingText:
     provenance: dict
 
 
-def _corpus_filter(setting: str) -> str:
-    if setting not in SETTINGS:
-        raise ValueError(f"corpus must be one of {SETTINGS}, not {setting!r}")
-    return "" if setting == "all" else f"and s.corpus = '{setting}'"
+def _corpus_filter(corpus: str) -> str:
+    corpus = Setting("sentence", corpus).corpus  # validated: it becomes part of the SQL text
+    return "" if corpus == "all" else f"and s.corpus = '{corpus}'"
 
 
 def sentence_sequences(con: duckdb.DuckDBPyConnection, setting: str, kinds: tuple[str, ...]) -> list[tuple[str, list[str]]]:
@@ -59,8 +57,7 @@ def corpus_hash(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
 def training_text(con: duckdb.DuckDBPyConnection, linearization: str, setting: str,
                   kinds: tuple[str, ...] = ("instruction",)) -> TrainingText:
     """The setting's sequences for a linearisation, split by document (5% held out)."""
-    if linearization not in LINEARIZATIONS:
-        raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {linearization!r}")
+    Setting(linearization, setting)  # validates both
     pairs = (sentence_sequences(con, setting, kinds) if linearization == "sentence"
              else frame_sequences(con, setting))
     pairs = [(doc, seq) for doc, seq in pairs if len(seq) >= 2]

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import re
 
+from lmcr.setting import LINEARIZATIONS
 from lmcr.srl.lexicon import Lexicon, load_lexicon
 
-LINEARIZATIONS = ("frame", "sentence")
 _TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)?|\d+(?:[./]\d+)?")
 NUMBER = "<num>"
 

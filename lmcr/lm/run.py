@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import subprocess
 import uuid
 from collections.abc import Callable
 from dataclasses import replace
@@ -12,23 +11,20 @@ from pathlib import Path
 import duckdb
 
 import lmcr
-from lmcr.config import REPO_ROOT
+from lmcr.config import git_commit
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 from lmcr.store import transaction
 
 
 def code_version() -> str:
     """Package version and, in a git checkout, the commit."""
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO_ROOT, capture_output=True,
-                                text=True, timeout=5).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        commit = ""
-    return f"{lmcr.__version__}+{commit}" if commit else lmcr.__version__
+    commit = git_commit()
+    return f"{lmcr.__version__}+{commit[:12]}" if commit[:1].isalnum() and " " not in commit else lmcr.__version__
 
 
 def train_setting(
@@ -53,7 +49,7 @@ def train_setting(
     """
     with open_store() as con:
         if skip_unchanged:
-            current = up_to_date(checkpoints / f"{linearization}-{corpus}", corpus_hash(con, linearization),
+            current = up_to_date(checkpoints / Setting(linearization, corpus).name, corpus_hash(con, linearization),
                                  model_config or LMConfig(0), train_config, min_freq)
             if current is not None:
                 return current
@@ -72,7 +68,7 @@ def train_setting(
                   "min_freq": min_freq, "run_id": run_id}
     # Publish unpromoted, record the run, then promote: LATEST never names a version without its
     # lm_runs row, whatever fails or is killed in between.
-    setting = f"{linearization}-{corpus}"
+    setting = Setting(linearization, corpus).name
     path = ckpt.publish(checkpoints, setting, model.cpu(), vocab, linearization, metrics,
                         {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote=False)
     with open_store() as con:

@@ -21,6 +21,7 @@ import spacy
 from spacy.language import Language
 from spacy.tokens import Doc, Span, Token
 
+from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import Frame, extract_frames
@@ -229,7 +230,7 @@ class FrameParser:
         return split_off
 
 
-class NoPredicateError(ValueError):
+class NoPredicateError(LMCRError, ValueError):
     """An instruction with none of the robot's predicates."""
 
 

@@ -1,0 +1,56 @@
+"""A language-model setting: a linearisation of the frames times a training corpus. Checkpoint folders
+and flows spell it `sentence-all`, evaluation and the CLI `sentence_lm/all`; `Setting.parse` reads
+either, and every place that needs a name asks the setting for it. Light: the CLI imports it at start."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+LINEARIZATIONS = ("sentence", "frame")
+CORPORA = ("youcook2", "recipes", "all")
+# The scorer (method) name of each linearisation's language model.
+LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
+METHOD_OF = {linearization: method for method, linearization in LM_METHODS.items()}
+
+
+@dataclass(frozen=True, order=True)
+class Setting:
+    linearization: str
+    corpus: str = "all"
+
+    def __post_init__(self) -> None:
+        if self.linearization not in LINEARIZATIONS:
+            raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {self.linearization!r}")
+        if self.corpus not in CORPORA:
+            raise ValueError(f"corpus must be one of {CORPORA}, not {self.corpus!r}")
+
+    @classmethod
+    def parse(cls, text: str) -> Setting:
+        """'sentence-all', 'sentence_lm/all' or 'sentence/all'; a bare linearisation or method means all."""
+        head, sep, corpus = text.partition("/" if "/" in text else "-")
+        linearization = LM_METHODS.get(head, head)
+        if linearization not in LINEARIZATIONS:
+            raise ValueError(f"unknown setting {text!r}: write linearization-corpus (e.g. sentence-all) or "
+                             f"method/corpus (e.g. sentence_lm/all)")
+        return cls(linearization, corpus if sep else "all")
+
+    @property
+    def name(self) -> str:
+        """The checkpoint folder's name, 'sentence-all'."""
+        return f"{self.linearization}-{self.corpus}"
+
+    @property
+    def method(self) -> str:
+        """The scorer of this setting's LM, 'sentence_lm'."""
+        return METHOD_OF[self.linearization]
+
+    @property
+    def label(self) -> str:
+        """How evaluation names it, 'sentence_lm/all'."""
+        return f"{self.method}/{self.corpus}"
+
+    def __str__(self) -> str:
+        return self.name
+
+
+ALL_SETTINGS = tuple(Setting(lin, corpus) for lin in LINEARIZATIONS for corpus in CORPORA)
