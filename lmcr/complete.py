@@ -19,9 +19,9 @@ from pathlib import Path
 
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
+from lmcr.frame import Frame
 from lmcr.srl.parser import FrameParser, parse_instruction
 
-Frame = tuple[str, dict[str, str]]
 Scorer = Callable[[list[Frame]], list[float]]
 
 
@@ -106,7 +106,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
                               f"the limit is {config.max_frames:,}")
-    scores = scorer([(frame.predicate, {**roles, **f}) for f in fillings])
+    scores = scorer([Frame.of(frame.predicate, {**roles, **f}) for f in fillings])
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
     candidates = [{"object": f[missing[0]], "objects": f, "score": round(s, 4), "probability": round(p, 4)}

@@ -21,9 +21,8 @@ from collections import Counter
 from collections.abc import Iterable
 from pathlib import Path
 
+from lmcr.frame import Frame
 from lmcr.store import named_query, read_connection
-
-Frame = tuple[str, dict[str, str]]
 
 
 class FrameCountScorer:

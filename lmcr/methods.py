@@ -11,6 +11,7 @@ from pathlib import Path
 
 from lmcr.config import paths_from_env
 from lmcr.files import atomic_path, file_sha256
+from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
 from lmcr.setting import LM_METHODS, Setting
 from lmcr.srl.lexicon import load_lexicon
@@ -19,7 +20,6 @@ from lmcr.store import read_connection
 # The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
 # command line and light commands start fast (`bench/bench_cli.py`).
 
-Frame = tuple[str, dict[str, str]]
 METHODS = ("sentence_lm", "frame_lm", "frame_counts", "cooccur", "word2vec", "conceptnet", "random")
 # What completes instructions by default: the sentence LM times the frame counts, the most accurate
 # on the dev ratings (Table I) and the dev instructions (README, Completion).
@@ -214,7 +214,7 @@ def _frame_of(row: dict, path: Path, line: int, lex, n_columns: int) -> Frame:
         raise InputError(f"{path}:{line}: roles {sorted(roles)} are not {verb}'s {list(spec.roles)}")
     if not all(roles.values()):
         raise InputError(f"{path}:{line}: empty argument")
-    return verb, roles
+    return Frame.of(verb, roles)
 
 
 def write_scores_csv(path: Path, columns: list[str], rows: list[FrameRow], scores: dict[str, list[float]]) -> None:

@@ -340,7 +340,7 @@ def test_unknown_objects_are_never_chosen():
     from lmcr.srl.parser import load_parser
 
     parser = load_parser()
-    prefer_unknown = lambda frames: [10.0 if f[1]["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
+    prefer_unknown = lambda frames: [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
     out = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor", "cup"])
     assert out["frame"]["roles"]["Destination"] == "cup" and out["ignored_objects"] == ["flux capacitor"]
     with pytest.raises(CompletionError, match="not in the robot's object vocabulary"):

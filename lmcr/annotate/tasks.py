@@ -14,7 +14,6 @@ agreement (mean >= 4.67 or <= 1.33 over >= 3 ratings): their answers come from p
 from __future__ import annotations
 
 import csv
-import hashlib
 import html
 import json
 import random
@@ -28,10 +27,10 @@ import numpy as np
 
 from lmcr.annotate.hits import HitSettings
 from lmcr.files import atomic_dir, check_output_dir
+from lmcr.frame import Frame
 from lmcr.lm.linearize import sentence_text
 from lmcr.srl.lexicon import load_lexicon
 
-Frame = tuple[str, dict[str, str]]
 MODES = ("protocol", "corpus", "disagreement")
 FIELDS = ("frame_id", "verb", "role1", "arg1", "role2", "arg2", "sentence")
 TEMPLATE_DIR = Path(__file__).resolve().parents[2] / "annotation"
@@ -46,12 +45,6 @@ class TaskConfig:
     n_frames: int | None = None  # corpus / disagreement: how many frames (default: all protocol frames)
     seed: int = 0
     batch: str = "batch"
-
-
-def frame_id(frame: Frame) -> str:
-    verb, roles = frame
-    key = json.dumps([verb, sorted(roles.items())])
-    return "f-" + hashlib.sha256(key.encode()).hexdigest()[:12]
 
 
 def render(frame: Frame) -> str:
@@ -69,7 +62,7 @@ def protocol_frames(seed: int, fixed_per_role: int) -> list[Frame]:
     for verb, spec in sorted(lex.predicates.items()):
         for role in spec.roles:
             for fixed in rng.sample(lex.objects, fixed_per_role):
-                frames += [(verb, {role: fixed, spec.other(role): o}) for o in lex.objects if o != fixed]
+                frames += [Frame.of(verb, {role: fixed, spec.other(role): o}) for o in lex.objects if o != fixed]
     return frames
 
 
@@ -83,7 +76,7 @@ def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Fra
         [list(lex.predicates), sorted(lex.object_pronouns)]).fetchall()
     distinct = sorted({(p, tuple(zip(roles, values))) for p, roles, values in rows})
     picked = random.Random(seed).sample(distinct, min(n, len(distinct)))
-    return [(p, dict(pairs)) for p, pairs in picked]
+    return [Frame(p, pairs) for p, pairs in picked]
 
 
 def disagreement_frames(pool: list[Frame], scorers: dict[str, Callable], n: int) -> list[Frame]:
@@ -101,12 +94,12 @@ def disagreement_frames(pool: list[Frame], scorers: dict[str, Callable], n: int)
 def gold_candidates(con: duckdb.DuckDBPyConnection) -> list[tuple[Frame, int, int]]:
     rows = con.execute("select verb, role1, arg1, role2, arg2, mean from frame_ratings "
                        "where n >= 3 and (mean >= 4.67 or mean <= 1.34) order by all").fetchall()
-    return [((v, {r1: a1, r2: a2}), 4 if m >= 4.5 else 1, 5 if m >= 4.5 else 2) for v, r1, a1, r2, a2, m in rows]
+    return [(Frame(v, ((r1, a1), (r2, a2))), 4 if m >= 4.5 else 1, 5 if m >= 4.5 else 2) for v, r1, a1, r2, a2, m in rows]
 
 
 def already_rated(con: duckdb.DuckDBPyConnection) -> set[str]:
     rows = con.execute("select verb, role1, arg1, role2, arg2 from frame_ratings").fetchall()
-    return {frame_id((v, {r1: a1, r2: a2})) for v, r1, a1, r2, a2 in rows}
+    return {Frame(v, ((r1, a1), (r2, a2))).id for v, r1, a1, r2, a2 in rows}
 
 
 def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: TaskConfig) -> tuple[list[dict], list[dict]]:
@@ -127,7 +120,7 @@ def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: 
         for k, (frame, g) in enumerate(items, 1):
             verb, roles = frame
             (role1, arg1), (role2, arg2) = list(roles.items())
-            fid = ("gold-" + frame_id(frame)[2:]) if g else frame_id(frame)
+            fid = ("gold-" + frame.id[2:]) if g else frame.id
             if g:
                 used[fid] = {"frame_id": fid, "expected_min": g[1], "expected_max": g[2], "batch": config.batch}
             row.update({f"{name}_{k}": value for name, value in zip(
@@ -143,10 +136,10 @@ def _fill_short_hit(items: list, frames: list[Frame], gold: list, per_hit: int, 
     free = per_hit - len(items)
     if free <= 0:
         return
-    present = {frame_id(f) for f, _ in items}
-    spare_gold = [g for g in gold if frame_id(g[0]) not in present]
+    present = {f.id for f, _ in items}
+    spare_gold = [g for g in gold if g[0].id not in present]
     extra = [(g[0], g) for g in rng.sample(spare_gold, min(free, len(spare_gold)))]
-    spare = [f for f in frames if frame_id(f) not in present]
+    spare = [f for f in frames if f.id not in present]
     extra += [(f, None) for f in rng.sample(spare, min(free - len(extra), len(spare)))]
     for item in extra:
         items.insert(rng.randrange(len(items) + 1), item)
@@ -193,8 +186,7 @@ def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskCo
     if config.mode == "corpus":
         pool = corpus_frames(con, config.n_frames or len(pool), config.seed)
     rated = already_rated(con)
-    pool = [f for f in dict.fromkeys(map(_freeze, pool)) if frame_id(_thaw(f)) not in rated]
-    pool = [_thaw(f) for f in pool]
+    pool = [f for f in dict.fromkeys(pool) if f.id not in rated]
     if config.mode == "disagreement":
         pool = disagreement_frames(pool, scorers or {}, config.n_frames or len(pool) // 10)
     elif config.n_frames:
@@ -213,10 +205,3 @@ def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskCo
     write_tasks(out_dir, rows, config, meta, settings)
     return meta
 
-
-def _freeze(frame: Frame) -> tuple:
-    return frame[0], tuple(frame[1].items())
-
-
-def _thaw(frozen: tuple) -> Frame:
-    return frozen[0], dict(frozen[1])

@@ -13,9 +13,8 @@ from collections.abc import Callable, Iterable
 from itertools import combinations
 
 from lmcr.baselines.terms import Lemmatizer, TermMatcher
+from lmcr.frame import Frame
 from lmcr.lm.linearize import tokens
-
-Frame = tuple[str, dict[str, str]]
 
 
 def frame_terms(frame: Frame) -> list[str]:

@@ -10,6 +10,7 @@ import duckdb
 
 from lmcr import store
 from lmcr.annotate.results import ingest_ratings
+from lmcr.frame import Frame
 
 
 @dataclass(frozen=True)
@@ -23,8 +24,8 @@ class RatedFrame:
     n: int
 
     @property
-    def frame(self) -> tuple[str, dict[str, str]]:
-        return self.verb, {self.role1: self.arg1, self.role2: self.arg2}
+    def frame(self) -> Frame:
+        return Frame(self.verb, ((self.role1, self.arg1), (self.role2, self.arg2)))
 
     @property
     def key(self) -> tuple[str, str, str, str, str]:

@@ -24,7 +24,7 @@ import pyarrow.parquet as pq
 from lmcr.files import atomic_path
 from lmcr.ingest.stage import write_parquet_atomic
 from lmcr.srl.compounds import Compounds, learn_compounds
-from lmcr.srl.frames import Frame
+from lmcr.srl.frames import FrameMention
 from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import COMPOUNDS_FILE, PRIORS_FILE, FrameParser, load_nlp
 from lmcr.srl.priors import RolePriors
@@ -129,7 +129,7 @@ def _worker_parser(model: str | None, compounds_path: str) -> FrameParser:
     return FrameParser(load_nlp(model), compounds=compounds)
 
 
-def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[Frame]) -> tuple[list[dict], list[dict]]:
+def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention]) -> tuple[list[dict], list[dict]]:
     """Table rows for the frames of one sentence."""
     frame_rows, role_rows = [], []
     for number, frame in enumerate(frames):
@@ -193,9 +193,9 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
         "from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
         "where f.known and f.ambiguous_role is not null order by all"
     ).fetchall()
-    frames: dict[tuple, Frame] = {}
+    frames: dict[tuple, FrameMention] = {}
     for corpus, doc_id, sent_id, frame_no, predicate, ambiguous, role, value in rows:
-        frame = frames.setdefault((corpus, doc_id, sent_id, frame_no), Frame(predicate, {}, True, 0, 0, {}, ambiguous))
+        frame = frames.setdefault((corpus, doc_id, sent_id, frame_no), FrameMention(predicate, {}, True, 0, 0, {}, ambiguous))
         frame.roles[role] = value
     lex = load_lexicon()
     flipped = []

@@ -19,7 +19,7 @@ PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
 
 
 @dataclass
-class Frame:
+class FrameMention:
     """One predicate occurrence: roles map to values (None when not expressed), spans to char offsets."""
 
     predicate: str
@@ -37,10 +37,10 @@ class Frame:
     def to_json(self) -> dict:
         return {"predicate": self.predicate, "roles": dict(self.roles)}
 
-    def shifted(self, offset: int) -> Frame:
+    def shifted(self, offset: int) -> FrameMention:
         """The same frame with character offsets moved (for text that was re-parsed with a prefix)."""
         spans = {r: (s + offset, e + offset) for r, (s, e) in self.spans.items()}
-        return Frame(self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans,
+        return FrameMention(self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans,
                      self.ambiguous_object)
 
 
@@ -111,8 +111,8 @@ def _right_node_object(verb: Token) -> list[Token]:
     return []
 
 
-def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None) -> Frame:
-    frame = Frame(spec.name, {role: None for role in spec.roles}, True, verb.idx, verb.idx + len(verb))
+def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None) -> FrameMention:
+    frame = FrameMention(spec.name, {role: None for role in spec.roles}, True, verb.idx, verb.idx + len(verb))
 
     def fill(role: str, token: Token) -> bool:
         found = argument_value(token, lex, compounds)
@@ -133,8 +133,8 @@ def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, co
     return frame
 
 
-def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds: Compounds | None) -> Frame:
-    frame = Frame(lemma, {}, False, verb.idx, verb.idx + len(verb))
+def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds: Compounds | None) -> FrameMention:
+    frame = FrameMention(lemma, {}, False, verb.idx, verb.idx + len(verb))
     for role, token in ([("Theme", args.objects[0])] if args.objects else []) + args.preps:
         found = argument_value(token, lex, compounds)
         if found and role not in frame.roles:
@@ -142,7 +142,7 @@ def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds
     return frame
 
 
-def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[Frame]:
+def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[FrameMention]:
     """Every predicate occurrence in `doc`, in text order; `compounds` (learned) decides adjective-tagged
     modifiers, without it only noun-tagged modifiers join a name."""
     frames = []

@@ -24,7 +24,7 @@ from spacy.tokens import Doc, Span, Token
 from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
 from lmcr.srl.compounds import Compounds
-from lmcr.srl.frames import Frame, extract_frames
+from lmcr.srl.frames import FrameMention, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
 from lmcr.srl.lexicon import Lexicon, load_lexicon
 from lmcr.srl.priors import RolePriors
@@ -133,10 +133,10 @@ class FrameParser:
     def _parse(self, texts: Iterable[str]) -> Iterator[Doc]:
         return (self.lemmas.fill(doc) for doc in self.nlp.pipe(texts, batch_size=self.batch_size))
 
-    def parse(self, text: str) -> list[Frame]:
+    def parse(self, text: str) -> list[FrameMention]:
         return next(self.pipe([text]))
 
-    def pipe(self, texts: Iterable[str], chunk: int = 2048) -> Iterator[list[Frame]]:
+    def pipe(self, texts: Iterable[str], chunk: int = 2048) -> Iterator[list[FrameMention]]:
         """Frames for each text, in order; texts go through `nlp.pipe` a chunk at a time."""
         batch: list[str] = []
         for text in texts:
@@ -147,8 +147,8 @@ class FrameParser:
         if batch:
             yield from self._batch(batch)
 
-    def _batch(self, texts: list[str]) -> list[list[Frame]]:
-        frames: list[list[Frame]] = [[] for _ in texts]
+    def _batch(self, texts: list[str]) -> list[list[FrameMention]]:
+        frames: list[list[FrameMention]] = [[] for _ in texts]
         segments = [_Segment(i, 0, text) for i, text in enumerate(texts)]
         while segments:
             segments = self._round(segments, frames)
@@ -172,7 +172,7 @@ class FrameParser:
             r, v, n = self.first_words.get(first.lower_, (0, 0, 0))
             self.first_words[first.lower_] = (r + repaired, v + (repaired or first.tag_.startswith("VB")), n + 1)
 
-    def _round(self, segments: list[_Segment], frames: list[list[Frame]]) -> list[_Segment]:
+    def _round(self, segments: list[_Segment], frames: list[list[FrameMention]]) -> list[_Segment]:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
         parses: list[tuple[_Segment, Span, int]] = []  # (segment, parse, offset of the parse's text)
         requests: list[tuple[_Segment, Span, int]] = []  # (segment, sentence, offset of its doc's text)
@@ -252,7 +252,7 @@ def load_parser(model: str | None = None, resources: Path | None = None) -> Fram
     return FrameParser(load_nlp(model), compounds=compounds, priors=priors)
 
 
-def parse_instruction(parser: FrameParser, text: str) -> Frame:
+def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
     """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
     parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
     known = [f for f in parser.parse(check_text(text, "instruction")) if f.known]

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from lmcr.files import atomic_path
-from lmcr.srl.frames import Frame
+from lmcr.srl.frames import FrameMention
 
 SMOOTHING = 1.0
 
@@ -28,7 +28,7 @@ class RolePriors:
     by_verb: Counter = field(default_factory=Counter)
     pooled: Counter = field(default_factory=Counter)
 
-    def observe(self, frames: Iterable[Frame], alternating: set[str]) -> None:
+    def observe(self, frames: Iterable[FrameMention], alternating: set[str]) -> None:
         """Count role fillers of unambiguous, fully specified alternating-verb frames."""
         for frame in frames:
             if frame.predicate not in alternating or frame.ambiguous_object or None in frame.roles.values():
@@ -45,7 +45,7 @@ class RolePriors:
                 return (hit + SMOOTHING) / (hit + miss + 2 * SMOOTHING)
         return None
 
-    def resolve(self, frame: Frame) -> Frame:
+    def resolve(self, frame: FrameMention) -> FrameMention:
         """Swap a default-assigned lone object into the other role when the corpus prefers that role."""
         role = frame.ambiguous_object
         if role is None:
@@ -58,7 +58,7 @@ class RolePriors:
         roles = {role: None, other: value} if list(frame.roles)[0] == role else {other: value, role: None}
         roles = {r: roles[r] for r in frame.roles}
         spans = {other: frame.spans[role]} if role in frame.spans else {}
-        return Frame(frame.predicate, roles, frame.known, frame.start, frame.end, spans, other)
+        return FrameMention(frame.predicate, roles, frame.known, frame.start, frame.end, spans, other)
 
     def save(self, path: Path) -> None:
         """Write as JSON under a temporary name, then rename."""
