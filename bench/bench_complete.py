@@ -18,8 +18,8 @@ from pathlib import Path
 from lmcr.complete import complete, completion_scorer
 from lmcr.config import paths_from_env
 from lmcr.jsonl import read_jsonl
+from lmcr.lexicon import load_lexicon
 from lmcr.methods import COMPLETION_METHOD, resources_from_env
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import load_parser
 
 

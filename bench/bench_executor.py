@@ -21,8 +21,8 @@ from lmcr.config import paths_from_env
 from lmcr.executor.execute import ExecutionError, execute
 from lmcr.executor.scene import make_scene
 from lmcr.jsonl import InputError
+from lmcr.lexicon import load_lexicon
 from lmcr.methods import COMPLETION_METHOD, resources_from_env
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import load_parser
 
 # predicate -> (incomplete instruction, the object it needs that is stated, the one to be filled in)

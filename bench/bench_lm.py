@@ -28,13 +28,13 @@ from torch import nn
 
 from lmcr.config import paths_from_env
 from lmcr.evaluate.ratings import load_ratings
+from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import training_text
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import LMScorer
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
-from lmcr.srl.lexicon import load_lexicon
 
 OBJECTS = load_lexicon().objects
 

@@ -18,9 +18,9 @@ from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.files import file_sha256
+from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
 from lmcr.methods import EVALUATED, MethodResources, resources_from_env
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
 
 

@@ -14,12 +14,12 @@ from flows.annotate import ingest_task
 from flows.ingest import ingest_flow
 from lmcr.config import paths_from_env
 from lmcr.evaluate.ratings import rated_frames
+from lmcr.lexicon import load_lexicon
 from lmcr.lm.model import LMConfig
 from lmcr.lm.run import train_setting
 from lmcr.lm.train import TrainConfig
 from lmcr.retrain import RetrainConfig, decide, inputs_sha256, last_inputs, record
 from lmcr.setting import Setting
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import connect
 
 

@@ -333,7 +333,7 @@ def evaluate(
     from lmcr.evaluate.ratings import load_ratings
     from lmcr.evaluate.run import run_evaluation
     from lmcr.files import check_output_dir
-    from lmcr.srl.lexicon import load_lexicon
+    from lmcr.lexicon import load_lexicon
 
     paths = paths_from_env()
     res = resources_from_env(checkpoint, "all", vectors, conceptnet, seed)

@@ -13,16 +13,14 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
+from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.parser import FrameParser, parse_instruction
-
-Scorer = Callable[[list[Frame]], list[float]]
 
 
 class CompletionError(LMCRError, ValueError):
@@ -167,8 +165,6 @@ def load_config(path: Path, fingerprint: str | None) -> CompletionConfig | None:
 def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str | None]:
     """Where a method's completion calibration lives (what `lmcr evaluate` writes and `lmcr complete`
     reads), and the fingerprint it must carry; None for a method that is not calibrated."""
-    from lmcr.methods import scorer_fingerprint
-
     # Named by the fingerprint too, so the calibration of a retrain candidate can be written before it
     # is promoted without disturbing the one the current checkpoint uses.
     fingerprint = scorer_fingerprint(method, res)
@@ -179,8 +175,6 @@ def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
     """The scorer of `method` and the completion settings `lmcr evaluate` calibrated for exactly what it
     is built from (its fingerprint), or uncalibrated defaults when there are none."""
-    from lmcr.methods import make_scorer
-
     scorer = make_scorer(method, res)
     path, fingerprint = calibration_file(method, res, calibration_dir)
     config = load_config(path, fingerprint) if fingerprint else None

@@ -8,23 +8,22 @@ import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 from lmcr.config import paths_from_env
 from lmcr.files import atomic_path, file_sha256
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
+from lmcr.lexicon import load_lexicon
 from lmcr.setting import LM_METHODS, Setting
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.store import read_connection
 
 # The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
 # command line and light commands start fast (`bench/bench_cli.py`).
 
-METHODS = ("sentence_lm", "frame_lm", "frame_counts", "cooccur", "word2vec", "conceptnet", "random")
 # What completes instructions by default: the sentence LM times the frame counts, the most accurate
 # on the dev ratings (Table I) and the dev instructions (README, Completion).
 COMPLETION_METHOD = "sentence_lm+frame_counts"
-EVALUATED = (*METHODS[:3], COMPLETION_METHOD, *METHODS[3:])  # what `lmcr evaluate` compares by default
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
 
@@ -79,65 +78,118 @@ def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vect
                            cache_dir=paths.data_dir / "baselines", seed=seed)
 
 
-def make_scorer(method: str, res: MethodResources) -> Callable[[list[Frame]], list[float]]:
-    """A function scoring a list of complete frames with `method`; 'a+b' sums the scores of methods a
-    and b (for log-probability methods, a product of experts)."""
-    from lmcr.baselines.conceptnet import ConceptNetScorer
+class Scorer(Protocol):
+    """Complete frames in, one float each out (higher = more plausible; log-probabilities for the LMs
+    and frame_counts, so that 'a+b' sums are products of experts)."""
+
+    def __call__(self, frames: list[Frame]) -> list[float]: ...
+
+
+@dataclass(frozen=True)
+class ScorerSpec:
+    """How to build a method's scorer from the resources, and what a completion calibration of it is
+    valid for (None: its completion is not calibrated)."""
+
+    build: Callable[[MethodResources], Scorer]
+    fingerprint: Callable[[MethodResources], str | None] = lambda res: None
+
+
+def _lm_scorer(linearization: str) -> Callable[[MethodResources], Scorer]:
+    def build(res: MethodResources) -> Scorer:
+        from lmcr.lm import checkpoint as ckpt
+        from lmcr.lm.score import LMScorer
+
+        loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
+        if loaded.linearization != linearization:
+            raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {linearization}")
+        return LMScorer(loaded).score_frames
+    return build
+
+
+def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
+    def fingerprint(res: MethodResources) -> str:
+        from lmcr.lm import checkpoint as ckpt
+
+        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
+        return file_sha256(version / "manifest.json")
+    return fingerprint
+
+
+def _frame_counts(res: MethodResources) -> Scorer:
+    from lmcr.counts import FrameCountScorer
+
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
+    return FrameCountScorer.from_store(res.db, paths_from_env().sql_dir, res.corpus).score_frames
+
+
+def _frame_corpus_hash(res: MethodResources) -> str:
+    from lmcr.lm.corpus import corpus_hash
+
+    con = read_connection(res.db)
+    try:
+        return corpus_hash(con, "frame")
+    finally:
+        con.close()
+
+
+def _cooccur(res: MethodResources) -> Scorer:
     from lmcr.baselines.cooccur import CooccurrenceScorer
     from lmcr.baselines.terms import default_lemmatizer
-    from lmcr.baselines.vectors import VectorScorer, load_vectors
-    from lmcr.counts import FrameCountScorer
-    from lmcr.lm import checkpoint as ckpt
-    from lmcr.lm.score import LMScorer
 
+    return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model), robot_terms()).score_frames
+
+
+def _word2vec(res: MethodResources) -> Scorer:
+    from lmcr.baselines.vectors import VectorScorer, load_vectors
+
+    return VectorScorer(load_vectors(res.vectors or corpus_word2vec(res))).score_frames
+
+
+def _conceptnet(res: MethodResources) -> Scorer:
+    from lmcr.baselines.conceptnet import ConceptNetScorer
+
+    if res.conceptnet is None:
+        raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+    return ConceptNetScorer.from_path(res.conceptnet).score_frames
+
+
+def _random(res: MethodResources) -> Scorer:
+    rng = random.Random(res.seed)
+    return lambda frames: [rng.random() for _ in frames]
+
+
+# The methods, in the order reports list them: a new method is one entry here.
+SCORERS: dict[str, ScorerSpec] = {
+    **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin)) for method, lin in LM_METHODS.items()},
+    "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
+    "cooccur": ScorerSpec(_cooccur),
+    "word2vec": ScorerSpec(_word2vec),
+    "conceptnet": ScorerSpec(_conceptnet),
+    "random": ScorerSpec(_random),
+}
+
+
+METHODS = tuple(SCORERS)
+EVALUATED = (*METHODS[:3], COMPLETION_METHOD, *METHODS[3:])  # what `lmcr evaluate` compares by default
+
+
+def make_scorer(method: str, res: MethodResources) -> Scorer:
+    """The scorer of `method`; 'a+b' sums the scores of methods a and b (for log-probability methods,
+    a product of experts)."""
     if "+" in method:
         parts = [make_scorer(m, res) for m in method.split("+")]
         return lambda frames: [sum(scores) for scores in zip(*(part(frames) for part in parts))]
-    if method in LM_METHODS:
-        loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, LM_METHODS[method], res.corpus))
-        if loaded.linearization != LM_METHODS[method]:
-            raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {LM_METHODS[method]}")
-        return LMScorer(loaded).score_frames
-    if method == "frame_counts":
-        if res.db is None or not Path(res.db).exists():
-            raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
-        return FrameCountScorer.from_store(res.db, paths_from_env().sql_dir, res.corpus).score_frames
-    if method == "cooccur":
-        return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model),
-                                  robot_terms()).score_frames
-    if method == "word2vec":
-        return VectorScorer(load_vectors(res.vectors or corpus_word2vec(res))).score_frames
-    if method == "conceptnet":
-        if res.conceptnet is None:
-            raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
-        return ConceptNetScorer.from_path(res.conceptnet).score_frames
-    if method == "random":
-        rng = random.Random(res.seed)
-        return lambda frames: [rng.random() for _ in frames]
-    raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+    if method not in SCORERS:
+        raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+    return SCORERS[method].build(res)
 
 
 def scorer_fingerprint(method: str, res: MethodResources) -> str | None:
-    """What a completion calibration of `method` is valid for: the sha256 of each LM checkpoint
-    manifest it uses and the store's frame corpus hash for frame_counts; None for methods whose
-    completion is not calibrated (the baselines)."""
-    from lmcr.lm import checkpoint as ckpt
-    from lmcr.lm.corpus import corpus_hash
-
-    parts = []
-    for part in method.split("+"):
-        if part in LM_METHODS:
-            version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, LM_METHODS[part], res.corpus))
-            parts.append(file_sha256(version / "manifest.json"))
-        elif part == "frame_counts":
-            con = read_connection(res.db)
-            try:
-                parts.append(corpus_hash(con, "frame"))
-            finally:
-                con.close()
-        else:
-            return None
-    return "+".join(parts)
+    """What a completion calibration of `method` is valid for: each part's fingerprint (an LM's
+    checkpoint manifest sha256, the frame corpus hash), joined; None when any part is not calibrated."""
+    parts = [SCORERS[m].fingerprint(res) if m in SCORERS else None for m in method.split("+")]
+    return None if None in parts else "+".join(parts)
 
 
 def robot_terms() -> set[str]:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from collections import Counter
 
+from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import extract_frames
-from lmcr.srl.lexicon import load_lexicon
 from lmcr.srl.parser import find_split, needs_reparse
 from lmcr.srl.priors import RolePriors
 from tests.srl_docs import make_doc

@@ -28,8 +28,8 @@ import numpy as np
 from lmcr.annotate.hits import HitSettings
 from lmcr.files import atomic_dir, check_output_dir
 from lmcr.frame import Frame
+from lmcr.lexicon import load_lexicon
 from lmcr.lm.linearize import sentence_text
-from lmcr.srl.lexicon import load_lexicon
 
 MODES = ("protocol", "corpus", "disagreement")
 FIELDS = ("frame_id", "verb", "role1", "arg1", "role2", "arg2", "sentence")

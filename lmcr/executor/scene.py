@@ -18,7 +18,7 @@ import pybullet as p
 
 from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
 from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
-from lmcr.srl.lexicon import load_lexicon
+from lmcr.lexicon import load_lexicon
 
 TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
 TABLE_TOP = 0.75  # height above the floor

@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 import duckdb
 
+from lmcr.lexicon import load_lexicon
 from lmcr.lm.data import split_by_document
 from lmcr.lm.linearize import frame_text, tokens
 from lmcr.setting import Setting
-from lmcr.srl.lexicon import load_lexicon
 
 
 @dataclass

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import re
 
+from lmcr.lexicon import Lexicon, load_lexicon
 from lmcr.setting import LINEARIZATIONS
-from lmcr.srl.lexicon import Lexicon, load_lexicon
 
 _TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)?|\d+(?:[./]\d+)?")
 NUMBER = "<num>"

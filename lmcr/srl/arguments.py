@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from spacy.tokens import Token
 
+from lmcr.lexicon import Lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
-from lmcr.srl.lexicon import Lexicon
 
 NOUN_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS"})
 HEAD_TAGS = NOUN_TAGS | {"JJ", "VBG"}

