@@ -4,7 +4,6 @@ promote it only if it is not worse. The decision is recorded in DuckDB and publi
 
 from __future__ import annotations
 
-from dataclasses import astuple
 from pathlib import Path
 
 from prefect import flow, get_run_logger, task
@@ -28,8 +27,9 @@ def candidate_task(setting: str, db: str | None, data_dir: str | None, embedding
                    max_minutes: float | None) -> str:
     """Train a new version of `setting` without making it LATEST."""
     paths = paths_from_env(data_dir=data_dir, db=db)
-    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, *astuple(Setting.parse(setting)),
-                         LMConfig(0, embedding), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
+    chosen = Setting.parse(setting)
+    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, chosen.linearization,
+                         chosen.corpus, LMConfig(0, embedding), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
                          promote=False)
     return str(path)
 

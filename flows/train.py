@@ -5,8 +5,6 @@ Settings train one after another: each uses every core through torch's threads a
 
 from __future__ import annotations
 
-from dataclasses import astuple
-
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 
@@ -26,8 +24,9 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
     """Train and publish one setting; returns its best validation perplexity and checkpoint."""
     logger = get_run_logger()
     paths = paths_from_env(data_dir=data_dir, db=db)
+    chosen = Setting.parse(setting)
     path = train_setting(
-        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, *astuple(Setting.parse(setting)),
+        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, chosen.linearization, chosen.corpus,
         LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
         on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
                                          row["val_ppl"], row["tokens_per_s"]),

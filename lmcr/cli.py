@@ -21,8 +21,8 @@ from lmcr.annotate.hits import HitSettings
 from lmcr.config import paper_from_env, paths_from_env
 from lmcr.errors import LMCRError, one_line
 from lmcr.ingest import expand_inputs
-from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
-from lmcr.setting import CORPORA, LINEARIZATIONS
+from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS, resources_from_env
+from lmcr.setting import ALL_SETTINGS, CORPORA, LINEARIZATIONS
 from lmcr.store import check_contracts, connect
 
 console = Console(stderr=True)
@@ -291,8 +291,7 @@ def score(
     frames_csv: Path = typer.Option(..., "--frames", help="CSV with verb, role1, arg1, role2, arg2."),
     out: Path = typer.Option(..., "--out", help="CSV: the input plus one score column per method."),
     methods: str = typer.Option("sentence_lm,frame_lm",
-                                help="Comma-separated: sentence_lm, frame_lm, frame_counts, cooccur, word2vec, "
-                                     "conceptnet, random; a+b sums the scores of a and b."),
+                                help=f"Comma-separated: {', '.join(METHODS)}; a+b sums the scores of a and b."),
     corpus: CorpusSetting = typer.Option("all", help="Training setting of the LM checkpoints."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
@@ -316,8 +315,7 @@ def evaluate(
     ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
     out: Path = typer.Option(..., help="Report folder: report.md, report.html, fig4*.png, figures.json."),
     methods: str = typer.Option(",".join(EVALUATED), help="Comma-separated methods for Table I and Fig. 4 A/B."),
-    settings: str = typer.Option(",".join(("sentence_lm/youcook2", "sentence_lm/recipes", "sentence_lm/all",
-                                           "frame_lm/youcook2", "frame_lm/recipes", "frame_lm/all")),
+    settings: str = typer.Option(",".join(s.label for s in ALL_SETTINGS),
                                  help="LM settings for Fig. 4 C/D (method/corpus)."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Path | None = typer.Option(None, help=VECTORS_HELP),

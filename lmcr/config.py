@@ -47,14 +47,15 @@ def paper_from_env() -> Path | None:
     return Path(os.environ["LMCR_PAPER"]) if os.environ.get("LMCR_PAPER") else None
 
 
-def git_commit(root: Path = REPO_ROOT) -> str:
-    """The checked-out commit (with '+changes' when the tree differs), or why there is none."""
+def git_commit(root: Path = REPO_ROOT) -> str | None:
+    """The checked-out commit (with '+changes' when tracked files differ), or None outside a git checkout
+    or without git."""
     try:
         head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10)
         if head.returncode != 0:
-            return "not a git checkout"
+            return None
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
                                capture_output=True, text=True, timeout=10).stdout.strip()
         return head.stdout.strip() + ("+changes" if dirty else "")
     except (OSError, subprocess.TimeoutExpired):
-        return "git not available"
+        return None

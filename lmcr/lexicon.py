@@ -9,6 +9,8 @@ from functools import lru_cache
 from pathlib import Path
 
 LEXICON_PATH = Path(__file__).with_name("lexicon.json")
+# What the lexicon is made of: a change to either changes every frame the parser finds.
+LEXICON_FILES = (Path(__file__), LEXICON_PATH)
 
 
 @dataclass(frozen=True)

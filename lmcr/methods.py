@@ -106,12 +106,16 @@ def _lm_scorer(linearization: str) -> Callable[[MethodResources], Scorer]:
     return build
 
 
+def lm_version_dir(res: MethodResources, linearization: str) -> Path:
+    """The checkpoint version folder an LM scorer of `linearization` loads (a setting's LATEST resolved)."""
+    from lmcr.lm import checkpoint as ckpt
+
+    return ckpt.resolve(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
+
+
 def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     def fingerprint(res: MethodResources) -> str:
-        from lmcr.lm import checkpoint as ckpt
-
-        version = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
-        return file_sha256(version / "manifest.json")
+        return file_sha256(lm_version_dir(res, linearization) / "manifest.json")
     return fingerprint
 
 

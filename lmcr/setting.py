@@ -13,6 +13,13 @@ LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
 METHOD_OF = {linearization: method for method, linearization in LM_METHODS.items()}
 
 
+def check_corpus(corpus: str) -> str:
+    """`corpus` when it is one of CORPORA (it may become part of SQL text), else ValueError."""
+    if corpus not in CORPORA:
+        raise ValueError(f"corpus must be one of {CORPORA}, not {corpus!r}")
+    return corpus
+
+
 @dataclass(frozen=True, order=True)
 class Setting:
     linearization: str
@@ -21,8 +28,7 @@ class Setting:
     def __post_init__(self) -> None:
         if self.linearization not in LINEARIZATIONS:
             raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {self.linearization!r}")
-        if self.corpus not in CORPORA:
-            raise ValueError(f"corpus must be one of {CORPORA}, not {self.corpus!r}")
+        check_corpus(self.corpus)
 
     @classmethod
     def parse(cls, text: str) -> Setting:

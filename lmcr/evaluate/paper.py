@@ -15,6 +15,9 @@ PAPER_METHODS = {"random": "random", "cooccur": "cooccur", "word2vec": "word2vec
                  "lmcr": "sentence_lm"}
 
 
+ACCURACY = re.compile(r"\d*\.\d+")  # a table cell holding a figure, '0.88' or '.88'
+
+
 class PaperTableError(LMCRError, ValueError):
     """The file has no Table I the reader understands."""
 
@@ -62,12 +65,11 @@ def read_paper_table(tex: Path) -> dict[str, dict[str, float]]:
     table: dict[str, dict[str, float]] = {}
     for line in re.split(r"\\\\", rows.replace(r"\midrule", "").replace(r"\bottomrule", "")):
         cells = [_plain(c) for c in line.split("&")]
-        if not cells[0] or not any(re.fullmatch(r"\d*\.\d+", c) for c in cells[1:]):
+        values = [(position, cell) for position, cell in enumerate(cells[1:], 1) if ACCURACY.fullmatch(cell)]
+        if not cells[0] or not values:
             continue
         verb = "all" if cells[0].lower() == "overall" else cells[0].lower()
-        for position, cell in enumerate(cells[1:], 1):
-            if not re.fullmatch(r"\d*\.\d+", cell):
-                continue
+        for position, cell in values:
             method = PAPER_METHODS.get(headings.get(position, ""))
             if method is None:
                 raise PaperTableError(f"{tex}: Table I value {cell} of row {cells[0]!r} is under no known method")

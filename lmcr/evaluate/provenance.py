@@ -26,34 +26,32 @@ def sample_hashes() -> set[str]:
     return {file_sha256(p) for p in SAMPLE_DIR.rglob("*") if p.is_file()} if SAMPLE_DIR.exists() else set()
 
 
-def _store_files(db: Path | None, ratings: Path) -> tuple[list[dict], list[dict]]:
-    """(rating files, corpus files) recorded in the store, each {file, sha256}."""
-    rating_rows, corpus_rows = [], []
-    for path in {p for p in (db, ratings) if p is not None and Path(p).exists() and Path(p).suffix != ".csv"}:
-        con = read_connection(path)
-        try:
-            tables = {t for (t,) in con.execute("select table_name from duckdb_tables()").fetchall()}
-            if "rating_files" in tables and Path(path) == Path(ratings):
-                rating_rows += con.execute("select source_file, sha256 from rating_files order by 1").fetchall()
-            if "ingested_files" in tables:
-                corpus_rows += con.execute("select source_file, sha256 from ingested_files order by 1").fetchall()
-        finally:
-            con.close()
-    as_dicts = lambda rows: [{"file": f, "sha256": h} for f, h in sorted(set(rows))]  # noqa: E731
-    return as_dicts(rating_rows), as_dicts(corpus_rows)
+def recorded_files(db: Path | None, table: str) -> list[dict]:
+    """{file, sha256} of each input file a store recorded in `table` (ingested_files, rating_files);
+    none when there is no such store or table."""
+    if db is None or not Path(db).is_file():
+        return []
+    con = read_connection(db)
+    try:
+        if not con.execute("select count(*) from duckdb_tables() where table_name = ?", [table]).fetchone()[0]:
+            return []
+        rows = con.execute(f"select distinct source_file, sha256 from {table} order by all").fetchall()
+    finally:
+        con.close()
+    return [{"file": f, "sha256": h} for f, h in rows]
 
 
 def collect(ratings: Path, db: Path | None, checkpoints: dict[str, Path]) -> dict:
     """The provenance of one evaluation; `checkpoints` maps each evaluated LM setting to its version folder."""
-    rating_files, corpus_files = _store_files(db, ratings)
-    if Path(ratings).suffix == ".csv":
-        rating_files = [{"file": str(ratings), "sha256": file_sha256(Path(ratings))}]
+    corpus_files = recorded_files(db, "ingested_files")
+    rating_files = ([{"file": str(ratings), "sha256": file_sha256(Path(ratings))}] if Path(ratings).suffix == ".csv"
+                    else recorded_files(ratings, "rating_files"))
     sample = sample_hashes()
     from_sample = [f["file"] for f in rating_files + corpus_files if f["sha256"] in sample]
     return {
         "date": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
         "lmcr": __version__,
-        "git_commit": git_commit(),
+        "git_commit": git_commit() or "unknown (not a git checkout)",
         "machine": machine(),
         "ratings": rating_files,
         "corpus": corpus_files,

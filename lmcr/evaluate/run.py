@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import astuple, replace
+from dataclasses import replace
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
@@ -16,7 +16,7 @@ from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import MethodResources, lm_checkpoint_dir, make_scorer
+from lmcr.methods import MethodResources, lm_version_dir, make_scorer
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
 
 SETTINGS = tuple(s.label for s in ALL_SETTINGS)
@@ -40,13 +40,18 @@ DEVIATIONS = [
 ]
 
 
+def named_method(name: str, res: MethodResources) -> tuple[str, MethodResources]:
+    """'sentence_lm/youcook2' -> the method and the resources of that corpus; a bare name keeps `res`'s."""
+    method, _, corpus = name.partition("/")
+    return method, replace(res, corpus=corpus or res.corpus)
+
+
 def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None]) -> tuple[dict, list[str]]:
     """Scorers by name ('sentence_lm', 'sentence_lm/youcook2', 'cooccur', ...); unavailable ones noted."""
     scorers, notes = {}, []
     for name in names:
-        method, _, corpus = name.partition("/")
         try:
-            scorers[name] = make_scorer(method, replace(res, corpus=corpus or res.corpus))
+            scorers[name] = make_scorer(*named_method(name, res))
         except (ckpt.CheckpointError, ValueError, FileNotFoundError) as exc:
             notes.append(f"{name} not evaluated: {exc}")
             log(notes[-1])
@@ -81,11 +86,10 @@ def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, P
     """LM setting ('sentence-all') -> the checkpoint version folder each evaluated name uses."""
     found = {}
     for name in names:
-        method, _, corpus = name.partition("/")
+        method, named = named_method(name, res)
         for part in method.split("+"):
             if part in LM_METHODS:
-                setting = Setting(LM_METHODS[part], corpus or res.corpus)
-                found[setting.name] = ckpt.resolve(lm_checkpoint_dir(res.checkpoints, *astuple(setting)))
+                found[Setting(LM_METHODS[part], named.corpus).name] = lm_version_dir(named, LM_METHODS[part])
     return found
 
 

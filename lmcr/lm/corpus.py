@@ -10,7 +10,7 @@ import duckdb
 from lmcr.lexicon import load_lexicon
 from lmcr.lm.data import split_by_document
 from lmcr.lm.linearize import frame_text, tokens
-from lmcr.setting import Setting
+from lmcr.setting import Setting, check_corpus
 
 
 @dataclass
@@ -23,7 +23,7 @@ class TrainingText:
 
 
 def _corpus_filter(corpus: str) -> str:
-    corpus = Setting("sentence", corpus).corpus  # validated: it becomes part of the SQL text
+    check_corpus(corpus)  # it becomes part of the SQL text
     return "" if corpus == "all" else f"and s.corpus = '{corpus}'"
 
 

@@ -24,7 +24,7 @@ from lmcr.store import transaction
 def code_version() -> str:
     """Package version and, in a git checkout, the commit."""
     commit = git_commit()
-    return f"{lmcr.__version__}+{commit[:12]}" if commit[:1].isalnum() and " " not in commit else lmcr.__version__
+    return f"{lmcr.__version__}+{commit[:12]}" if commit else lmcr.__version__
 
 
 def train_setting(

@@ -21,10 +21,9 @@ import duckdb
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from lmcr import lexicon as lexicon_module
 from lmcr.files import atomic_path
 from lmcr.ingest.stage import write_parquet_atomic
-from lmcr.lexicon import LEXICON_PATH, load_lexicon
+from lmcr.lexicon import LEXICON_FILES, load_lexicon
 from lmcr.srl.compounds import Compounds, learn_compounds
 from lmcr.srl.frames import FrameMention
 from lmcr.srl.parser import COMPOUNDS_FILE, PRIORS_FILE, FrameParser, load_nlp
@@ -32,7 +31,6 @@ from lmcr.srl.priors import RolePriors
 from lmcr.store import transaction
 
 SRL_CODE = Path(__file__).parent
-LEXICON_CODE = Path(lexicon_module.__file__)  # the lexicon shapes every frame: part of the SRL code
 FRAME_SCHEMA = pa.schema([
     ("corpus", pa.string()), ("doc_id", pa.string()), ("sent_id", pa.int32()), ("frame_no", pa.int32()),
     ("predicate", pa.string()), ("known", pa.bool_()), ("pred_start", pa.int32()), ("pred_end", pa.int32()),
@@ -78,7 +76,7 @@ class ShardResult:
 def code_fingerprint() -> str:
     """Hash of the SRL code and lexicon: a change to either re-parses every shard."""
     digest = hashlib.sha256()
-    for path in sorted(SRL_CODE.glob("*.py")) + [LEXICON_CODE, LEXICON_PATH]:
+    for path in sorted(SRL_CODE.glob("*.py")) + list(LEXICON_FILES):
         digest.update(path.name.encode() + path.read_bytes())
     return digest.hexdigest()
 
