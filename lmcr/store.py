@@ -12,6 +12,7 @@ from pathlib import Path
 import duckdb
 
 from lmcr.errors import LMCRError, one_line
+from lmcr.files import check_output_file
 
 MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
 
@@ -67,6 +68,7 @@ class Migration:
 def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.DuckDBPyConnection:
     """Open the store (creating its folder) and bring its schema up to date unless read-only."""
     if str(db) != ":memory:":
+        check_output_file(Path(db))  # a data folder that is a file: one line naming it, not mkdir's errno
         Path(db).parent.mkdir(parents=True, exist_ok=True)
     con = _open(db, read_only)
     con.execute("set enable_progress_bar = false")  # library calls report progress their own way

@@ -83,3 +83,12 @@ def test_data_dir_option_is_the_environment_variable(sample_dir, tmp_path, monke
 
     row = json.loads(listed.stdout.splitlines()[0])
     assert row["corpus"] == "recipes" and all(isinstance(row[k], int) for k in row if k != "corpus")
+
+
+def test_a_data_dir_that_is_a_file_is_one_line(tmp_path, monkeypatch):
+    monkeypatch.delenv("LMCR_DB", raising=False)
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    result = runner.invoke(app, ["--data-dir", str(afile), "migrate"])
+    assert result.exit_code == 1 and f"{afile} is a file, not a folder" in result.output
+    assert len(result.output.strip().splitlines()) == 1 and afile.read_text() == "x"
