@@ -15,12 +15,11 @@ import statistics
 import time
 from pathlib import Path
 
-from lmcr.complete import complete, completion_scorer
-from lmcr.config import paths_from_env
+from lmcr.complete import complete
 from lmcr.jsonl import read_jsonl
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD, resources_from_env
-from lmcr.srl.parser import load_parser
+from lmcr.methods import COMPLETION_METHOD
+from lmcr.workspace import Workspace
 
 
 def accuracy(parser, scorer, config, path: Path) -> str:
@@ -59,9 +58,9 @@ def main() -> None:
     parser_.add_argument("--method", default=COMPLETION_METHOD)
     parser_.add_argument("--corpus", default="all")
     args = parser_.parse_args()
-    scorer, config = completion_scorer(args.method, resources_from_env(corpus=args.corpus),
-                                       paths_from_env().data_dir / "calibration")
-    parser = load_parser(None, paths_from_env().srl_dir)
+    ws = Workspace.from_env()
+    scorer, config = ws.completion_scorer(args.method, ws.resources(corpus=args.corpus))
+    parser = ws.parser()
     print(f"{args.method} ({args.corpus}); {config.source}")
     print(accuracy(parser, scorer, config, args.instructions))
     print(latency(parser, scorer, config))

@@ -16,14 +16,12 @@ import argparse
 import random
 import statistics
 
-from lmcr.complete import completion_scorer
-from lmcr.config import paths_from_env
 from lmcr.executor.execute import ExecutionError, execute
 from lmcr.executor.scene import make_scene
 from lmcr.jsonl import InputError
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD, resources_from_env
-from lmcr.srl.parser import load_parser
+from lmcr.methods import COMPLETION_METHOD
+from lmcr.workspace import Workspace
 
 # predicate -> (incomplete instruction, the object it needs that is stated, the one to be filled in)
 TASKS = {
@@ -51,9 +49,9 @@ def main() -> None:
                          help="random extra objects: with none the completion has one choice and the run measures "
                               "execution; with some it also measures the completion")
     args = parser_.parse_args()
-    paths = paths_from_env()
-    scorer, config = completion_scorer(args.method, resources_from_env(), paths.data_dir / "calibration")
-    nlp = load_parser(None, paths.srl_dir)
+    ws = Workspace.from_env()
+    scorer, config = ws.completion_scorer(args.method)
+    nlp = ws.parser()
     objects = load_lexicon().objects
     times, totals = [], {"ok": 0, "n": 0}
     for predicate in args.predicates.split(","):
@@ -64,7 +62,7 @@ def main() -> None:
             others = rng.sample([o for o in objects if o not in (stated, expected)], args.distractors)
             try:
                 scene = make_scene([(label, None) for label in [stated, expected, *others]], seed=rng.randrange(10**6))
-                out = execute(instruction, scene, nlp, scorer, config, paths.data_dir / "robot")
+                out = execute(instruction, scene, nlp, scorer, config, ws.robot)
             except (ExecutionError, InputError):  # the completion named something absent; no room on the table
                 failed += 1
                 continue

@@ -12,10 +12,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from lmcr.config import REPO_ROOT, paths_from_env
+from lmcr.config import REPO_ROOT
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import corpus_summary, ingest_sources
 from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 
 def main() -> None:
@@ -25,7 +26,7 @@ def main() -> None:
     args = parser.parse_args()
     data = args.shared / "data"
     with tempfile.TemporaryDirectory() as tmp:
-        paths = paths_from_env(data_dir=tmp)
+        paths = Workspace.from_env(data_dir=tmp)
         con = connect(paths.db, paths.sql_dir)
         sources = expand_inputs([data / "youcook2" / "youcookii_annotations_trainval.json"], "youcook2")
         sources += expand_inputs([data / "recipes" / "web_recipes.jsonl.gz", data / "recipes" / "feeding_america"], "recipes")

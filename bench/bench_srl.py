@@ -16,10 +16,11 @@ from pathlib import Path
 
 import duckdb
 
-from lmcr.config import REPO_ROOT, paths_from_env
+from lmcr.config import REPO_ROOT
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
+from lmcr.workspace import Workspace
 
 
 def dev_scores(parser, eval_dir: Path) -> str:
@@ -53,7 +54,7 @@ def main() -> None:
     parser.add_argument("--resources", type=Path, default=None)
     parser.add_argument("--sample", type=int, default=40_000)
     args = parser.parse_args()
-    paths = paths_from_env(db=args.db)
+    paths = Workspace.from_env(db=args.db)
     resources = args.resources or paths.srl_dir
     for repair in (False, True):
         srl = load_parser(resources=resources)

@@ -14,33 +14,30 @@ from prefect.artifacts import create_table_artifact
 from lmcr.annotate.quality import QualityRules, alpha_by_verb, decisions, worker_table, write_decisions
 from lmcr.annotate.results import ingest_ratings
 from lmcr.annotate.tasks import TaskConfig, generate_tasks
-from lmcr.config import paths_from_env
-from lmcr.store import check_contracts, connect
+from lmcr.store import check_contracts
+from lmcr.workspace import Workspace
 
 
 @task(name="generate-tasks")
-def tasks_task(out: str, config: TaskConfig, db: str | None, data_dir: str | None) -> dict:
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+def tasks_task(out: str, config: TaskConfig, ws: Workspace) -> dict:
+    with ws.connect() as con:
         meta = generate_tasks(con, Path(out), config)
     get_run_logger().info("%d frames in %d HITs -> %s", meta["frames"], meta["hits"], out)
     return meta
 
 
 @task(name="ingest-ratings", retries=2, retry_delay_seconds=5)  # files may still be copying in
-def ingest_task(path: str, db: str | None, data_dir: str | None) -> dict:
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+def ingest_task(path: str, ws: Workspace) -> dict:
+    with ws.connect() as con:
         counts = ingest_ratings(con, Path(path))
-        check_contracts(con, paths.sql_dir, "ratings")
+        check_contracts(con, ws.sql_dir, "ratings")
     get_run_logger().info("%s: %s", path, counts)
     return counts
 
 
 @task(name="aggregate-ratings")
-def aggregate_task(decisions_out: str | None, db: str | None, data_dir: str | None) -> dict:
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+def aggregate_task(decisions_out: str | None, ws: Workspace) -> dict:
+    with ws.connect() as con:
         alpha = alpha_by_verb(con)
         workers = worker_table(con)
         if decisions_out:
@@ -62,13 +59,13 @@ def annotate_flow(
     data_dir: str | None = None,
 ) -> dict:
     """Generate a batch (with `tasks_out`), ingest result files, aggregate whatever ratings exist."""
+    ws = Workspace.from_env(data_dir=data_dir, db=db)
     out: dict = {}
     if tasks_out:
-        out["tasks"] = tasks_task(tasks_out, task_config, db, data_dir)
-    out["ingested"] = [ingest_task(path, db, data_dir) for path in results]
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+        out["tasks"] = tasks_task(tasks_out, task_config, ws)
+    out["ingested"] = [ingest_task(path, ws) for path in results]
+    with ws.connect() as con:
         rated = con.execute("select count(*) from ratings").fetchone()[0]
     if rated:
-        out["aggregate"] = aggregate_task(decisions_out, db, data_dir)
+        out["aggregate"] = aggregate_task(decisions_out, ws)
     return out

@@ -7,21 +7,22 @@ from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import replace
 from pathlib import Path
 
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
 from prefect.cache_policies import TASK_SOURCE, CacheKeyFnPolicy
 
-from lmcr.config import paper_from_env, paths_from_env
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.files import file_sha256
 from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import EVALUATED, MethodResources, resources_from_env
+from lmcr.methods import EVALUATED, MethodResources
 from lmcr.store import read_connection
+from lmcr.workspace import Workspace
 
 
 def evaluation_key(context, parameters: dict) -> str:
@@ -48,13 +49,11 @@ def evaluation_key(context, parameters: dict) -> str:
 @task(name="evaluate", retries=0, persist_result=True,
       cache_policy=TASK_SOURCE + CacheKeyFnPolicy(cache_key_fn=evaluation_key))
 def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
-                  per_verb: int, seed: int, calibration_dir: str | None, paper: str | None = None) -> dict:
-    logger = get_run_logger()
-    paths = paths_from_env()
-    rated = load_ratings(Path(ratings), paths.sql_dir, set(load_lexicon().predicates))
+                  per_verb: int, seed: int, ws: Workspace) -> dict:
+    """Table I and Fig. 4 on the ratings; completion of the LM methods calibrated into the workspace."""
+    rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
     results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
-                             Path(calibration_dir) if calibration_dir else None, log=logger.info,
-                             ratings_source=Path(ratings), paper=Path(paper) if paper else paper_from_env())
+                             ws.calibration, log=get_run_logger().info, ratings_source=Path(ratings), paper=ws.paper)
     return results.to_json()
 
 
@@ -66,7 +65,7 @@ def evaluate_flow(
     settings: list[str] = list(SETTINGS),  # noqa: B006
     conceptnet: str | None = None,
     vectors: str | None = None,
-    per_verb: int = 50,
+    per_verb: int = EvalConfig.per_verb,
     seed: int = 0,
     corpus: str = "all",
     data_dir: str | None = None,
@@ -74,11 +73,12 @@ def evaluate_flow(
 ) -> dict:
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods."""
-    paths = paths_from_env(data_dir=data_dir)
-    res = resources_from_env(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed, data_dir=data_dir)
-    report = Path(out or paths.data_dir / "report")
-    results = evaluate_task(ratings or str(paths.db), str(report), methods, settings, res, per_verb, seed,
-                            str(paths.data_dir / "calibration"), paper)
+    ws = Workspace.from_env(data_dir=data_dir)
+    if paper:
+        ws = replace(ws, paper=Path(paper))
+    res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
+    report = Path(out or ws.report)
+    results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws)
     create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",
                           table=[{"method": m, "overall": round(acc.get("all", float("nan")), 3)}
                                  for m, acc in results["table1"].items()])

@@ -6,69 +6,47 @@ local Dask cluster and `dask="tcp://scheduler:8786"` on an existing Dask schedul
 
 from __future__ import annotations
 
-import time
-from pathlib import Path
-
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner, TaskRunner
 
-from lmcr.config import paths_from_env
-from lmcr.srl.corpus import (
-    FrameCorpusConfig,
-    Shard,
-    ShardResult,
-    finish_build,
-    parse_shard,
-    prepare_build,
-    shard_output_dir,
-    summarize_build,
-)
-from lmcr.srl.parser import COMPOUNDS_FILE
-from lmcr.store import check_contracts, connect, named_query, query_dicts
+from lmcr.frames.build import build_frame_corpus
+from lmcr.frames.config import FrameCorpusConfig
+from lmcr.frames.shards import Shard, ShardJob, ShardResult, parse_shard
+from lmcr.store import check_contracts, named_query, query_dicts
+from lmcr.workspace import Workspace
 
 
 @task(name="parse-shard", task_run_name="parse shard {shard.number}")
-def parse_shard_task(shard: Shard, out_dir: str, model: str | None, compounds: str) -> ShardResult:
+def parse_shard_task(shard: Shard, job: ShardJob) -> ShardResult:
     """Parse one sentence shard to frame Parquet (runs on the task runner's workers)."""
-    return parse_shard(shard, out_dir, model, compounds)
+    return parse_shard(shard, job)
 
 
-@task(name="load-frames")
-def load_frames_task(db: Path, sql_dir: Path, srl_dir: Path, results: list[ShardResult], build: dict) -> list[dict]:
-    """The single DuckDB writer: load frames, learn role priors, check contracts, count per predicate."""
-    with connect(db, sql_dir) as con:
-        finish_build(con, srl_dir, results, build)
-        check_contracts(con, sql_dir, prefix="frames_")
-        return query_dicts(con, named_query(sql_dir, "frame_counts"))
+def on_task_runner(shards: list[Shard], job: ShardJob) -> list[ShardResult]:
+    """The build's `parse_all`: a task per shard on the flow's task runner."""
+    futures = [parse_shard_task.submit(shard, job) for shard in shards]
+    return [future.result() for future in futures]
 
 
 @flow(name="frames", task_runner=ProcessPoolTaskRunner(max_workers=2))
 def frames_flow(
-    kinds: list[str] = ["instruction", "comment"],  # noqa: B006 - Prefect parameters must be JSON
-    shard_size: int = 20_000,
+    kinds: list[str] = list(FrameCorpusConfig.kinds),  # noqa: B006 - Prefect parameters must be JSON
+    shard_size: int = FrameCorpusConfig.shard_size,
     model: str | None = None,
     db: str | None = None,
     data_dir: str | None = None,
 ) -> dict:
-    """Build the frame corpora from the ingested sentences; skipped when nothing they depend on changed."""
-    logger = get_run_logger()
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    config = FrameCorpusConfig(tuple(kinds), shard_size, model)
-    with connect(paths.db, paths.sql_dir) as con:
-        prepared = prepare_build(con, paths.staging, paths.srl_dir, config)
-    if prepared is None:
-        logger.info("frame corpus unchanged: skipped")
+    """Build the frame corpora from the ingested sentences; skipped when nothing they depend on changed.
+    The store is written by this flow alone: the shard tasks only read and write Parquet."""
+    ws = Workspace.from_env(data_dir=data_dir, db=db)
+    config = FrameCorpusConfig(tuple(kinds), shard_size, model or ws.spacy_model)
+    with ws.connect() as con:
+        build = build_frame_corpus(con, ws.staging, ws.srl_dir, config, on_task_runner, log=get_run_logger().info)
+        check_contracts(con, ws.sql_dir, prefix="frames_")
+        counts = query_dicts(con, named_query(ws.sql_dir, "frame_counts"))
+    if build is None:
         return {"skipped": True}
-    fingerprint, shards = prepared
-    logger.info("parsing %d shards of %d sentences", len(shards), sum(s.sentences for s in shards))
-    out_dir, compounds = shard_output_dir(paths.staging), str(paths.srl_dir / COMPOUNDS_FILE)
-    started = time.perf_counter()
-    futures = [parse_shard_task.submit(s, out_dir, model, compounds) for s in shards]
-    results = [f.result() for f in futures]
-    build = summarize_build(fingerprint, config, results, time.perf_counter() - started)
-    logger.info("%s words at %s words/s", f"{build['words']:,}", f"{build['words_per_s']:,.0f}")
-    counts = load_frames_task(paths.db, paths.sql_dir, paths.srl_dir, results, build)
     create_table_artifact(key="frame-counts", table=counts, description="Robot-predicate frames per corpus")
     return {"skipped": False, **build, "kinds": list(build["kinds"]), "counts": counts}
 

@@ -8,11 +8,10 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner
 
-from lmcr.config import paths_from_env
 from lmcr.ingest import Source, StagedFile, expand_inputs
 from lmcr.ingest.run import corpus_summary, parse_and_stage, plan
 from lmcr.ingest.stage import load_staged
-from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 
 @task(name="parse-and-stage", task_run_name="parse {source.path.name}")
@@ -22,15 +21,15 @@ def parse_and_stage_task(source: Source, sha256: str, staging_dir: Path) -> Stag
 
 
 @task(name="load-duckdb", retries=2, retry_delay_seconds=2)
-def load_task(db: Path, sql_dir: Path, staged: list[StagedFile]) -> list[dict]:
+def load_task(ws: Workspace, staged: list[StagedFile]) -> list[dict]:
     """The single DuckDB writer: load every staged source, then summarise per corpus."""
     logger = get_run_logger()
-    with connect(db, sql_dir) as con:
+    with ws.connect() as con:
         for item in staged:
             load_staged(con, item)
             logger.info("loaded %s: %d in = %d loaded + %d quarantined", Path(item.source_file).name,
                         item.records_in, item.records_loaded, item.records_quarantined)
-        return corpus_summary(con, sql_dir)
+        return corpus_summary(con, ws.sql_dir)
 
 
 @flow(name="ingest", task_runner=ProcessPoolTaskRunner(max_workers=2), log_prints=True)
@@ -42,13 +41,13 @@ def ingest_flow(
     data_dir: str | None = None,
 ) -> list[dict]:
     """Ingest YouCook2 and recipe corpora; unchanged sources are skipped; publishes a summary table."""
-    paths = paths_from_env(data_dir=data_dir, db=db)
+    ws = Workspace.from_env(data_dir=data_dir, db=db)
     sources = expand_inputs([Path(p) for p in youcook2 or []], "youcook2", fmt)
     sources += expand_inputs([Path(p) for p in recipes or []], "recipes", fmt)
-    with connect(paths.db, paths.sql_dir) as con:
+    with ws.connect() as con:
         todo, skipped = plan(con, sources)
     get_run_logger().info("%d sources to ingest, %d unchanged", len(todo), len(skipped))
-    futures = [parse_and_stage_task.submit(s, sha, paths.staging) for s, sha in todo]
-    summary = load_task(paths.db, paths.sql_dir, [f.result() for f in futures])
+    futures = [parse_and_stage_task.submit(s, sha, ws.staging) for s, sha in todo]
+    summary = load_task(ws, [f.result() for f in futures])
     create_table_artifact(key="ingest-summary", table=summary, description="Corpus counts after ingest")
     return summary

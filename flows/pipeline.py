@@ -26,9 +26,13 @@ from flows.evaluate import evaluate_flow
 from flows.frames import frames_flow
 from flows.ingest import ingest_flow
 from flows.train import train_flow
-from lmcr.config import REPO_ROOT, paths_from_env
-from lmcr.methods import COMPLETION_METHOD, EVALUATED, resources_from_env
+from lmcr.config import REPO_ROOT
+from lmcr.evaluate.protocol import EvalConfig
+from lmcr.frames.config import FrameCorpusConfig
+from lmcr.lm.config import LMConfig, TrainConfig
+from lmcr.methods import COMPLETION_METHOD, EVALUATED
 from lmcr.setting import Setting
+from lmcr.workspace import Workspace
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 
@@ -45,11 +49,11 @@ class PipelineParams(BaseModel):
     paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
     settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all"])
     methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
-    shard_size: int = Field(20_000, gt=0)
-    embedding: int = Field(256, gt=0)
-    max_epochs: int = Field(8, gt=0)
-    max_minutes: float | None = Field(55.0, gt=0)
-    per_verb: int = Field(50, gt=0)
+    shard_size: int = Field(FrameCorpusConfig.shard_size, gt=0)
+    embedding: int = Field(LMConfig.embedding, gt=0)
+    max_epochs: int = Field(TrainConfig.max_epochs, gt=0)
+    max_minutes: float | None = Field(TrainConfig.max_minutes, gt=0)
+    per_verb: int = Field(EvalConfig.per_verb, gt=0)
     seed: int = 0
     executor_instruction: str = "pour me some water"
     executor_scene: str = str(SAMPLE / "scenes" / "pour_me_some_water.json")
@@ -60,16 +64,12 @@ class PipelineParams(BaseModel):
 def executor_check_task(instruction: str, scene: str, data_dir: str | None) -> dict:
     """The default completion (published sentence LM times the frame counts) completes an instruction and
     the simulated Baxter carries it out."""
-    from lmcr.complete import completion_scorer
     from lmcr.executor.execute import execute
     from lmcr.executor.scene import load_scene
-    from lmcr.srl.parser import load_parser
 
-    paths = paths_from_env(data_dir=data_dir)
-    scorer, config = completion_scorer(COMPLETION_METHOD, resources_from_env(data_dir=data_dir),
-                                       paths.data_dir / "calibration")
-    out = execute(instruction, load_scene(Path(scene)), load_parser(None, paths.srl_dir), scorer, config,
-                  paths.data_dir / "robot")
+    ws = Workspace.from_env(data_dir=data_dir)
+    scorer, config = ws.completion_scorer(COMPLETION_METHOD)
+    out = execute(instruction, load_scene(Path(scene)), ws.parser(), scorer, config, ws.robot)
     return {k: out[k] for k in ("frame", "chosen_object", "success", "checks")}
 
 
@@ -93,7 +93,7 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
                           table=[{"instruction": params.executor_instruction, "chosen_object": check["chosen_object"],
                                   "frame": json.dumps(check["frame"]["roles"]), "success": check["success"]}])
     checkpoints = {r["setting"]: r["checkpoint"] for r in trained}
-    report = str(paths_from_env(data_dir=data_dir).data_dir / "report" / "report.html")
+    report = str(Workspace.from_env(data_dir=data_dir).report / "report.html")
     print(f"report: {report}")
     for setting, path in checkpoints.items():
         print(f"checkpoint {setting}: {path}")

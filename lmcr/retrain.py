@@ -25,6 +25,7 @@ from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
 from lmcr.methods import COMPLETION_METHOD, MethodResources, make_scorer
 from lmcr.setting import METHOD_OF, Setting
+from lmcr.store import insert_rows
 
 
 @dataclass(frozen=True)
@@ -119,5 +120,4 @@ def decide(con: duckdb.DuckDBPyConnection, checkpoints: Path, candidate: Path, r
 def record(con: duckdb.DuckDBPyConnection, row: dict) -> None:
     cols = ["setting", "inputs_sha256", "decision", "reason", "candidate", "current", "candidate_accuracy",
             "current_accuracy", "calibration"]
-    con.execute(f"insert into retrain_decisions ({', '.join(cols)}) values ({', '.join('?' * len(cols))})",
-                [row.get(c) for c in cols])
+    insert_rows(con, "retrain_decisions", [{c: row.get(c) for c in cols}])

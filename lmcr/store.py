@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import duckdb
+import pyarrow as pa
 
 from lmcr.errors import LMCRError, one_line
 from lmcr.files import check_output_file
@@ -52,6 +53,24 @@ def transaction(con: duckdb.DuckDBPyConnection) -> Iterator[duckdb.DuckDBPyConne
         con.execute("rollback")
         raise
     con.execute("commit")
+
+
+def insert_rows(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: str | None = None,
+                convert: dict[str, str] | None = None) -> None:
+    """Insert dict rows by column name (as sqlite-utils' `insert_all`): columns the rows lack take their
+    defaults; with `key`, rows whose key is already in the table are left as they are; `convert` maps a
+    column to the SQL expression that converts its value on the way in (e.g. `mturk_time(submit_time)`)."""
+    if not rows:
+        return
+    names = [d[0] for d in con.execute(f"select * from {table} limit 0").description]
+    names = [n for n in names if n in rows[0]]
+    con.register("_insert_batch", pa.Table.from_pylist([{n: r.get(n) for n in names} for r in rows]))
+    try:
+        values = ", ".join((convert or {}).get(n, n) for n in names)
+        where = f" where {key} not in (select {key} from {table})" if key else ""
+        con.execute(f"insert into {table} ({', '.join(names)}) select {values} from _insert_batch{where}")
+    finally:
+        con.unregister("_insert_batch")
 
 
 @dataclass(frozen=True)

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from lmcr.config import REPO_ROOT, Paths, paths_from_env
+from lmcr.config import REPO_ROOT
 from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 
@@ -19,13 +20,13 @@ def sample_dir() -> Path:
 
 
 @pytest.fixture
-def paths(tmp_path: Path) -> Paths:
+def paths(tmp_path: Path) -> Workspace:
     """A private data dir and store for one test."""
-    return paths_from_env(data_dir=tmp_path / "data")
+    return Workspace.from_env(data_dir=tmp_path / "data")
 
 
 @pytest.fixture
-def con(paths: Paths):
+def con(paths: Workspace):
     connection = connect(paths.db, paths.sql_dir)
     yield connection
     connection.close()

@@ -385,11 +385,10 @@ BAD_EXECUTE_LINES = st.one_of(
 @FUZZ
 @given(lines=st.lists(BAD_EXECUTE_LINES, min_size=1, max_size=4))
 def test_batch_execute_reports_every_bad_line(lines, monkeypatch):
-    import lmcr.cli
-    import lmcr.complete
+    from lmcr.workspace import Workspace
 
-    monkeypatch.setattr(lmcr.complete, "completion_scorer", lambda *a: (None, None))
-    monkeypatch.setattr(lmcr.cli, "_srl_parser", lambda *a: None)
+    monkeypatch.setattr(Workspace, "completion_scorer", lambda *a: (None, None))
+    monkeypatch.setattr(Workspace, "parser", lambda *a: None)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         (tmp / "in.jsonl").write_bytes(b"\n".join(lines) + b"\n")

@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from lmcr.config import paths_from_env
 from lmcr.counts import FrameCountScorer
 from lmcr.store import connect
+from lmcr.workspace import Workspace
 
 FILLERS = [("pour", "Theme", "water", 4), ("pour", "Destination", "cup", 3), ("pour", "Destination", "bowl", 1),
            ("cut", "Theme", "water", 2)]
@@ -38,7 +38,7 @@ def test_seen_together_beats_seen_apart_and_unseen():
 
 def test_counts_come_from_the_stores_robot_frames(tmp_path):
     db = tmp_path / "lmcr.duckdb"
-    con = connect(db, paths_from_env().sql_dir)
+    con = connect(db, Workspace.from_env().sql_dir)
     frames = [("youcook2", "d1", 0, 0, "pour", True), ("recipes", "d2", 0, 0, "pour", True),
               ("recipes", "d2", 1, 0, "stir", False)]
     con.executemany("insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
@@ -48,9 +48,9 @@ def test_counts_come_from_the_stores_robot_frames(tmp_path):
              ("recipes", "d2", 1, 0, "Theme", "soup")]
     con.executemany("insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles)
     con.close()
-    every = FrameCountScorer.from_store(db, paths_from_env().sql_dir, "all")
+    every = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all")
     assert every.value == {"water": 1, "cup": 1, "milk": 1}  # no null, no generic predicate
     assert every.pair == {("pour", "Theme", "water", "Destination", "cup"): 1, ("pour", "Destination", "cup", "Theme", "water"): 1}
-    assert FrameCountScorer.from_store(db, paths_from_env().sql_dir, "recipes").value == {"milk": 1}
+    assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "recipes").value == {"milk": 1}
     with pytest.raises(ValueError, match="no robot-predicate frames for corpus 'nyc'"):
-        FrameCountScorer.from_store(db, paths_from_env().sql_dir, "nyc")
+        FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "nyc")

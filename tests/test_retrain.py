@@ -31,10 +31,9 @@ def run(tmp_path, ratings):
 
 def assert_completion_is_calibrated(data_dir):
     """What `lmcr complete` loads after the promotion is a calibration of the promoted checkpoint."""
-    from lmcr.complete import completion_scorer
-    from lmcr.methods import resources_from_env
+    from lmcr.workspace import Workspace
 
-    _, config = completion_scorer("sentence_lm", resources_from_env(data_dir=data_dir), data_dir / "calibration")
+    _, config = Workspace.from_env(data_dir=data_dir).completion_scorer("sentence_lm")
     assert config.source.startswith("calibrated on"), config.source
 
 

@@ -8,10 +8,11 @@ import pytest
 from typer.testing import CliRunner
 
 from lmcr.cli import app
+from lmcr.frames.build import build_frame_corpus, process_pool
+from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
-from lmcr.srl.corpus import FrameCorpusConfig, build_frame_corpus
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
 from lmcr.store import check_contracts
@@ -91,7 +92,7 @@ def test_frame_corpus_on_sample(con, paths, sample_dir):
         "recipes")
     ingest_sources(con, sources, paths.staging, workers=1)
     config = FrameCorpusConfig(shard_size=40)
-    build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers=2)
+    build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2))
     assert build["sentences"] == con.execute(
         "select count(*) from sentences where kind in ('instruction', 'comment')").fetchone()[0]
     check_contracts(con, paths.sql_dir)
@@ -100,5 +101,5 @@ def test_frame_corpus_on_sample(con, paths, sample_dir):
     assert ("blender",) in pours and ("glass",) in pours
     assert (paths.srl_dir / "compounds.json").exists() and (paths.srl_dir / "role_priors.json").exists()
     before = con.execute("select * from frame_roles order by all").fetchall()
-    assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, workers=2) is None  # unchanged: skipped
+    assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2)) is None  # unchanged: skipped
     assert con.execute("select * from frame_roles order by all").fetchall() == before

@@ -19,11 +19,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import duckdb
-import pyarrow as pa
 
 from lmcr.files import file_sha256
 from lmcr.jsonl import InputError, read_lines
-from lmcr.store import transaction
+from lmcr.store import insert_rows, transaction
 
 META = ("HITId", "AssignmentId", "WorkerId", "AssignmentStatus")
 ITEM_FIELDS = ("verb", "role1", "arg1", "role2", "arg2")
@@ -177,38 +176,22 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
         workers.setdefault(row["WorkerId"], {"worker_id": row["WorkerId"], "first_file": source})
         ratings += [{"assignment_id": aid, **item} for item in a.items]
     with transaction(con):
-        _insert(con, "hits", list(hits.values()), "hit_id")
-        _insert(con, "workers", list(workers.values()), "worker_id")
-        _insert(con, "assignments", new)
-        _insert(con, "ratings", ratings)
-        _insert(con, "quarantine", quarantine)
+        insert_rows(con, "hits", list(hits.values()), "hit_id", CONVERTED)
+        insert_rows(con, "workers", list(workers.values()), "worker_id")
+        insert_rows(con, "assignments", new, convert=CONVERTED)
+        insert_rows(con, "ratings", ratings)
+        insert_rows(con, "quarantine", quarantine)
         for sql, params in (("update assignments set status = ? where assignment_id = ?", status_updates),
                             ("update assignments set conflict = ? where assignment_id = ?", conflicts)):
             if params:
                 con.executemany(sql, params)
-        con.execute(f"insert into rating_files (sha256, source_file, layout, {', '.join(counts)}) values "
-                    f"(?, ?, ?, {', '.join('?' * len(counts))})", [parsed.sha256, source, parsed.layout, *counts.values()])
+        insert_rows(con, "rating_files", [{"sha256": parsed.sha256, "source_file": source, "layout": parsed.layout,
+                                           **counts}])
     return {"source_file": source, "layout": parsed.layout, **counts}
 
 
 # MTurk's text values converted on insert by the macros of migration 010 ('$0.30', 'Tue Nov 17 ... PST 2026').
 CONVERTED = {"reward": "mturk_reward(reward)", "submit_time": "mturk_time(submit_time)"}
-
-
-def _insert(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: str | None = None) -> None:
-    """Insert dict rows by column name; with `key`, rows whose key already exists are left as they are."""
-    if not rows:
-        return
-    names = [d[0] for d in con.execute(f"select * from {table} limit 0").description]
-    names = [n for n in names if n in rows[0]]
-    con.register("batch", pa.Table.from_pylist([{n: r.get(n) for n in names} for r in rows]))
-    try:
-        cols = ", ".join(names)
-        values = ", ".join(CONVERTED.get(n, n) for n in names)
-        where = f" where {key} not in (select {key} from {table})" if key else ""
-        con.execute(f"insert into {table} ({cols}) select {values} from batch{where}")
-    finally:
-        con.unregister("batch")
 
 
 def ingest_ratings(con: duckdb.DuckDBPyConnection, path: Path) -> dict:

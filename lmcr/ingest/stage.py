@@ -12,7 +12,7 @@ import pyarrow.parquet as pq
 from lmcr.files import atomic_path
 from lmcr.ingest.detect import Source
 from lmcr.ingest.records import IngestError, ParsedFile
-from lmcr.store import transaction
+from lmcr.store import insert_rows, transaction
 
 DOCUMENT_SCHEMA = pa.schema([
     ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("title", pa.string()),
@@ -102,12 +102,9 @@ def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
         columns = ", ".join(schema.names)
         con.execute(f"insert into {table} ({columns}) select {columns} from read_parquet(?)",
                     [staged.parquet[table]])
-    con.execute(
-        "insert into ingested_files (source_file, sha256, format, corpus, encoding, records_in, records_loaded,"
-        " records_quarantined, documents, sentences, words) values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-        [staged.source_file, staged.sha256, staged.format, staged.corpus, staged.encoding, staged.records_in,
-         staged.records_loaded, staged.records_quarantined, staged.documents, staged.sentences, staged.words],
-    )
+    insert_rows(con, "ingested_files", [{k: getattr(staged, k) for k in (
+        "source_file", "sha256", "format", "corpus", "encoding", "records_in", "records_loaded", "records_quarantined",
+        "documents", "sentences", "words")}])
 
 
 def load_staged(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:

@@ -6,31 +6,11 @@ embedding = hidden size (tying needs them equal), V vocabulary.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-
 import torch
 from torch import nn
 from torch.nn import functional as F
 
-
-@dataclass(frozen=True)
-class LMConfig:
-    vocab_size: int
-    embedding: int = 256
-    layers: int = 2
-    dropout: float = 0.3
-    # Training softmax over the targets plus this many shared negatives (0: full softmax), used only
-    # when the vocabulary is over 8x larger: the full softmax over a 30k vocabulary is most of a CPU
-    # training step, over a few thousand words it costs little and samples only add noise. Validation
-    # perplexity and scoring are always exact.
-    sampled: int = 1024
-
-    @property
-    def uses_sampling(self) -> bool:
-        return 0 < self.sampled and 8 * self.sampled < self.vocab_size
-
-    def to_json(self) -> dict:
-        return asdict(self)
+from lmcr.lm.config import LMConfig
 
 
 class RecurrentLM(nn.Module):

