@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 SAMPLE := data/sample
 
-.PHONY: setup demo test bench browser clean
+.PHONY: setup demo test bench browser clean speech-audio speech-bench
 
 setup: $(VENV)/.installed
 
@@ -40,3 +40,13 @@ bench: setup
 
 clean:
 	rm -rf $(VENV) data/staging data/lmcr.duckdb annotation/browser/node_modules
+
+# Spoken dev instructions (espeak-ng voices x rates, clean / 20 dB noise / telephone) and the recogniser
+# bench on them; SHARED is the shared data folder, LMCR_DATA_DIR a workspace with a built speech model.
+SHARED ?= ../shared
+SPEECH_AUDIO ?= data/speech-dev
+speech-audio: setup
+	$(BIN)/python bench/render_speech.py --instructions $(SHARED)/eval/instructions_dev.jsonl --out $(SPEECH_AUDIO)
+
+speech-bench: setup
+	$(BIN)/python bench/bench_speech.py --index $(SPEECH_AUDIO)/index.jsonl

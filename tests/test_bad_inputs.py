@@ -129,6 +129,7 @@ def _write_jsonl(path: Path, valid: list[str], at: int, bad: bytes) -> None:
 
 SRL_FIELDS = {"id": "a", "text": "pour the water into the cup"}
 COMPLETE_FIELDS = {"id": "a", "instruction": "pour me some water", "objects": ["cup", "plate"]}
+LISTEN_FIELDS = {"id": "a", "audio": "said.wav"}
 
 
 def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case) -> bool:
@@ -158,6 +159,13 @@ def test_srl_batch_rejects_malformed_jsonl(case):
 def test_complete_batch_rejects_malformed_jsonl(case):
     if _check_rejected("complete", COMPLETE_FIELDS, "instruction", "objects", case):
         _count("complete JSONL")
+
+
+@FUZZ
+@given(case=_jsonl_case(LISTEN_FIELDS, "audio", None))
+def test_listen_batch_rejects_malformed_jsonl(case):
+    if _check_rejected("listen", LISTEN_FIELDS, "audio", None, case):
+        _count("listen JSONL")
 
 
 def test_srl_batch_text_over_the_length_cap_is_one_line(tmp_path):

@@ -132,6 +132,8 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     assert '<div class="scroll"><table>' in page and "<blockquote>" in page and page.count("data:image/png") == 4
     second = pipeline_flow(params)
     assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
+    speech = tmp_path / "speech" / "en-us"  # the speech model: built once, kept on the unchanged re-run
+    assert (speech / "LATEST").exists() and len([v for v in speech.iterdir() if v.name.startswith("v")]) == 1
     assert second["table1"] == first["table1"]
     # What a Prefect UI user sees of the run: Table I, the report and the executor check as artifacts.
     assert {"table-i", "evaluation-report", "evaluation-report-html", "executor-check"} <= artifact_keys()

@@ -115,11 +115,11 @@ def test_a_file_dropped_from_the_manifest_is_refused(published):
     manifest = json.loads((path / "manifest.json").read_text())
     del manifest["files"]["model.pt"]
     (path / "manifest.json").write_text(json.dumps(manifest))
-    with pytest.raises(ckpt.CheckpointError, match="not the checkpoint's files"):
+    with pytest.raises(ckpt.CheckpointError, match="not the version's files"):
         ckpt.load(path)
     manifest["files"] = {}
     (path / "manifest.json").write_text(json.dumps(manifest))
-    with pytest.raises(ckpt.CheckpointError, match="not the checkpoint's files"):
+    with pytest.raises(ckpt.CheckpointError, match="not the version's files"):
         ckpt.load(path)
 
 
@@ -384,10 +384,11 @@ def test_every_lmcr_error_is_one_lmcr_error():
     import lmcr.lm.checkpoint
     import lmcr.srl.parser
     import lmcr.store
+    import lmcr.versions
     from lmcr.errors import LMCRError
 
     modules = [lmcr.baselines.vectors, lmcr.complete, lmcr.evaluate.paper, lmcr.executor.execute, lmcr.files,
-               lmcr.ingest.records, lmcr.jsonl, lmcr.lm.checkpoint, lmcr.srl.parser, lmcr.store]
+               lmcr.ingest.records, lmcr.jsonl, lmcr.lm.checkpoint, lmcr.srl.parser, lmcr.store, lmcr.versions]
     errors = {obj for m in modules for obj in vars(m).values()
               if isinstance(obj, type) and issubclass(obj, Exception) and obj.__module__ == m.__name__}
     assert len(errors) >= 12

@@ -1,0 +1,94 @@
+"""Speech bench: word error rate and frame accuracy per voice, rate and noise, and decoding speed.
+
+    python bench/render_speech.py --instructions ../shared/eval/instructions_dev.jsonl --out /tmp/speech
+    lmcr --data-dir DATA speech-lm
+    python bench/bench_speech.py --index /tmp/speech/index.jsonl   # LMCR_DATA_DIR=DATA
+
+Frame accuracy (`frame`): the first robot frame of the reading `lmcr listen` takes (the best text, or
+the first close alternative with a robot predicate; `best`: the best text alone) has the right predicate, every stated role right and
+the missing role empty (as `lmcr srl-eval --instructions`); `text` is the same for the written
+instruction, the ceiling the recogniser can reach with this parser. Decoding runs on one core.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+from lmcr.lexicon import load_lexicon  # noqa: E402
+from lmcr.speech.audio import RATE, read_wav  # noqa: E402
+from lmcr.speech.domain_lm import tokenize  # noqa: E402
+from lmcr.speech.listen import understood_reading  # noqa: E402
+from lmcr.speech.recognize import Recognizer  # noqa: E402
+from lmcr.srl.evaluate import instruction_correct  # noqa: E402
+from lmcr.srl.parser import NoPredicateError, parse_instruction  # noqa: E402
+from lmcr.workspace import Workspace  # noqa: E402
+
+
+def word_errors(ref: list[str], hyp: list[str]) -> int:
+    """Levenshtein distance over words (substitutions + deletions + insertions)."""
+    row = list(range(len(hyp) + 1))
+    for i, r in enumerate(ref, 1):
+        prev, row[0] = row[0], i
+        for j, h in enumerate(hyp, 1):
+            prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (r != h))
+    return row[-1]
+
+
+def first_frame(parser, text: str) -> dict | None:
+    try:
+        return parse_instruction(parser, text).to_json() if text else None
+    except NoPredicateError:
+        return None
+
+
+def main() -> None:
+    args_parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    args_parser.add_argument("--index", type=Path, required=True, help="index.jsonl of render_speech.py")
+    args_parser.add_argument("--model", type=Path, help="speech model (default: the workspace's)")
+    args_parser.add_argument("--lw", type=float, default=None, help="language weight (default: the recogniser's)")
+    args = args_parser.parse_args()
+    ws = Workspace.from_env()
+    lexicon = load_lexicon()
+    recognizer = Recognizer(args.model or ws.speech, lexicon, **({"lw": args.lw} if args.lw else {}))
+    parser = ws.parser()
+    rows = [json.loads(line) for line in args.index.read_text(encoding="utf-8").splitlines() if line.strip()]
+    groups: dict[tuple, dict] = defaultdict(lambda: defaultdict(float))
+    speed = []
+    for row in rows:
+        samples = read_wav(args.index.parent / row["audio"])
+        started = time.perf_counter()
+        heard = recognizer.transcribe(samples)
+        reading = understood_reading(parser, heard) if heard.text else ""
+        speed.append((time.perf_counter() - started, len(samples) / RATE))
+        ref = tokenize(row["text"])
+        for key in ((row["voice"], row["rate"], row["condition"]), ("all", "", "")):
+            g = groups[key]
+            g["n"] += 1
+            g["errors"] += word_errors(ref, tokenize(heard.text))
+            g["words"] += len(ref)
+            g["best"] += instruction_correct(first_frame(parser, heard.text), row["expected"], row["missing"])
+            g["frame"] += instruction_correct(first_frame(parser, reading), row["expected"], row["missing"])
+            g["text"] += instruction_correct(first_frame(parser, row["text"]), row["expected"], row["missing"])
+            g["asked"] += bool(heard.doubts)
+    print(f"{'voice':<12} {'rate':>4} {'condition':<10} {'n':>4} {'WER':>6} {'best':>6} {'frame':>6} {'text':>6} {'asks':>5}")
+    for (voice, rate, condition), g in sorted(groups.items(), key=lambda kv: (kv[0][0] == "all", str(kv[0]))):
+        print(f"{voice:<12} {rate!s:>4} {condition:<10} {int(g['n']):>4} {g['errors'] / g['words']:>6.3f} "
+              f"{g['best'] / g['n']:>6.3f} {g['frame'] / g['n']:>6.3f} {g['text'] / g['n']:>6.3f} {g['asked'] / g['n']:>5.2f}")
+    per_second = [t / s for t, s in speed]
+    print(f"decoding: median {statistics.median(per_second):.3f} s per audio second "
+          f"({3 * statistics.median(per_second):.2f} s for a 3-second utterance; target 0.5), "
+          f"{len(speed)} utterances, {sum(s for _, s in speed):.0f} s of audio")
+
+
+if __name__ == "__main__":
+    main()

