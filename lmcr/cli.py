@@ -631,6 +631,63 @@ def listen(
     console.print(f"{len(results):,} recordings -> {output} ({errors} could not be decoded)")
 
 
+@app.command()
+def robot(
+    scene: Path = typer.Option(..., help="Scene JSON: the objects on the table."),
+    turns: Path | None = typer.Option(None, help="Scripted turns, one per line (default: type them; empty line ends)."),
+    audio_dir: Path | None = typer.Option(None, help="Spoken turns: the folder's WAV files in name order."),
+    method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instructions."),
+    corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root or folder."),
+    json_out: bool = typer.Option(False, "--json", help="Print each outcome as one JSON line."),
+) -> None:
+    """Talk to the robot: instructions and answers to its questions, typed, scripted or spoken."""
+    import json
+
+    from lmcr.dialogue import converse
+    from lmcr.executor.scene import load_scene
+    from lmcr.jsonl import read_bytes
+
+    if turns is not None and audio_dir is not None:
+        fail("give --turns or --audio-dir, not both")
+    ws = Workspace.from_env()
+    layout = load_scene(scene)
+    if turns is not None:
+        lines = read_bytes(turns).decode("utf-8", errors="replace").splitlines()
+        said = iter([t.strip() for t in lines if t.strip()])
+    elif audio_dir is not None:
+        said = _heard_turns(ws, audio_dir)
+    else:
+        said = iter(lambda: input("> ").strip(), "")
+    scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
+    outcomes = converse(said, layout, ws.parser(), scorer, config, ws.robot,
+                        say=lambda line: console.print(escape(line), highlight=False))
+    if json_out:
+        for outcome in outcomes:
+            print(json.dumps({k: v for k, v in outcome.items() if k not in ("waypoints", "detections")}))
+
+
+def _heard_turns(ws: Workspace, folder: Path):
+    """The transcripts of a folder's WAV files, in name order (a file that cannot be heard is skipped
+    with its reason)."""
+    from lmcr.speech.audio import AudioError, read_wav
+
+    wavs = sorted(folder.glob("*.wav")) if folder.is_dir() else []
+    if not wavs:
+        fail(f"{folder}: no .wav files")
+    recognizer = ws.recognizer()
+    for wav in wavs:
+        try:
+            heard = recognizer.transcribe(read_wav(wav))
+        except AudioError as exc:
+            console.print(escape(f"{exc}"), highlight=False)
+            continue
+        if heard.text:
+            yield heard.text
+        else:
+            console.print(escape(f"{wav}: {heard.reason}"), highlight=False)
+
+
 def check_record_text(line: int, record: dict, field: str, path: Path) -> dict:
     """A batch record whose text field the parser can take (length cap), else the one-line error."""
     from lmcr.jsonl import check_text

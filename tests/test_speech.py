@@ -162,3 +162,15 @@ def test_a_model_that_was_never_built_is_one_line(tmp_path):
     ws = Workspace.from_env(data_dir=tmp_path)
     done = _lmcr(ws, "listen", str(FIXTURES / "fry_the_egg.wav"))
     assert done.returncode != 0 and "lmcr speech-lm" in done.stderr + done.stdout and "Traceback" not in done.stderr
+
+
+def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
+    scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    (tmp_path / "turns").mkdir()
+    shutil.copy(FIXTURES / "pour_me_some_water.wav", tmp_path / "turns" / "01.wav")
+    done = _lmcr(speech_workspace, "robot", "--scene", str(tmp_path / "scene.json"), "--audio-dir",
+                 str(tmp_path / "turns"), "--method", "sentence_lm", "--corpus", "youcook2", "--json")
+    assert done.returncode == 0, done.stderr + done.stdout
+    outcome = json.loads(done.stdout.strip().splitlines()[-1])
+    assert outcome["frame"]["roles"] == {"Theme": "water", "Destination": "cup"} and outcome["success"]

@@ -27,15 +27,18 @@ def _connect() -> None:
 
 
 def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
-            frames: list | None = None) -> dict:
+            frames: list | None = None, answer: dict[str, str] | None = None) -> dict:
     """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success.
-    With `frames` (a list), camera images are appended at every waypoint for rendering."""
+    With `frames` (a list), camera images are appended at every waypoint for rendering. `answer` (role ->
+    object) is what a person answered to the completion's question: it fills those roles instead."""
     started = time.perf_counter()
     _connect()
     robot = build_world(scene, cache_dir)
     seen = detect(scene.bodies)
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config)
     frame = completion["frame"]
+    if answer:
+        frame = {"predicate": frame["predicate"], "roles": {**frame["roles"], **answer}}
     predicate, roles = frame["predicate"], frame["roles"]
     held_role, target_role, plan = PLANS[predicate]
     try:
@@ -49,7 +52,9 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
         frames.append(capture()[0])
     checks = plan(arm, held, target)
     waypoints_ok = all(w["error_m"] <= TOLERANCE for w in arm.log)
-    return {"frame": frame, "chosen_object": completion["candidates"][0]["object"] if completion["candidates"] else None,
+    chosen = next(iter(answer.values())) if answer else (
+        completion["candidates"][0]["object"] if completion["candidates"] else None)
+    return {"frame": frame, "chosen_object": chosen,
             "success": bool(checks["ok"] and waypoints_ok and arm.grasps_ok), "waypoints": arm.log,
             "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
                        "grasped": arm.grasps_ok, "waypoints_within_tolerance": waypoints_ok},
