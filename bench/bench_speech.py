@@ -68,7 +68,7 @@ def main() -> None:
         samples = read_wav(args.index.parent / row["audio"])
         started = time.perf_counter()
         heard = recognizer.transcribe(samples)
-        reading = understood_reading(parser, heard) if heard.text else ""
+        reading = understood_reading(parser, heard, row.get("objects")) if heard.text else ""
         speed.append((time.perf_counter() - started, len(samples) / RATE))
         ref = tokenize(row["text"])
         for key in ((row["voice"], row["rate"], row["condition"]), ("all", "", "")):

@@ -74,7 +74,8 @@ def main() -> None:
                 for condition, path in (("clean", clean), (f"noise{args.snr:g}", noisy), ("telephone", phone)):
                     index.append({"id": f"{rec['id']}-{tag}-{condition}", "audio": str(path.relative_to(args.out)),
                                   "text": rec["instruction"], "voice": voice, "rate": rate, "condition": condition,
-                                  "expected": rec.get("expected"), "missing": rec.get("missing")})
+                                  "objects": rec.get("objects"), "expected": rec.get("expected"),
+                                  "missing": rec.get("missing")})
             print(f"{tag}: {len(records)} instructions x 3 conditions", flush=True)
     (args.out / "index.jsonl").write_text("".join(json.dumps(r) + "\n" for r in index), encoding="utf-8")
     print(f"{len(index)} WAVs -> {args.out / 'index.jsonl'}")

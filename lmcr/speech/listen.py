@@ -1,8 +1,9 @@
 """From audio to frames: transcribe, pick the reading the robot understands, and ask when unsure.
 
 The recogniser's best text is not always the one the robot can act on ("a few in the chocolate" when
-the close alternative is "dip a few in the chocolate"); among the best text and its close n-best
-alternatives, the first that parses to a robot predicate is taken. When close alternatives put a
+an alternative is "dip a few in the chocolate"); among the best text and its n-best alternatives, the
+first whose robot frame names only objects on the table is taken when the scene is known, else the
+first that parses to a robot predicate. When close alternatives put a
 different predicate or object word in the same place, the robot asks instead of acting.
 """
 
@@ -16,12 +17,17 @@ from lmcr.speech.recognize import Recognizer, Transcript
 from lmcr.srl.parser import FrameParser
 
 
-def understood_reading(parser: FrameParser, heard: Transcript) -> str:
-    """The best text, or the first close alternative with a robot predicate when the best has none."""
-    for text in (heard.text, *heard.alternatives):
-        if any(frame.known for frame in parser.parse(text)):
-            return text
-    return heard.text
+def understood_reading(parser: FrameParser, heard: Transcript, objects: list[str] | None = None) -> str:
+    """The first of the best text and its n-best alternatives whose robot frame names only objects on the
+    table (`objects`, when the scene is known), else the first with a robot predicate, else the best."""
+    readings = [(text, [f for f in parser.parse(text) if f.known]) for text in (heard.text, *heard.alternatives)]
+    if objects is not None:
+        on_table = set(objects)
+        for text, frames in readings:
+            stated = [v for v in frames[0].roles.values() if v] if frames else []
+            if stated and set(stated) <= on_table:
+                return text
+    return next((text for text, frames in readings if frames), heard.text)
 
 
 def clarifying_question(heard: Transcript) -> str | None:
@@ -32,10 +38,11 @@ def clarifying_question(heard: Transcript) -> str | None:
     return f"Did you say {', '.join(options[:-1])} or {options[-1]}?"
 
 
-def listen(recognizer: Recognizer, parser: FrameParser, audio: Path) -> dict:
-    """One WAV file -> {text, frames, confidence, alternatives, question, [reason]} (frames as `lmcr srl`)."""
+def listen(recognizer: Recognizer, parser: FrameParser, audio: Path, objects: list[str] | None = None) -> dict:
+    """One WAV file -> {text, frames, confidence, alternatives, question, [reason]} (frames as `lmcr srl`);
+    with the scene's `objects`, a reading naming what is on the table is preferred."""
     heard = recognizer.transcribe(read_wav(audio))
-    text = understood_reading(parser, heard) if heard.text else ""
+    text = understood_reading(parser, heard, objects) if heard.text else ""
     frames = [f.to_json() for f in parser.parse(text) if f.known] if text else []
     out = {**heard.to_json(), "text": text, "frames": frames, "question": clarifying_question(heard)}
     if text != heard.text:

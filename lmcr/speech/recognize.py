@@ -31,11 +31,11 @@ class SpeechModelError(LMCRError, RuntimeError):
 
 @dataclass(frozen=True)
 class Transcript:
-    """What was heard: the best text, its posterior probability, the close n-best alternatives, and why
-    it is empty when it is."""
+    """What was heard: the best text, its posterior probability, the other n-best texts, the lexicon
+    words close alternatives disagree on, and why it is empty when it is."""
 
     text: str
-    alternatives: list[str] = field(default_factory=list)
+    alternatives: list[str] = field(default_factory=list)  # the other n-best texts, best first
     confidence: float = 0.0  # the best hypothesis' posterior probability
     reason: str | None = None  # set when nothing was recognised
     doubts: list[list[str]] = field(default_factory=list)  # lexicon words the alternatives disagree on
@@ -90,16 +90,17 @@ class Recognizer:
         if hyp is None or not hyp.hypstr.strip():
             return Transcript("", reason=f"no words recognised ({level:.0f} dBFS)")
         best_score = None
-        alternatives = []
+        alternatives, close = [], []
         for _, alt in zip(range(NBEST), d.nbest()):
             if alt is None:
                 break
-            score = alt.score
-            best_score = score if best_score is None else best_score
+            best_score = alt.score if best_score is None else best_score
             text = " ".join(alt.hypstr.split())
-            if text and text != hyp.hypstr and text not in alternatives and _close(best_score, score):
+            if text and text != hyp.hypstr and text not in alternatives:
                 alternatives.append(text)
-        return Transcript(hyp.hypstr, alternatives, float(hyp.prob), doubts=self._doubts(hyp.hypstr, alternatives))
+                if _close(best_score, alt.score):
+                    close.append(text)
+        return Transcript(hyp.hypstr, alternatives, float(hyp.prob), doubts=self._doubts(hyp.hypstr, close))
 
     def _doubts(self, best: str, alternatives: list[str]) -> list[list[str]]:
         """Per position of a lexicon word in the best text: the other lexicon words close alternatives
