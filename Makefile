@@ -42,10 +42,12 @@ clean:
 	rm -rf $(VENV) data/staging data/lmcr.duckdb annotation/browser/node_modules
 
 # Spoken dev instructions (espeak-ng voices x rates, clean / 20 dB noise / telephone) and the recogniser
-# bench on them; SHARED is the shared data folder, LMCR_DATA_DIR a workspace with a built speech model.
-SHARED ?= ../shared
+# bench on them: `make speech-audio SHARED=/path/to/shared` (or $$LMCR_SHARED_DIR); LMCR_DATA_DIR names a
+# workspace with a built speech model.
+SHARED ?= $(LMCR_SHARED_DIR)
 SPEECH_AUDIO ?= data/speech-dev
 speech-audio: setup
+	@test -n "$(SHARED)" || { echo "speech-audio: set SHARED=/path/to/shared (or LMCR_SHARED_DIR)"; exit 1; }
 	$(BIN)/python bench/render_speech.py --instructions $(SHARED)/eval/instructions_dev.jsonl --out $(SPEECH_AUDIO)
 
 speech-bench: setup

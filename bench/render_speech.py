@@ -21,6 +21,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from lmcr.jsonl import InputError, read_jsonl  # noqa: E402
 from lmcr.speech.audio import read_wav, write_wav  # noqa: E402
 
 
@@ -57,7 +58,10 @@ def main() -> None:
     for tool in ("espeak-ng", "sox"):
         if shutil.which(tool) is None:
             sys.exit(f"render_speech: {tool} is not installed (apt-get install espeak-ng sox)")
-    records = [json.loads(line) for line in args.instructions.read_text(encoding="utf-8").splitlines() if line.strip()]
+    try:
+        records = [rec for _, rec in read_jsonl(args.instructions, {"id": (str, int), "instruction": str})]
+    except InputError as exc:
+        sys.exit(f"render_speech: {exc}")
     index = []
     for voice in args.voices.split(","):
         for rate in (int(r) for r in args.rates.split(",")):

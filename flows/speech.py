@@ -16,6 +16,6 @@ def speech_flow(config: SpeechLMConfig = SpeechLMConfig(), db: str | None = None
     """Build (or keep) the speech model; returns its version folder."""
     ws = Workspace.from_env(data_dir=data_dir, db=db)
     with ws.read() as con:
-        path = build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech.parent, config,
+        path = build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech, config,
                                log=get_run_logger().info)
     return str(path)

@@ -591,7 +591,7 @@ def speech_lm(
         fail(f"--request-share must be in [0, 1), not {request_share}")
     ws = Workspace.from_env(db=db)
     with ws.read() as con:
-        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech.parent,
+        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech,
                         SpeechLMConfig(max_sentences=max_sentences, request_share=request_share, max_vocab=max_vocab),
                         log=lambda m: console.print(m, highlight=False))
 
@@ -646,31 +646,44 @@ def robot(
 
     from lmcr.dialogue import converse
     from lmcr.executor.scene import load_scene
-    from lmcr.jsonl import read_bytes
+    from lmcr.jsonl import read_lines
 
     if turns is not None and audio_dir is not None:
         fail("give --turns or --audio-dir, not both")
     ws = Workspace.from_env()
     layout = load_scene(scene)
+    parser = ws.parser()
     if turns is not None:
-        lines = read_bytes(turns).decode("utf-8", errors="replace").splitlines()
-        said = iter([t.strip() for t in lines if t.strip()])
+        said = iter([t.strip() for t in read_lines(turns) if t.strip()])
     elif audio_dir is not None:
-        said = _heard_turns(ws, audio_dir)
+        said = _heard_turns(ws, parser, audio_dir, [o.label for o in layout.objects])
     else:
-        said = iter(lambda: input("> ").strip(), "")
+        said = _typed_turns()
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
-    outcomes = converse(said, layout, ws.parser(), scorer, config, ws.robot,
+    outcomes = converse(said, layout, parser, scorer, config, ws.robot,
                         say=lambda line: console.print(escape(line), highlight=False))
     if json_out:
         for outcome in outcomes:
             print(json.dumps({k: v for k, v in outcome.items() if k not in ("waypoints", "detections")}))
 
 
-def _heard_turns(ws: Workspace, folder: Path):
-    """The transcripts of a folder's WAV files, in name order (a file that cannot be heard is skipped
-    with its reason)."""
-    from lmcr.speech.audio import AudioError, read_wav
+def _typed_turns():
+    """Lines typed at the prompt until an empty line or the end of input."""
+    while True:
+        try:
+            line = input("> ").strip()
+        except EOFError:
+            return
+        if not line:
+            return
+        yield line
+
+
+def _heard_turns(ws: Workspace, parser, folder: Path, on_table: list[str]):
+    """What `lmcr listen` hears in each of a folder's WAV files, in name order (a file that cannot be
+    heard is skipped with its reason)."""
+    from lmcr.speech.audio import AudioError
+    from lmcr.speech.listen import listen
 
     wavs = sorted(folder.glob("*.wav")) if folder.is_dir() else []
     if not wavs:
@@ -678,14 +691,14 @@ def _heard_turns(ws: Workspace, folder: Path):
     recognizer = ws.recognizer()
     for wav in wavs:
         try:
-            heard = recognizer.transcribe(read_wav(wav))
+            heard = listen(recognizer, parser, wav, on_table)
         except AudioError as exc:
             console.print(escape(f"{exc}"), highlight=False)
             continue
-        if heard.text:
-            yield heard.text
+        if heard["text"]:
+            yield heard["text"]
         else:
-            console.print(escape(f"{wav}: {heard.reason}"), highlight=False)
+            console.print(escape(f"{wav}: {heard['reason']}"), highlight=False)
 
 
 def check_record_text(line: int, record: dict, field: str, path: Path) -> dict:

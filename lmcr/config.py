@@ -6,6 +6,7 @@ import subprocess
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
+SQL_DIR = REPO_ROOT / "sql"  # the migrations, contracts and named queries shipped with the code
 
 
 def git_commit(root: Path = REPO_ROOT) -> str | None:

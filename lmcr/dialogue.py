@@ -16,11 +16,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from lmcr.complete import CompletionConfig, CompletionError, complete
+from lmcr.complete import CompletionConfig, complete
 from lmcr.errors import LMCRError, one_line
 from lmcr.executor.execute import execute
 from lmcr.executor.scene import Scene
-from lmcr.srl.parser import FrameParser, NoPredicateError
+from lmcr.srl.parser import FrameParser
 
 MAX_TRIES = 3
 YES = frozenset({"yes", "yeah", "yep", "sure", "ok", "okay", "right", "correct", "exactly"})
@@ -70,20 +70,20 @@ def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Ca
     on_table = [o.label for o in scene.objects]
     for instruction in turns:
         say(f"you: {instruction}")
-        try:
+        try:  # an instruction the robot cannot parse, complete or carry out is answered; the talk goes on
             completion = complete(parser, scorer, instruction, on_table, config)
-        except (NoPredicateError, CompletionError, LMCRError) as exc:
+            answer = None
+            if completion["question"]:
+                answer = _ask(completion, turns, on_table, parser.lex.objects, say)
+                if answer is None:
+                    say("robot: I'll leave it.")
+                    outcomes.append({"instruction": instruction, "left": True, "question": completion["question"]})
+                    continue
+            result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
+        except LMCRError as exc:
             say(f"robot: {one_line(exc)}")
             outcomes.append({"instruction": instruction, "error": one_line(exc)})
             continue
-        answer = None
-        if completion["question"]:
-            answer = _ask(completion, turns, on_table, parser.lex.objects, say)
-            if answer is None:
-                say("robot: I'll leave it.")
-                outcomes.append({"instruction": instruction, "left": True, "question": completion["question"]})
-                continue
-        result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
         frame = result["frame"]
         say(f"robot: {frame['predicate']} {frame['roles']} with the {result['arm']} arm: "
             f"{'done' if result['success'] else 'that did not work'}.")

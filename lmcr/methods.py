@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
-from lmcr.config import REPO_ROOT
+from lmcr.config import SQL_DIR
 from lmcr.files import atomic_path, file_sha256
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
@@ -36,7 +36,7 @@ class MethodResources:
     checkpoints: Path
     corpus: str = "all"
     db: Path | None = None
-    sql_dir: Path = REPO_ROOT / "sql"
+    sql_dir: Path = SQL_DIR
     vectors: Path | None = None
     conceptnet: Path | None = None
     spacy_model: str = SPACY_MODEL

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from lmcr.config import REPO_ROOT
+from lmcr.config import SQL_DIR
 
 if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first used (CLI start-up)
     import duckdb
@@ -52,7 +52,7 @@ class Workspace:
         """Explicit arguments win, then the environment, then `data/` beside the current directory."""
         data = Path(data_dir or os.environ.get("LMCR_DATA_DIR") or "data")
         return cls(data_dir=data, db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
-                   sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or REPO_ROOT / "sql"),
+                   sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or SQL_DIR),
                    spacy_model=spacy_model_from_env(), vectors=_env_path("LMCR_VECTORS"),
                    conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"))
 

@@ -411,3 +411,11 @@ def test_batch_execute_with_an_unreadable_input_is_one_line(tmp_path):
     result = invoke(["execute", "--input", str(tmp_path), "--output", str(tmp_path / "o.jsonl")], tmp_path)
     assert_one_line_error(result, tmp_path)
     assert not (tmp_path / "o.jsonl").exists()
+
+
+def test_robot_turns_that_are_not_utf8_are_one_line(tmp_path):
+    (tmp_path / "scene.json").write_text('{"objects": [{"label": "water", "xy": [0, 0]}]}')
+    (tmp_path / "turns.txt").write_bytes(b"pour me some water\n\xff\xfe the cup\n")
+    result = invoke(["robot", "--scene", str(tmp_path / "scene.json"), "--turns", str(tmp_path / "turns.txt")],
+                    tmp_path)
+    assert_one_line_error(result, tmp_path / "turns.txt")

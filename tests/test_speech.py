@@ -118,7 +118,7 @@ def speech_workspace(tmp_path_factory):
                        workers=1)
         train_setting(lambda: nullcontext(con), ws.checkpoints, "sentence", "youcook2", LMConfig(0, 16, 1),
                       TrainConfig(max_epochs=1))
-        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech.parent, SpeechLMConfig(), log=lambda m: None)
+        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech, SpeechLMConfig(), log=lambda m: None)
     return ws
 
 
@@ -187,3 +187,15 @@ def test_the_reading_that_names_the_table_wins():
     assert understood_reading(parser, heard) == "dip them in the bowl"  # no scene: the first with a predicate
     assert understood_reading(parser, heard, ["chocolate", "strawberry"]) == "dip a few in the chocolate"
     assert understood_reading(parser, Transcript("hello there", [], 0.5), ["cup"]) == "hello there"
+
+
+def test_close_alternatives_with_another_key_word_make_a_question():
+    from lmcr.speech.listen import clarifying_question
+    from lmcr.speech.recognize import Transcript, doubts
+
+    keys = {"pour", "fill", "water", "milk", "cup"}
+    found = doubts("pour the water", ["fill the water", "pour the milk", "four the water"], keys)
+    assert found == [["pour", "fill"], ["water", "milk"]]
+    assert clarifying_question(Transcript("pour the water", doubts=found)) == "Did you say pour or fill?"
+    assert doubts("pour the water", ["pour a water"], keys) == []
+    assert clarifying_question(Transcript("pour the water")) is None

@@ -27,7 +27,6 @@ from lmcr.files import file_sha256
 from lmcr.lexicon import LEXICON_FILES, Lexicon
 from lmcr.versions import publish_version, resolve, write_json
 
-MODEL_NAME = "en-us"  # the published model's folder under <data>/speech
 FILES = ("domain.lm", "domain.dict", "build.json")
 WORD = re.compile(r"[a-z]+(?:'[a-z]+)?")
 # Generic English request frames (not sentences of any test set): the spoken form of an instruction.
@@ -54,6 +53,11 @@ class SpeechLMConfig:
 def tokenize(text: str) -> list[str]:
     """Lowercase words as the recogniser writes them (digits and punctuation dropped)."""
     return WORD.findall(text.lower().replace("’", "'"))
+
+
+def lexicon_words(lexicon: Lexicon) -> set[str]:
+    """The words of the lexicon's predicates and object names: the ones the robot must hear."""
+    return {w for name in (*lexicon.objects, *lexicon.predicates) for w in tokenize(name)}
 
 
 def corpus_sentences(con: duckdb.DuckDBPyConnection, limit: int, seed: int) -> list[str]:
@@ -187,15 +191,15 @@ def write_arpa(entries: list[dict[tuple, tuple[float, float]]], path: Path) -> N
         out.write("\\end\\\n")
 
 
-def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: Path, root: Path,
+def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: Path, model_dir: Path,
                     config: SpeechLMConfig = SpeechLMConfig(), log: Callable[[str], None] = print) -> Path:
-    """Estimate the domain model from the store and the lexicon and publish it under `root/en-us`; when
+    """Estimate the domain model from the store and the lexicon and publish a version of it in
+    `model_dir` (the workspace's `speech` folder); when
     the latest version was built from the same inputs (ingested files, lexicon, dictionary, settings),
     return it instead (re-running the stage is free)."""
     fingerprint = inputs_fingerprint(con, cmudict, config)
-    latest = root / MODEL_NAME
-    if (latest / "LATEST").exists():
-        current = resolve(latest)
+    if (model_dir / "LATEST").exists():
+        current = resolve(model_dir)
         if (current / "build.json").exists() and load_build(current).get("inputs_sha256") == fingerprint:
             log(f"speech model {current}: inputs unchanged (kept)")
             return current
@@ -205,7 +209,7 @@ def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: P
     ratio = config.request_share * corpus_tokens / ((1 - config.request_share) * request_tokens)
     w_corpus, w_request = (1.0, ratio) if ratio >= 1 else (1 / ratio, 1.0)  # weights >= 1: discounts stay sound
     prons = read_cmudict(cmudict)
-    needed = {w for name in (*lexicon.objects, *lexicon.predicates) for w in tokenize(name)}
+    needed = lexicon_words(lexicon)
     frequency = Counter(w for words in corpus for w in words)
     frequency.update({w: w_request for words in requests for w in words})
     vocab, fallback, missing = {}, [], []
@@ -237,7 +241,7 @@ def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: P
         lines = [f"{w}{'' if i == 0 else f'({i + 1})'} {p}" for w in sorted(vocab) for i, p in enumerate(vocab[w])]
         (folder / "domain.dict").write_text("\n".join(lines) + "\n", encoding="utf-8")
         write_json(folder / "build.json", build)
-    path = publish_version(root, MODEL_NAME, FILES, write)
+    path = publish_version(model_dir.parent, model_dir.name, FILES, write)
     log(f"speech model {path}: {len(vocab):,} words, n-grams {build['ngrams']}, "
         f"{len(corpus):,} corpus sentences + {len(requests):,} request forms")
     return path

@@ -1,4 +1,4 @@
-"""Decoding: 16 kHz samples -> a transcript with its n-best alternatives and word confidences.
+"""Decoding: 16 kHz samples -> a transcript with its posterior, n-best alternatives and doubts.
 
 pocketsphinx's en-US acoustic model with the published domain model (`domain_lm`). The recogniser
 is unsure of a word when a close n-best alternative puts a different lexicon word (a predicate or an
@@ -15,13 +15,14 @@ import numpy as np
 
 from lmcr.errors import LMCRError
 from lmcr.lexicon import Lexicon
-from lmcr.speech.audio import SILENCE_DBFS, level_dbfs
-from lmcr.speech.domain_lm import FILES, tokenize
+from lmcr.speech.audio import RATE, SILENCE_DBFS, level_dbfs
+from lmcr.speech.domain_lm import FILES, lexicon_words
 from lmcr.versions import CheckpointError, resolve, verify
 
 NBEST = 8
-# An alternative whose scaled path score is within this (natural log) of the best one counts as close:
-# on the rendered dev speech, alternatives within 0.05 differ in a word the listener also hesitates on.
+# An alternative whose scaled path score is within this (natural log) of the best one counts as close.
+# Picked by looking at a few rendered dev utterances, whose first n-best paths lay 0.02-0.07 apart; not
+# tuned on the bench.
 CLOSE_LOG_SCORE = 0.05
 
 
@@ -73,9 +74,9 @@ class Recognizer:
         from pocketsphinx import Decoder
 
         self.decoder = Decoder(hmm=str(acoustic_model_dir()), lm=str(self.path / "domain.lm"),
-                               dict=str(self.path / "domain.dict"), samprate=16000, bestpath=True, lw=lw, dither=True, cmn="batch",
-                               loglevel="FATAL", logfn=os.devnull)
-        self.key_words = {w for name in (*lexicon.objects, *lexicon.predicates) for w in tokenize(name)}
+                               dict=str(self.path / "domain.dict"), samprate=RATE, bestpath=True, lw=lw,
+                               dither=True, cmn="batch", loglevel="FATAL", logfn=os.devnull)
+        self.key_words = lexicon_words(lexicon)
 
     def transcribe(self, samples: np.ndarray) -> Transcript:
         """Decode one utterance (int16, 16 kHz)."""
@@ -100,24 +101,26 @@ class Recognizer:
                 alternatives.append(text)
                 if _close(best_score, alt.score):
                     close.append(text)
-        return Transcript(hyp.hypstr, alternatives, float(hyp.prob), doubts=self._doubts(hyp.hypstr, close))
+        return Transcript(hyp.hypstr, alternatives, float(hyp.prob), doubts=doubts(hyp.hypstr, close, self.key_words))
 
-    def _doubts(self, best: str, alternatives: list[str]) -> list[list[str]]:
-        """Per position of a lexicon word in the best text: the other lexicon words close alternatives
-        hear there (aligned by the words around it)."""
-        best_words = best.split()
-        doubts = []
-        for i, word in enumerate(best_words):
-            if word not in self.key_words:
-                continue
-            heard = [word]
-            for alt in alternatives:
-                other = _aligned(best_words, alt.split(), i)
-                if other and other != word and other in self.key_words and other not in heard:
-                    heard.append(other)
-            if len(heard) > 1:
-                doubts.append(heard)
-        return doubts
+
+
+def doubts(best: str, close: list[str], key_words: set[str]) -> list[list[str]]:
+    """Per position of a key word (predicate or object) in the best text: that word and the other key
+    words close alternatives hear there (aligned by the words around it); only places heard two ways."""
+    best_words = best.split()
+    found = []
+    for i, word in enumerate(best_words):
+        if word not in key_words:
+            continue
+        heard = [word]
+        for alt in close:
+            other = _aligned(best_words, alt.split(), i)
+            if other and other not in heard and other in key_words:
+                heard.append(other)
+        if len(heard) > 1:
+            found.append(heard)
+    return found
 
 
 def _close(best: float, score: float) -> bool:
@@ -133,7 +136,7 @@ def _aligned(best: list[str], other: list[str], i: int) -> str | None:
         return other[i]
     left = best[i - 1] if i > 0 else None
     right = best[i + 1] if i + 1 < len(best) else None
-    for j, _ in enumerate(other):
+    for j in range(len(other)):
         if (other[j - 1] if j > 0 else None) == left and (other[j + 1] if j + 1 < len(other) else None) == right:
             return other[j]
     return None
