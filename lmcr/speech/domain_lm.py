@@ -211,7 +211,9 @@ def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: P
     prons = read_cmudict(cmudict)
     needed = lexicon_words(lexicon)
     frequency = Counter(w for words in corpus for w in words)
-    frequency.update({w: w_request for words in requests for w in words})
+    for words in requests:  # weighted like the n-gram counts: every occurrence counts w_request
+        for w in words:
+            frequency[w] += w_request
     vocab, fallback, missing = {}, [], []
     for word, _ in frequency.most_common():
         if len(vocab) >= config.max_vocab and word not in needed:
