@@ -12,9 +12,13 @@ import pybullet as p
 from lmcr.complete import CompletionConfig, complete
 from lmcr.errors import LMCRError, one_line
 from lmcr.executor.detect import capture, detect
-from lmcr.executor.motion import PLANS, TILTING, TOLERANCE, choose_arm
+from lmcr.executor.plan import Infeasible, Plan, Planner
+from lmcr.executor.run import run_plan
 from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
+from lmcr.executor.tasks import TASKS
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
+
+MAX_TRIED = 4  # candidates planned at most, in the language model's order, to find one the robot can do
 
 
 class ExecutionError(LMCRError, ValueError):
@@ -28,40 +32,97 @@ def _connect() -> None:
 
 def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
             frames: list | None = None, answer: dict[str, str] | None = None) -> dict:
-    """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success.
-    With `frames` (a list), camera images are appended at every waypoint for rendering. `answer` (role ->
-    object) is what a person answered to the completion's question: it fills those roles instead."""
+    """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success, and
+    whether the plan was feasible. The robot moves only when the whole plan is feasible. When the
+    language model's choice is not but another candidate is, nothing moves and the result asks
+    (`question`, `suggestion`). With `frames` (a list), camera images are appended at every waypoint for
+    rendering. `answer` (role -> object) is what a person answered: it fills those roles instead."""
     started = time.perf_counter()
     _connect()
     robot = build_world(scene, cache_dir)
     seen = detect(scene.bodies)
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config)
+    completed = time.perf_counter()
+    planner = Planner(robot, scene, scene.table)
+    tried = []
+    for frame, candidate in _options(completion, answer)[:MAX_TRIED]:
+        tried.append((frame, candidate, _plan(planner, scene, frame)))
+        if isinstance(tried[-1][2], Plan):
+            break
+    planned = time.perf_counter()
+    frame, candidate, result = tried[0]
+    out = {"frame": frame, "chosen_object": _chosen(candidate, answer), "feasible": isinstance(result, Plan),
+           "success": False, "waypoints": [], "checks": {}, "missing": completion["missing"],
+           "question": completion["question"], "holding": scene.holding.label if scene.holding else None,
+           "ranking": _ranking(completion, tried),
+           "detections": [{"label": d.label, "position": [round(v, 3) for v in d.position]} for d in seen]}
+    if isinstance(result, Infeasible):
+        out.update(_refusal(frame, result, tried, parser))
+    else:
+        if frames is not None:
+            result.arm.on_waypoint = lambda: frames.append(capture()[0])
+            frames.append(capture()[0])
+        task = TASKS[frame["predicate"]]
+        roles = frame["roles"]
+        held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
+        out.update(run_plan(result, task, held, target, [o for o in scene.objects if o not in (held, target)]))
+        out["arm"] = result.arm.side
+    done = time.perf_counter()
+    out["seconds"] = {"perceive_and_complete": round(completed - started, 3), "plan": round(planned - completed, 3),
+                      "execute": round(done - planned, 3), "plan_and_execute": round(done - completed, 3)}
+    return out
+
+
+def _options(completion: dict, answer: dict[str, str] | None) -> list[tuple[dict, dict | None]]:
+    """The frames worth planning, best first: the answered one, else one per candidate in the language
+    model's order (just the completed frame when nothing was missing)."""
     frame = completion["frame"]
     if answer:
-        frame = {"predicate": frame["predicate"], "roles": {**frame["roles"], **answer}}
-    predicate, roles = frame["predicate"], frame["roles"]
-    held_role, target_role, plan = PLANS[predicate]
+        return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **answer}}, None)]
+    if not completion["candidates"]:
+        return [(frame, None)]
+    return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **c["objects"]}}, c)
+            for c in completion["candidates"]]
+
+
+def _plan(planner: Planner, scene: Scene, frame: dict) -> Plan | Infeasible:
+    task = TASKS[frame["predicate"]]
+    roles = frame["roles"]
     try:
-        held, target = scene.find(roles[held_role]), scene.find(roles[target_role])
+        held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
     except KeyError as exc:
-        raise ExecutionError(f"cannot {predicate} here: {exc.args[0]}") from exc
-    planned = time.perf_counter()
-    arm = choose_arm(robot, scene, held, target, tilts=predicate in TILTING)
-    if frames is not None:
-        arm.on_waypoint = lambda: frames.append(capture()[0])
-        frames.append(capture()[0])
-    checks = plan(arm, held, target)
-    waypoints_ok = all(w["error_m"] <= TOLERANCE for w in arm.log)
-    chosen = next(iter(answer.values())) if answer else (
-        completion["candidates"][0]["object"] if completion["candidates"] else None)
-    return {"frame": frame, "chosen_object": chosen,
-            "success": bool(checks["ok"] and waypoints_ok and arm.grasps_ok), "waypoints": arm.log,
-            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
-                       "grasped": arm.grasps_ok, "waypoints_within_tolerance": waypoints_ok},
-            "arm": arm.side, "missing": completion["missing"], "question": completion["question"],
-            "detections": [{"label": d.label, "position": [round(v, 3) for v in d.position]} for d in seen],
-            "seconds": {"perceive_and_complete": round(planned - started, 3),
-                        "plan_and_execute": round(time.perf_counter() - planned, 3)}}
+        raise ExecutionError(f"cannot {frame['predicate']} here: {exc.args[0]}") from exc
+    holding = scene.holding is not None and held is scene.holding
+    if scene.holding is not None and not holding:
+        return Infeasible(f"my hand is full: I am holding the {scene.holding.label}")
+    return planner.plan(task, held, target, holding)
+
+
+def _chosen(candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+    if answer:
+        return next(iter(answer.values()))
+    return candidate["object"] if candidate else None
+
+
+def _ranking(completion: dict, tried: list) -> list[dict]:
+    """The candidates by language-model probability x feasibility (1 planned feasible, 0 not, unknown
+    when not planned: those keep their probability and rank after the feasible ones)."""
+    feasible = {c["object"]: isinstance(r, Plan) for _, c, r in tried if c is not None}
+    rows = [{"object": c["object"], "probability": c["probability"], "feasible": feasible.get(c["object"])}
+            for c in completion["candidates"]]
+    return sorted(rows, key=lambda r: -(r["probability"] * (r["feasible"] is not False)))
+
+
+def _refusal(frame: dict, result: Infeasible, tried: list, parser) -> dict:
+    """Why nothing moved, and the question to ask when another candidate is feasible."""
+    out = {"reason": result.reason}
+    alternative = next(((f, c) for f, c, r in tried[1:] if isinstance(r, Plan)), None)
+    if alternative is not None:
+        f, c = alternative
+        sentence = parser.lex.predicates[f["predicate"]].sentence.format(**f["roles"])
+        out["question"] = f"I can't reach the {tried[0][1]['object']}. Should I {sentence} instead?"
+        out["suggestion"] = c["objects"]
+    return out
 
 
 BATCH_FIELDS = {"id": (str, int), "instruction": str}

@@ -20,10 +20,11 @@ from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
 from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
 from lmcr.lexicon import load_lexicon
 
-TABLE_CENTRE = (0.65, 0.0)  # in the robot's base frame (x forward), metres
+TABLE_CENTRE = (0.60, 0.0)  # in the robot's base frame (x forward), metres: as near as the pedestal allows
 TABLE_TOP = 0.75  # height above the floor
-TABLE_SIZE = (0.8, 1.2)
+TABLE_SIZE = (0.7, 1.2)
 X_LIMIT, Y_LIMIT = 0.3, 0.5
+HAND_OFF = (-1.6, 0.0)  # where a held object waits (behind the robot, on the floor) until it is put in the hand
 
 # label -> (kind, size): container (width, depth, height, wall), bottle (radius, height),
 # food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
@@ -67,12 +68,14 @@ class SceneObject:
 
 @dataclass
 class Scene:
-    objects: list[SceneObject]
+    objects: list[SceneObject]  # on the table
     seed: int = 0
-    bodies: dict[int, str] = field(default_factory=dict)
+    holding: SceneObject | None = None  # in the robot's hand at the start (not on the table)
+    bodies: dict[int, str] = field(default_factory=dict)  # the table objects' bodies -> labels
+    table: int = -1
 
     def find(self, label: str) -> SceneObject:
-        for obj in self.objects:
+        for obj in [*self.objects, *([self.holding] if self.holding else [])]:
             if obj.label == label:
                 return obj
         raise KeyError(f"no {label!r} on the table (there are: {', '.join(o.label for o in self.objects)})")
@@ -127,7 +130,10 @@ def scene_from_json(data: object, where: str) -> Scene:
         if not isinstance(obj, dict):
             raise InputError(f"{where}: object {k} is not a JSON object")
         items.append((obj.get("label"), obj.get("xy")))
-    return make_scene(items, seed, where)
+    holding = data.get("holding")
+    if holding is not None and (not isinstance(holding, str) or holding not in load_lexicon().objects):
+        raise InputError(f"{where}: 'holding' must be a known object label, not {holding!r:.60}")
+    return make_scene(items, seed, where, holding)
 
 
 def _valid_xy(xy: object) -> bool:
@@ -135,9 +141,10 @@ def _valid_xy(xy: object) -> bool:
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in xy))
 
 
-def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str = "scene") -> Scene:
+def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str = "scene",
+               holding: str | None = None) -> Scene:
     """Validated objects (known labels, finite on-table positions that do not overlap), the ones
-    without a position placed at random with `seed`."""
+    without a position placed at random with `seed`; `holding` is the label of what the robot holds."""
     vocabulary = set(load_lexicon().objects)
     placed: list[SceneObject] = []
     for k, (label, xy) in enumerate(items):
@@ -156,7 +163,7 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
     for obj in sorted(placed, key=lambda o: -footprint(o.label)):  # big ones first: they need the room
         if obj.xy is None:
             obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
-    return Scene(placed, seed)
+    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
 
 
 def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
@@ -177,7 +184,7 @@ def _color(label: str) -> list[float]:
     return [rng.uniform(0.2, 0.9), rng.uniform(0.2, 0.9), rng.uniform(0.2, 0.9), 1.0]
 
 
-def _container(label: str, x: float, y: float) -> int:
+def _container(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     w, d, h = CONTAINERS[label]
     t = 0.006  # wall thickness
     parts = [([w / 2, d / 2, t / 2], [0, 0, t / 2]), ([t / 2, d / 2, h / 2], [w / 2 - t / 2, 0, h / 2]),
@@ -187,10 +194,10 @@ def _container(label: str, x: float, y: float) -> int:
                                       collisionFramePositions=[o for _, o in parts])
     vis = p.createVisualShapeArray([p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts],
                                    visualFramePositions=[o for _, o in parts], rgbaColors=[_color(label)] * 5)
-    return p.createMultiBody(0.3, col, vis, [x, y, TABLE_TOP])
+    return p.createMultiBody(0.3, col, vis, [x, y, z])
 
 
-def _solid(label: str, x: float, y: float) -> int:
+def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     shape = solid_shape(label)
     if shape[0] == "sphere":
         col = p.createCollisionShape(p.GEOM_SPHERE, radius=shape[1])
@@ -202,7 +209,7 @@ def _solid(label: str, x: float, y: float) -> int:
         half = [s / 2 for s in shape[1:]]
         col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half)
         vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_color(label))
-    return p.createMultiBody(0.15, col, vis, [x, y, TABLE_TOP + height(label) / 2 + 0.001])
+    return p.createMultiBody(0.15, col, vis, [x, y, z + height(label) / 2 + 0.001])
 
 
 def build_world(scene: Scene, cache_dir: Path) -> int:
@@ -213,15 +220,19 @@ def build_world(scene: Scene, cache_dir: Path) -> int:
     floor = p.createCollisionShape(p.GEOM_PLANE)
     p.createMultiBody(0, floor)
     half = [TABLE_SIZE[0] / 2, TABLE_SIZE[1] / 2, 0.02]
-    p.createMultiBody(0, p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
-                      p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
-                      [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02])
+    scene.table = p.createMultiBody(0, p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
+                                    p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
+                                    [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02])
     robot = p.loadURDF(str(baxter_urdf(cache_dir)), [0, 0, PEDESTAL_HEIGHT], useFixedBase=True)
     scene.bodies = {}
     for obj in scene.objects:
         x, y = world_xy(obj.xy)
         obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
         scene.bodies[obj.body] = obj.label
+    if scene.holding is not None:
+        x, y = world_xy(scene.holding.xy)
+        make = _container if scene.holding.kind == "container" else _solid
+        scene.holding.body = make(scene.holding.label, x, y, 0.0)  # on the floor
     for _ in range(120):  # let everything settle
         p.stepSimulation()
     return robot

@@ -1,0 +1,206 @@
+"""One Baxter arm: joint bookkeeping, inverse kinematics for planning, and driving the joints along a
+planned joint-space path in the simulation.
+
+Planning is kinematic (joints are set, nothing is simulated) and leaves the arm where it found it;
+execution drives position-controlled motors through the planned configurations. A grasp closes the
+fingers and attaches the object with a fixed constraint (stable friction grasps need per-object tuning
+that says nothing about the instruction).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as p
+
+from lmcr.executor.baxter import FINGER_TRAVEL, JOINTS
+
+DOWN = p.getQuaternionFromEuler((math.pi, 0, 0))  # gripper pointing at the table
+ORIENTATION_WEIGHT = 0.3  # metres of position error one radian of orientation error is worth
+IK_POSITION = 0.003  # metres: a pose counts as reachable when IK gets this close ...
+IK_ROTATION = 0.03  # ... and this close in orientation (radians)
+JOINT_STEP = 0.012  # radians per control tick pair while following a path (about 1.4 rad/s)
+SETTLED = 0.002  # radians: the joints have arrived
+
+
+def rotation_error(current, target) -> np.ndarray:
+    """World-frame rotation vector turning orientation `current` into `target` (quaternions)."""
+    rc = np.asarray(p.getMatrixFromQuaternion(current)).reshape(3, 3)
+    rt = np.asarray(p.getMatrixFromQuaternion(target)).reshape(3, 3)
+    r = rt @ rc.T
+    angle = math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2)))
+    if angle < 1e-9:
+        return np.zeros(3)
+    axis = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    norm = np.linalg.norm(axis)
+    if norm < 1e-9:  # half a turn: the axis is the symmetric part's eigenvector
+        _, v = np.linalg.eigh(r + np.eye(3))
+        return v[:, -1] * math.pi
+    return axis / norm * angle
+
+
+def joint_index(robot: int) -> dict[str, int]:
+    """Joint name -> pybullet joint index."""
+    return {p.getJointInfo(robot, i)[1].decode(): i for i in range(p.getNumJoints(robot))}
+
+
+@dataclass
+class Arm:
+    robot: int
+    side: str
+    held: int | None = None
+    constraint: int | None = None
+    on_waypoint: object = None  # called after each reached waypoint (rendering)
+    log: list[dict] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        names = joint_index(self.robot)
+        self.joints = [names[f"{self.side}_{j}"] for j in JOINTS]
+        self.fingers = [names[f"{self.side}_gripper_l_finger_joint"], names[f"{self.side}_gripper_r_finger_joint"]]
+        self.ee = names[f"{self.side}_endpoint"]
+        self.movable = [i for i in range(p.getNumJoints(self.robot)) if p.getJointInfo(self.robot, i)[2] != p.JOINT_FIXED]
+        self.columns = [self.movable.index(j) for j in self.joints]  # this arm's columns of the Jacobian
+        self.limits = np.array([p.getJointInfo(self.robot, j)[8:10] for j in self.joints])
+        sign = 1 if self.side == "left" else -1
+        # Baxter's "untucked" pose: elbow bent, gripper over the near edge of the table (mirrored for the right arm)
+        self.home = np.array([0.08 * sign, -1.0, -1.19 * sign, 1.94, 0.67 * sign, 1.03, -0.5 * sign])
+        # out of the other arm's way: the shoulder turned outwards, the hand raised
+        self.parked = np.array([0.9 * sign, -0.6, -1.19 * sign, 1.94, 0.67 * sign, 1.03, -0.5 * sign])
+
+    # kinematics (planning)
+    def config(self) -> np.ndarray:
+        return np.array([s[0] for s in p.getJointStates(self.robot, self.joints)])
+
+    def set_config(self, q) -> None:
+        for j, v in zip(self.joints, q):
+            p.resetJointState(self.robot, j, float(v))
+
+    def ee_pose(self) -> tuple[np.ndarray, tuple]:
+        state = p.getLinkState(self.robot, self.ee, computeForwardKinematics=True)
+        return np.asarray(state[4]), state[5]
+
+    def solve(self, position, orientation, seeds) -> tuple[np.ndarray, float, float]:
+        """Joint angles within the limits reaching the pose: damped least squares from each seed in turn
+        until one converges; (joints, position error m, orientation error rad) of the best. From the first
+        seed the pose is also approached in stages (a large turn of the wrist, as in tilting to pour,
+        defeats a single local solve)."""
+        best = None
+        for seed in [*seeds, "staged"]:
+            if isinstance(seed, str):
+                seed = self._staged_seed(seeds[0], position, orientation)
+            q, err_pos, err_rot = self._dls(np.asarray(seed, dtype=float), np.asarray(position), orientation)
+            if best is None or err_pos + ORIENTATION_WEIGHT * err_rot < best[1] + ORIENTATION_WEIGHT * best[2]:
+                best = (q, err_pos, err_rot)
+            if err_pos <= IK_POSITION and err_rot <= IK_ROTATION:
+                break
+        return best
+
+    def _staged_seed(self, seed, position, orientation, stages: int = 4) -> np.ndarray:
+        """Joints reached by solving for poses part of the way from `seed`'s pose to the goal."""
+        q = np.asarray(seed, dtype=float)
+        self.set_config(q)
+        start_pos, start_orn = self.ee_pose()
+        for k in range(1, stages):
+            f = k / stages
+            orn = p.getQuaternionSlerp(start_orn, orientation, f)
+            q, _, _ = self._dls(q, start_pos + (np.asarray(position) - start_pos) * f, orn, iterations=60)
+        return q
+
+    def _dls(self, q: np.ndarray, target: np.ndarray, orientation, iterations: int = 150):
+        """Damped least squares on the 6-D pose error, clipped to the joint limits at every step.
+        Leaves the arm at the result."""
+        lo, hi = self.limits.T
+        all_q = [s[0] for s in p.getJointStates(self.robot, self.movable)]
+        zeros = [0.0] * len(self.movable)
+        for _ in range(iterations + 1):
+            self.set_config(q)
+            pos, orn = self.ee_pose()
+            err_pos, err_rot = target - pos, rotation_error(orn, orientation)
+            if _ == iterations or (np.linalg.norm(err_pos) < 2e-4 and np.linalg.norm(err_rot) < 2e-3):
+                break
+            for c, v in zip(self.columns, q):
+                all_q[c] = float(v)
+            lin, ang = p.calculateJacobian(self.robot, self.ee, [0, 0, 0], all_q, zeros, zeros)
+            jac = np.vstack([np.asarray(lin)[:, self.columns], ORIENTATION_WEIGHT * np.asarray(ang)[:, self.columns]])
+            err = np.concatenate([err_pos, ORIENTATION_WEIGHT * err_rot])
+            step = jac.T @ np.linalg.solve(jac @ jac.T + 0.03 ** 2 * np.eye(6), err)
+            q = np.clip(q + np.clip(step, -0.3, 0.3), lo, hi)
+        return q, float(np.linalg.norm(err_pos)), float(np.linalg.norm(err_rot))
+
+    # control (execution)
+    def hold(self, q) -> None:
+        """Position-control the joints to `q` (no stepping)."""
+        p.setJointMotorControlArray(self.robot, self.joints, p.POSITION_CONTROL, targetPositions=list(map(float, q)),
+                                    forces=[150.0] * 7, positionGains=[0.3] * 7)
+
+    def follow(self, path: list[np.ndarray]) -> None:
+        """Drive through a joint-space path at a steady joint speed, then wait for the joints to arrive."""
+        for a, b in zip(path, path[1:]):
+            n = max(1, math.ceil(float(np.max(np.abs(b - a))) / JOINT_STEP))
+            for k in range(1, n + 1):
+                self.hold(a + (b - a) * k / n)
+                p.stepSimulation()
+                p.stepSimulation()
+        for _ in range(240):
+            if float(np.max(np.abs(self.config() - path[-1]))) < SETTLED:
+                break
+            p.stepSimulation()
+
+    def record(self, name: str, target) -> float:
+        """Log how far the gripper ended from the waypoint `target` (metres)."""
+        error = float(np.linalg.norm(self.ee_pose()[0] - np.asarray(target)))
+        self.log.append({"name": name, "error_m": round(error, 4)})
+        if self.on_waypoint:
+            self.on_waypoint()
+        return error
+
+    def grasp(self, body: int, half_width: float) -> bool:
+        """Close the fingers on an object `half_width` wide and attach it where it is; False when the
+        object is not under the fingertips (knocked away or never reached)."""
+        close = float(np.clip(0.045 - half_width - 0.003, 0.0, FINGER_TRAVEL))
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=[close, -close])
+        for _ in range(60):
+            p.stepSimulation()
+        ee_pos, _ = self.ee_pose()
+        obj_pos, _ = p.getBasePositionAndOrientation(body)
+        lo, hi = p.getAABB(body)
+        reach = math.hypot(ee_pos[0] - obj_pos[0], ee_pos[1] - obj_pos[1])
+        if reach > max(hi[0] - lo[0], hi[1] - lo[1]) / 2 or abs(ee_pos[2] - hi[2]) > 0.03:
+            return False
+        self.attach(body)
+        return True
+
+    def attach(self, body: int) -> None:
+        """Hold `body` rigidly where it is relative to the gripper."""
+        ee_pos, ee_orn = self.ee_pose()
+        obj_pos, obj_orn = p.getBasePositionAndOrientation(body)
+        inv_pos, inv_orn = p.invertTransform(ee_pos.tolist(), ee_orn)
+        rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
+        self.constraint = p.createConstraint(self.robot, self.ee, body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos,
+                                             [0, 0, 0], rel_orn)
+        p.changeConstraint(self.constraint, maxForce=500)
+        robot_collisions(self.robot, body, False)  # held in the hand, it must not push the arm around
+        self.held = body
+
+    def release(self) -> None:
+        """Open the fingers and let go; the object touches the robot again only once it has dropped
+        away (turned back on while it still overlaps the fingers, contact would throw it off the table)."""
+        if self.constraint is not None:
+            p.removeConstraint(self.constraint)
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=[0.0, 0.0])  # open
+        settle(240)
+        if self.held is not None:
+            robot_collisions(self.robot, self.held, True)
+        self.constraint, self.held = None, None
+
+
+def robot_collisions(robot: int, body: int, enable: bool) -> None:
+    for link in range(-1, p.getNumJoints(robot)):
+        p.setCollisionFilterPair(robot, body, link, -1, int(enable))
+
+
+def settle(steps: int = 240) -> None:
+    for _ in range(steps):
+        p.stepSimulation()

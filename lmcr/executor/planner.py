@@ -1,0 +1,63 @@
+"""Joint-space paths that keep clear of the table, the objects and the robot: OMPL's RRT-Connect (the
+planner MoveIt! uses by default) over the arm's seven joints, with the pybullet clearance check as
+OMPL's state validity checker. A straight segment that is already clear is taken as it is."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+ou.setLogLevel(ou.LogLevel.LOG_NONE)  # OMPL's console chatter is no use to a CLI user
+
+RESOLUTION = 0.04  # radians between checked states along a motion
+PLAN_SECONDS = 1.5  # RRT-Connect's budget for one segment
+
+
+def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
+               seconds: float = PLAN_SECONDS) -> list[np.ndarray] | None:
+    """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none in
+    `seconds`. `clash(q)` names what the configuration hits, None when it is clear."""
+    q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+    if segment_clash(clash, q0, q1) is None:
+        return [q0, q1]
+    space = ob.RealVectorStateSpace(len(q0))
+    bounds = ob.RealVectorBounds(len(q0))
+    for k, (lo, hi) in enumerate(limits):
+        bounds.setLow(k, float(lo))
+        bounds.setHigh(k, float(hi))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(lambda state: clash(np.array([state[k] for k in range(len(q0))])) is None)
+    si.setStateValidityCheckingResolution(RESOLUTION / space.getMaximumExtent())
+    si.setup()
+    start, goal = space.allocState(), space.allocState()
+    for k in range(len(q0)):
+        start[k], goal[k] = float(q0[k]), float(q1[k])
+    problem = ob.ProblemDefinition(si)
+    problem.setStartAndGoalStates(start, goal)
+    planner = og.RRTConnect(si)
+    planner.setProblemDefinition(problem)
+    planner.setup()
+    solved = planner.solve(seconds) and problem.hasExactSolution()
+    path = None
+    if solved:
+        geometric = problem.getSolutionPath()
+        og.PathSimplifier(si).simplifyMax(geometric)
+        path = [np.array([s[k] for k in range(len(q0))]) for s in geometric.getStates()]
+    del planner, problem, si  # released here: nanobind reports objects still alive at exit as leaks
+    return path
+
+
+def segment_clash(clash, q0, q1) -> str | None:
+    """The first clash on the straight joint-space segment q0 -> q1, checked every RESOLUTION radians."""
+    q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+    n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / RESOLUTION)))
+    for k in range(1, n + 1):
+        hit = clash(q0 + (q1 - q0) * k / n)
+        if hit:
+            return hit
+    return None

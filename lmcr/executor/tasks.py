@@ -1,0 +1,293 @@
+"""One motion program per predicate: the steps (gripper poses, grasp, release, pouring) that act out a
+completed frame, computed from the objects' geometry, and the checks that say whether it worked.
+
+A program is built for one way of doing the task (`Variant`: the gripper's turn about the vertical when
+it grasps, the direction it tilts to pour); the planner tries variants until one is feasible. Poses are
+exact, not corrected while moving: the held object's pose in the hand is known from the grasp, so the
+gripper pose that puts a bottle's mouth over the cup's centre is computed, not searched for.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as p
+
+from lmcr.executor.arm import DOWN
+from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, solid_shape
+
+CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
+TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
+POUR_HEIGHT = 0.10  # the opening this far above the target's rim: low enough to aim, high enough for the hand
+PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far side of the table
+GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
+
+
+@dataclass(frozen=True)
+class Step:
+    """A gripper pose to reach (`kind` "move", first reachable of `positions`), or an action."""
+
+    kind: str  # move | grasp | release | spill | shake
+    name: str = ""
+    positions: tuple = ()
+    orientation: tuple = DOWN
+    touches: str = ""  # "held" | "target": what this motion may come close to (the rest is kept clear)
+    probe: str = ""  # a name to record the held object's pose under once the pose is reached
+    particles: int = 0
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One way to do the task (radians): the gripper's yaw when grasping, how far it leans away from the
+    robot (reaching the far side of the table needs the hand pitched forward) and the way it tilts."""
+
+    yaw: float = 0.0
+    pitch: float = 0.0
+    tilt_sign: int = 1  # which way it turns about the fingers' line
+
+    def upright(self) -> tuple:
+        """The gripper orientation that grasps, and carries the grasped object upright."""
+        lean = p.getQuaternionFromAxisAngle((0, 1, 0), -self.pitch)  # gripper axis towards +x (away)
+        return p.multiplyTransforms([0, 0, 0], lean, [0, 0, 0], _turned(DOWN, self.yaw))[1]
+
+
+@dataclass
+class Geometry:
+    """The task's objects as they stand when planning starts (measured once: planning moves the held
+    object about): the held one's pose (in the hand when it is already held) and the target's top
+    centre and outline."""
+
+    held: SceneObject
+    target: SceneObject
+    held_pos: tuple = ()
+    held_orn: tuple = ()
+    held_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    target_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    target_box: tuple = ()
+
+    @classmethod
+    def measure(cls, held: SceneObject, target: SceneObject) -> Geometry:
+        pos, orn = p.getBasePositionAndOrientation(held.body)
+        lo, hi = p.getAABB(target.body)
+        tpos, _ = p.getBasePositionAndOrientation(target.body)
+        return cls(held, target, pos, orn, np.array([pos[0], pos[1], p.getAABB(held.body)[1][2]]),
+                   np.array([tpos[0], tpos[1], hi[2]]), (lo, hi))
+
+    def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
+        """The gripper pose that grasps the held object by its top."""
+        return self.held_top + [0, 0, GRIP_GAP], variant.upright()
+
+    def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
+        """The held object's pose relative to the gripper after a top grasp."""
+        pos, orn = self.grip_pose(variant)
+        inv_pos, inv_orn = p.invertTransform(pos.tolist(), orn)
+        return p.multiplyTransforms(inv_pos, inv_orn, self.held_pos, self.held_orn)
+
+    def point_in_hand(self, variant: Variant, local) -> np.ndarray:
+        """A point given in the held object's frame, in the gripper's frame."""
+        rel_pos, rel_orn = self.in_hand(variant)
+        return np.asarray(p.multiplyTransforms(rel_pos, rel_orn, local, [0, 0, 0, 1])[0])
+
+    def mouth(self, variant: Variant) -> np.ndarray:
+        """The held object's opening (just above its top) in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - self.held_pos[2] + 0.012])
+
+    def centre(self, variant: Variant) -> np.ndarray:
+        """The held object's middle in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
+
+
+def _turned(orientation, yaw: float) -> tuple:
+    """`orientation` turned by `yaw` about the vertical."""
+    return p.multiplyTransforms([0, 0, 0], p.getQuaternionFromEuler((0, 0, yaw)), [0, 0, 0], orientation)[1]
+
+
+def tilted(variant: Variant) -> tuple:
+    """The gripper orientation with the grasped object turned TILT about the line between the fingers:
+    turned about any other axis, a finger would end up under the opening, in the way of what pours."""
+    upright = variant.upright()
+    fingers_line = np.asarray(p.getMatrixFromQuaternion(upright)).reshape(3, 3)[:, 1]
+    turn = p.getQuaternionFromAxisAngle(fingers_line.tolist(), variant.tilt_sign * TILT)
+    return p.multiplyTransforms([0, 0, 0], turn, [0, 0, 0], upright)[1]
+
+
+def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
+    """The gripper position that puts a point of the hand (gripper frame) at `goal` in orientation `orientation`."""
+    offset = p.multiplyTransforms([0, 0, 0], orientation, point_in_hand.tolist(), [0, 0, 0, 1])[0]
+    return np.asarray(goal) - offset
+
+
+def variants(held: SceneObject) -> list[Variant]:
+    """The grasp yaws that suit the held object's shape (fingers across a long object), upright or
+    leaning forward, each tilting either way."""
+    shape = solid_shape(held.label) if held.label not in CONTAINERS else ("box", *CONTAINERS[held.label])
+    yaws = [0.0, math.pi / 2, -math.pi / 2]
+    if shape[0] == "box" and abs(shape[1] - shape[2]) > 0.02:
+        yaws = [0.0, math.pi] if shape[1] > shape[2] else [math.pi / 2, -math.pi / 2]
+    return [Variant(yaw, pitch, sign) for pitch in PITCHES for yaw in yaws for sign in (1, -1)]
+
+
+def above(xy, name: str, orientation=DOWN) -> Step:
+    return Step("move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation)
+
+
+def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "") -> Step:
+    return Step("move", name, (np.asarray(position, dtype=float),), orientation, touches, probe)
+
+
+def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Approach from above, grasp the top, lift (nothing to do when the object is already in the hand)."""
+    if holding:
+        return []
+    pos, orn = g.grip_pose(v)
+    label = g.held.label
+    return [above(pos, f"above {label}", orn), move(f"grip {label}", pos, orn, touches="held"),
+            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn)]
+
+
+def over_target(g: Geometry, v: Variant) -> Step:
+    return above(g.target_top, f"over {g.target.label}", v.upright())
+
+
+def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the opening above the target's centre, tilted; let the liquid run; turn back upright."""
+    tilt = tilted(v)
+    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, POUR_HEIGHT])
+    return [*pick(g, v, holding), over_target(g, v), move("tilt to pour", spout, tilt),
+            Step("spill", "pour", particles=30), over_target(g, v)]
+
+
+def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the shaker's opening above the target, tilted, and shake three times."""
+    tilt = tilted(v)
+    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, POUR_HEIGHT + 0.02])
+    steps = [*pick(g, v, holding), over_target(g, v), move("tilt", spout, tilt)]
+    for k in range(3):
+        steps += [move(f"shake {k + 1} down", spout - [0, 0, 0.02], tilt), Step("spill", "shake", particles=8),
+                  move(f"shake {k + 1} up", spout, tilt)]
+    return [*steps, over_target(g, v)]
+
+
+def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -> list[Step]:
+    """Lower the held object into or onto the target and let go (heat, fry; blend also presses)."""
+    depth = CONTAINERS.get(g.target.label, (0, 0, 0))[2]
+    grip_pos, orn = g.grip_pose(v)
+    drop = grip_pos[2] - g.held_top[2] + height(g.held.label)  # gripper above the held object's bottom
+    # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
+    z = max(g.target_top[2] - depth + 0.015 + drop, g.target_top[2] + 0.01)
+    t = g.target_top
+    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.label}", [t[0], t[1], z], orn,
+                                                            touches="target"), Step("release", "let go")]
+    if press:
+        steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
+    return [*steps, above(t, "retreat", orn)]
+
+
+def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Carry the object over the target, turn the hand over and let go."""
+    tilt = tilted(v)
+    turned = gripper_for(g.centre(v), tilt, g.target_top + [0, 0, 0.03 + height(g.held.label) / 2])
+    return [*pick(g, v, holding), over_target(g, v), move("turn over", turned, tilt), Step("release", "let go"),
+            over_target(g, v)]
+
+
+def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Lower the held object below the target's rim, then lift it back out."""
+    _, orn = g.grip_pose(v)
+    t = g.target_top
+    bottom_below_rim = 0.02 + 0.3 * height(g.held.label)
+    z = t[2] - bottom_below_rim + height(g.held.label) + GRIP_GAP
+    return [*pick(g, v, holding), over_target(g, v), move("dip", [t[0], t[1], z], orn, touches="target", probe="dip"),
+            move("lift out", [t[0], t[1], t[2] + height(g.held.label) + 0.06], orn, probe="lifted")]
+
+
+def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the object just above the target's surface and stroke across it four times."""
+    _, orn = g.grip_pose(v)
+    t = g.target_top
+    lo, hi = g.target_box
+    reach = max(0.02, (hi[0] - lo[0]) / 2 - 0.03)
+    z = t[2] + height(g.held.label) + GRIP_GAP + 0.01  # the held object skims the surface
+    strokes = [move(f"stroke {k + 1}", [t[0] + (reach if k % 2 else -reach), t[1], z], orn, touches="target",
+                    probe=f"stroke {k + 1}") for k in range(4)]
+    return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
+
+
+@dataclass
+class Outcome:
+    """What happened while the program ran: particles poured, the held object's poses at probes."""
+
+    particles: list[int] = field(default_factory=list)
+    probes: dict[str, tuple] = field(default_factory=dict)  # name -> (position, AABB)
+
+
+def inside(target: SceneObject, point, above: float = 0.05) -> bool:
+    """Whether a point lies within the target's outline, above the table and at most `above` over its
+    rim (0.01: held in it, as a liquid must be; more: resting on top of it)."""
+    lo, hi = p.getAABB(target.body)
+    return lo[0] <= point[0] <= hi[0] and lo[1] <= point[1] <= hi[1] and TABLE_TOP - 0.01 <= point[2] <= hi[2] + above
+
+
+def share_inside(target: SceneObject, bodies: list[int], above: float) -> float:
+    hits = sum(inside(target, p.getBasePositionAndOrientation(b)[0], above) for b in bodies)
+    return round(hits / max(len(bodies), 1), 3)
+
+
+def check_pour(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    share = share_inside(target, out.particles, above=0.01)  # a liquid must stay inside, below the rim
+    return {"liquid_in_target": share, "ok": share >= 0.6}
+
+
+def check_sprinkle(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    share = share_inside(target, out.particles, above=0.05)
+    return {"powder_on_target": share, "ok": share >= 0.6}
+
+
+def check_in_target(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    ok = inside(target, p.getBasePositionAndOrientation(held.body)[0])
+    return {"in_target": ok, "ok": ok}
+
+
+def check_dip(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    rim = p.getAABB(target.body)[1][2]
+    pos, box = out.probes["dip"]
+    dipped = box[0][2] < rim and inside(target, pos)
+    lifted = out.probes["lifted"][1][0][2] > rim
+    return {"dipped_below_rim": bool(dipped), "lifted_out": bool(lifted), "ok": bool(dipped and lifted)}
+
+
+def check_stroke(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    lo, hi = p.getAABB(target.body)
+    on = all(lo[0] - 0.02 <= pos[0] <= hi[0] + 0.02 and lo[1] - 0.02 <= pos[1] <= hi[1] + 0.02
+             for name, (pos, _) in out.probes.items() if name.startswith("stroke"))
+    return {"over_target": bool(on), "ok": bool(on)}
+
+
+@dataclass(frozen=True)
+class Task:
+    held_role: str  # the role whose object the gripper holds
+    target_role: str  # the role whose object it acts on
+    program: Callable[[Geometry, Variant, bool], list[Step]]
+    check: Callable[[SceneObject, SceneObject, Outcome], dict]
+
+
+TASKS = {
+    "pour": Task("Theme", "Destination", program_pour, check_pour),
+    "fill": Task("Theme", "Destination", program_pour, check_pour),
+    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle),
+    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle),
+    "heat": Task("Theme", "Instrument", program_place, check_in_target),
+    "fry": Task("Theme", "Instrument", program_place, check_in_target),
+    "blend": Task("Theme", "Destination", lambda g, v, h: program_place(g, v, h, press=True), check_in_target),
+    "dump": Task("Theme", "Destination", program_dump, check_in_target),
+    "dip": Task("Theme", "Destination", program_dip, check_dip),
+    "brush": Task("Theme", "Destination", program_stroke, check_stroke),
+    "rub": Task("Theme", "Destination", program_stroke, check_stroke),
+}
+
+
+def held_half_width(held: SceneObject) -> float:
+    return footprint(held.label)
