@@ -23,6 +23,7 @@ IK_POSITION = 0.003  # metres: a pose counts as reachable when IK gets this clos
 IK_ROTATION = 0.03  # ... and this close in orientation (radians)
 JOINT_STEP = 0.012  # radians per control tick pair while following a path (about 1.4 rad/s)
 SETTLED = 0.002  # radians: the joints have arrived
+GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside the object's box to hold it
 
 
 def rotation_error(current, target) -> np.ndarray:
@@ -159,15 +160,14 @@ class Arm:
     def grasp(self, body: int, half_width: float) -> bool:
         """Close the fingers on an object `half_width` wide and attach it where it is; False when the
         object is not under the fingertips (knocked away or never reached)."""
-        close = float(np.clip(0.045 - half_width - 0.003, 0.0, FINGER_TRAVEL))
+        # finger centres start 4.5 cm out and are 1 cm thick: stop 2 mm short of the object's sides
+        close = float(np.clip(0.040 - half_width - 0.002, 0.0, FINGER_TRAVEL))
         p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=[close, -close])
         for _ in range(60):
             p.stepSimulation()
         ee_pos, _ = self.ee_pose()
-        obj_pos, _ = p.getBasePositionAndOrientation(body)
         lo, hi = p.getAABB(body)
-        reach = math.hypot(ee_pos[0] - obj_pos[0], ee_pos[1] - obj_pos[1])
-        if reach > max(hi[0] - lo[0], hi[1] - lo[1]) / 2 or abs(ee_pos[2] - hi[2]) > 0.03:
+        if not all(lo[k] - GRASP_SLACK <= ee_pos[k] <= hi[k] + GRASP_SLACK for k in range(3)):
             return False
         self.attach(body)
         return True

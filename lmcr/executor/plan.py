@@ -71,11 +71,18 @@ class Planner:
                     _put_in_hand(arm, held)
                 g = Geometry.measure(held, target)
                 clearance = Clearance(arm, self._obstacles(held))
-                for variant in (variants(held) if not holding else [v for v in variants(held) if v.yaw == 0.0]):
+                failed_grasps = set()
+                for variant in _variants(held, task, holding):
+                    grasp = (variant.yaw, variant.pitch, variant.side)
+                    if grasp in failed_grasps:
+                        continue  # the same pick-up failed already: only the later steps differ
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
-                    result = self._plan_variant(arm, clearance, task.program(g, variant, holding), held, target, carried)
+                    steps = task.program(g, variant, holding)
+                    result = self._plan_variant(arm, clearance, steps, held, target, carried)
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, g)
+                    if result.progress < _pick_steps(steps):
+                        failed_grasps.add(grasp)
                     if result.progress > best.progress:
                         best = result
             finally:
@@ -126,6 +133,20 @@ class Planner:
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
+
+
+def _pick_steps(steps: list[Step]) -> int:
+    """How many of a program's steps pick the object up (up to and including the lift after the grasp)."""
+    kinds = [s.kind for s in steps]
+    return kinds.index("grasp") + 2 if "grasp" in kinds else 0
+
+
+def _variants(held: SceneObject, task: Task, holding: bool) -> list[Variant]:
+    """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
+    over in (tilting either way)."""
+    if holding:
+        return [v for v in variants(held) if v.yaw == 0.0 and not v.side]
+    return variants(held, task.pours)
 
 
 def _grasped(arm: Arm, q, held: SceneObject) -> tuple:

@@ -17,12 +17,16 @@ import numpy as np
 import pybullet as p
 
 from lmcr.executor.arm import DOWN
-from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, solid_shape
+from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, solid_shape, world_xy
 
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
 TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
 POUR_HEIGHT = 0.10  # the opening this far above the target's rim: low enough to aim, high enough for the hand
-PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far side of the table
+SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
+SIDE_GRIP_WIDTH = 0.07  # objects at most this wide fit between the open fingers
+SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
+PITCHES = (0.0, 0.5)
+TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
 
 
@@ -44,12 +48,21 @@ class Variant:
     """One way to do the task (radians): the gripper's yaw when grasping, how far it leans away from the
     robot (reaching the far side of the table needs the hand pitched forward) and the way it tilts."""
 
-    yaw: float = 0.0
+    yaw: float = 0.0  # a side grasp's heading: the horizontal direction the gripper points in
     pitch: float = 0.0
-    tilt_sign: int = 1  # which way it turns about the fingers' line
+    tilt_sign: int = 1  # which way it turns to pour
+    side: bool = False  # grasped from the side (bottles and shakers, to pour), not by the top
+    turn: float = 0.0  # how far the hand turns about the vertical between the grasp and the target
+
+    def at_target(self) -> tuple:
+        """The gripper orientation over the target: the grasp's, turned about the vertical (the held
+        object stays upright)."""
+        return _turned(self.upright(), self.turn)
 
     def upright(self) -> tuple:
         """The gripper orientation that grasps, and carries the grasped object upright."""
+        if self.side:  # gripper axis horizontal along the heading, fingers either side of the object
+            return p.getQuaternionFromEuler((0, math.pi / 2, self.yaw))
         lean = p.getQuaternionFromAxisAngle((0, 1, 0), -self.pitch)  # gripper axis towards +x (away)
         return p.multiplyTransforms([0, 0, 0], lean, [0, 0, 0], _turned(DOWN, self.yaw))[1]
 
@@ -77,11 +90,15 @@ class Geometry:
                    np.array([tpos[0], tpos[1], hi[2]]), (lo, hi))
 
     def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
-        """The gripper pose that grasps the held object by its top."""
+        """The gripper pose that grasps the held object by its top, or from the side around its body
+        (high enough for the hand to clear the table)."""
+        if variant.side:
+            h = height(self.held.label)
+            return self.held_top - [0, 0, h - max(SIDE_GRIP * h, SIDE_GRIP_MIN)], variant.upright()
         return self.held_top + [0, 0, GRIP_GAP], variant.upright()
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
-        """The held object's pose relative to the gripper after a top grasp."""
+        """The held object's pose relative to the gripper after the grasp."""
         pos, orn = self.grip_pose(variant)
         inv_pos, inv_orn = p.invertTransform(pos.tolist(), orn)
         return p.multiplyTransforms(inv_pos, inv_orn, self.held_pos, self.held_orn)
@@ -95,6 +112,10 @@ class Geometry:
         """The held object's opening (just above its top) in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - self.held_pos[2] + 0.012])
 
+    def bottom(self, variant: Variant) -> np.ndarray:
+        """The middle of the held object's underside in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) - self.held_pos[2]])
+
     def centre(self, variant: Variant) -> np.ndarray:
         """The held object's middle in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
@@ -106,11 +127,12 @@ def _turned(orientation, yaw: float) -> tuple:
 
 
 def tilted(variant: Variant) -> tuple:
-    """The gripper orientation with the grasped object turned TILT about the line between the fingers:
-    turned about any other axis, a finger would end up under the opening, in the way of what pours."""
-    upright = variant.upright()
-    fingers_line = np.asarray(p.getMatrixFromQuaternion(upright)).reshape(3, 3)[:, 1]
-    turn = p.getQuaternionFromAxisAngle(fingers_line.tolist(), variant.tilt_sign * TILT)
+    """The gripper orientation with the grasped object turned TILT: a side grasp rolls the wrist about
+    the gripper's axis; a top grasp turns about the line between the fingers (about any other axis a
+    finger would end up under the opening, in the way of what pours)."""
+    upright = variant.at_target()
+    axis = np.asarray(p.getMatrixFromQuaternion(upright)).reshape(3, 3)[:, 2 if variant.side else 1]
+    turn = p.getQuaternionFromAxisAngle(axis.tolist(), variant.tilt_sign * TILT)
     return p.multiplyTransforms([0, 0, 0], turn, [0, 0, 0], upright)[1]
 
 
@@ -120,14 +142,23 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
     return np.asarray(goal) - offset
 
 
-def variants(held: SceneObject) -> list[Variant]:
-    """The grasp yaws that suit the held object's shape (fingers across a long object), upright or
-    leaning forward, each tilting either way."""
+def variants(held: SceneObject, pours: bool = False) -> list[Variant]:
+    """The grasps that suit the held object's shape (fingers across a long object), upright or leaning
+    forward, each tilting either way; for pouring, side grasps first where the object fits between the
+    fingers (the hand then stays high while it pours), headed from the robot towards the object."""
     shape = solid_shape(held.label) if held.label not in CONTAINERS else ("box", *CONTAINERS[held.label])
     yaws = [0.0, math.pi / 2, -math.pi / 2]
     if shape[0] == "box" and abs(shape[1] - shape[2]) > 0.02:
         yaws = [0.0, math.pi] if shape[1] > shape[2] else [math.pi / 2, -math.pi / 2]
-    return [Variant(yaw, pitch, sign) for pitch in PITCHES for yaw in yaws for sign in (1, -1)]
+    signs = (1, -1) if pours else (1,)
+    top = [Variant(yaw, pitch, sign, turn=turn) for pitch in PITCHES for yaw in yaws for turn in TURNS for sign in signs]
+    if not pours or 2 * footprint(held.label) > SIDE_GRIP_WIDTH:
+        return top
+    x, y = world_xy(held.xy)
+    heading = math.atan2(y, x)
+    side = [Variant(heading + a, 0.0, sign, side=True, turn=turn) for a in (0.0, 0.5, -0.5) for turn in TURNS
+            for sign in signs]
+    return side + top
 
 
 def above(xy, name: str, orientation=DOWN) -> Step:
@@ -139,17 +170,25 @@ def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = 
 
 
 def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
-    """Approach from above, grasp the top, lift (nothing to do when the object is already in the hand)."""
+    """Approach from above and grasp the top, or from the side around the body; lift (nothing to do
+    when the object is already in the hand)."""
     if holding:
         return []
     pos, orn = g.grip_pose(v)
     label = g.held.label
+    if v.side:
+        back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
+        return [move(f"next to {label}", pos - back, orn), move(f"grip {label}", pos, orn, touches="held"),
+                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn)]
     return [above(pos, f"above {label}", orn), move(f"grip {label}", pos, orn, touches="held"),
             Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn)]
 
 
-def over_target(g: Geometry, v: Variant) -> Step:
-    return above(g.target_top, f"over {g.target.label}", v.upright())
+def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
+    """Carrying height with the held object's middle over the target's."""
+    orn = v.at_target()
+    offset = gripper_for(g.centre(v), orn, [0, 0, 0])
+    return above(g.target_top + offset, name or f"over {g.target.label}", orn)
 
 
 def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -174,12 +213,12 @@ def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -> list[Step]:
     """Lower the held object into or onto the target and let go (heat, fry; blend also presses)."""
     depth = CONTAINERS.get(g.target.label, (0, 0, 0))[2]
-    grip_pos, orn = g.grip_pose(v)
-    drop = grip_pos[2] - g.held_top[2] + height(g.held.label)  # gripper above the held object's bottom
+    orn, t = v.at_target(), g.target_top
+    drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
     # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
-    z = max(g.target_top[2] - depth + 0.015 + drop, g.target_top[2] + 0.01)
-    t = g.target_top
-    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.label}", [t[0], t[1], z], orn,
+    bottom = max(t[2] - depth + 0.015, t[2] + 0.01 - drop)
+    lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
+    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.label}", lower, orn,
                                                             touches="target"), Step("release", "let go")]
     if press:
         steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
@@ -196,23 +235,21 @@ def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 
 def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Lower the held object below the target's rim, then lift it back out."""
-    _, orn = g.grip_pose(v)
-    t = g.target_top
-    bottom_below_rim = 0.02 + 0.3 * height(g.held.label)
-    z = t[2] - bottom_below_rim + height(g.held.label) + GRIP_GAP
-    return [*pick(g, v, holding), over_target(g, v), move("dip", [t[0], t[1], z], orn, touches="target", probe="dip"),
-            move("lift out", [t[0], t[1], t[2] + height(g.held.label) + 0.06], orn, probe="lifted")]
+    orn, t = v.at_target(), g.target_top
+    dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
+    out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
+    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip"),
+            move("lift out", out, orn, probe="lifted")]
 
 
 def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Hold the object just above the target's surface and stroke across it four times."""
-    _, orn = g.grip_pose(v)
-    t = g.target_top
+    orn, t = v.at_target(), g.target_top
     lo, hi = g.target_box
     reach = max(0.02, (hi[0] - lo[0]) / 2 - 0.03)
-    z = t[2] + height(g.held.label) + GRIP_GAP + 0.01  # the held object skims the surface
-    strokes = [move(f"stroke {k + 1}", [t[0] + (reach if k % 2 else -reach), t[1], z], orn, touches="target",
-                    probe=f"stroke {k + 1}") for k in range(4)]
+    # the held object's underside skims the surface, 1 cm above it
+    strokes = [move(f"stroke {k + 1}", gripper_for(g.bottom(v), orn, t + [reach if k % 2 else -reach, 0, 0.01]),
+                    orn, touches="target", probe=f"stroke {k + 1}") for k in range(4)]
     return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
 
 
@@ -272,13 +309,14 @@ class Task:
     target_role: str  # the role whose object it acts on
     program: Callable[[Geometry, Variant, bool], list[Step]]
     check: Callable[[SceneObject, SceneObject, Outcome], dict]
+    pours: bool = False  # the held object's contents run out of its opening
 
 
 TASKS = {
-    "pour": Task("Theme", "Destination", program_pour, check_pour),
-    "fill": Task("Theme", "Destination", program_pour, check_pour),
-    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle),
-    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle),
+    "pour": Task("Theme", "Destination", program_pour, check_pour, pours=True),
+    "fill": Task("Theme", "Destination", program_pour, check_pour, pours=True),
+    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle, pours=True),
+    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle, pours=True),
     "heat": Task("Theme", "Instrument", program_place, check_in_target),
     "fry": Task("Theme", "Instrument", program_place, check_in_target),
     "blend": Task("Theme", "Destination", lambda g, v, h: program_place(g, v, h, press=True), check_in_target),
