@@ -23,6 +23,7 @@ import time
 
 from lmcr.executor.execute import execute
 from lmcr.executor.scene import make_scene
+from lmcr.jsonl import InputError
 from lmcr.lexicon import load_lexicon
 from lmcr.methods import COMPLETION_METHOD
 from lmcr.workspace import Workspace
@@ -73,6 +74,20 @@ def refusal_reason(out: dict) -> str:
     return reason[:40]
 
 
+def random_scene(seed: str, stated: str, expected: str, objects: tuple, distractors: int, holding: str | None):
+    """The task's objects and random distractors at random spots; a draw whose objects do not fit on
+    the table is drawn again."""
+    for attempt in range(100):
+        rng = random.Random(f"{seed}:{attempt}" if attempt else seed)
+        others = rng.sample([o for o in objects if o not in (stated, expected)], distractors)
+        on_table = [o for o in [stated, expected, *others] if o != holding]
+        try:
+            return make_scene([(label, None) for label in on_table], seed=rng.randrange(10**6), holding=holding)
+        except InputError:  # no room for them all
+            continue
+    raise RuntimeError(f"{seed}: no layout fits")
+
+
 def main() -> None:
     parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser_.add_argument("--placements", type=int, default=20)
@@ -95,11 +110,8 @@ def main() -> None:
         instruction, stated, expected, role = TASKS[predicate]
         row = collections.Counter()
         for k in range(args.placements):
-            rng = random.Random(f"{args.seed}:{predicate}:{k}")
-            others = rng.sample([o for o in objects if o not in (stated, expected)], args.distractors)
-            holding = stated if args.holding and predicate in HELD_IS_STATED else None
-            on_table = [o for o in [stated, expected, *others] if o != holding]
-            scene = make_scene([(label, None) for label in on_table], seed=rng.randrange(10**6), holding=holding)
+            scene = random_scene(f"{args.seed}:{predicate}:{k}", stated, expected, objects, args.distractors,
+                                 stated if args.holding and predicate in HELD_IS_STATED else None)
             started = time.perf_counter()
             out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected})
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])

@@ -570,8 +570,12 @@ def execute(
     if not json_out:
         for w in result["waypoints"]:
             console.print(f"  {w['name']}: {1000 * w['error_m']:.1f} mm", highlight=False)
-        console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
-                      f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
+        if result["feasible"]:
+            console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
+                          f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
+        else:  # planned, found infeasible: the robot did not move
+            console.print(escape(f"not done (the robot did not move): {result['reason']}"
+                                 + (f". {result['question']}" if result.get("question") else "")), highlight=False)
     print(json.dumps(result))
 
 

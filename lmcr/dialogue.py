@@ -80,15 +80,40 @@ def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Ca
                     outcomes.append({"instruction": instruction, "left": True, "question": completion["question"]})
                     continue
             result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
+            if not result["feasible"] and result.get("suggestion"):  # "I can't reach the cup. Should I ...?"
+                answer = _offer(result, turns, on_table, parser.lex.objects, say)
+                if answer is None:
+                    outcomes.append({"instruction": instruction, "left": True, **result})
+                    continue
+                result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
         except LMCRError as exc:
             say(f"robot: {one_line(exc)}")
             outcomes.append({"instruction": instruction, "error": one_line(exc)})
             continue
         frame = result["frame"]
-        say(f"robot: {frame['predicate']} {frame['roles']} with the {result['arm']} arm: "
-            f"{'done' if result['success'] else 'that did not work'}.")
+        if result["feasible"]:
+            say(f"robot: {frame['predicate']} {frame['roles']} with the {result['arm']} arm: "
+                f"{'done' if result['success'] else 'that did not work'}.")
+        else:
+            say(f"robot: I can't do that without a mishap: {result['reason']}.")
         outcomes.append({"instruction": instruction, **({"answer": answer} if answer else {}), **result})
     return outcomes
+
+
+def _offer(result: dict, turns: Iterator[str], on_table: list[str], vocabulary: tuple[str, ...],
+           say: Callable[[str], None]) -> dict[str, str] | None:
+    """Offer the feasible alternative the robot found; yes (or naming it) takes it, anything else leaves it."""
+    role, offered = next(iter(result["suggestion"].items()))
+    say(f"robot: {result['question']}")
+    reply = next(turns, None)
+    if reply is None:
+        return None
+    say(f"you: {reply}")
+    reading = read_answer(reply, [offered, result["chosen_object"]], on_table, vocabulary)
+    if reading.choice != offered:
+        say("robot: I'll leave it.")
+        return None
+    return {role: offered}
 
 
 def _ask(completion: dict, turns: Iterator[str], on_table: list[str], vocabulary: tuple[str, ...],

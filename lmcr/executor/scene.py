@@ -209,7 +209,10 @@ def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
         half = [s / 2 for s in shape[1:]]
         col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half)
         vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_color(label))
-    return p.createMultiBody(0.15, col, vis, [x, y, z + height(label) / 2 + 0.001])
+    body = p.createMultiBody(0.15, col, vis, [x, y, z + height(label) / 2 + 0.001])
+    # real fruit and eggs do not roll on for ever: without rolling resistance a grazed sphere leaves the table
+    p.changeDynamics(body, -1, rollingFriction=0.002, spinningFriction=0.002)
+    return body
 
 
 def build_world(scene: Scene, cache_dir: Path) -> int:
