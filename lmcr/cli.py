@@ -507,6 +507,8 @@ def execute(
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     audio: Path | None = typer.Option(None, help="The instruction spoken, as a WAV file (instead of INSTRUCTION)."),
     speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    urdf: Path | None = typer.Option(None, help="Official Baxter URDF (baxter_common/baxter_description/urdf/"
+                                                "baxter.urdf; default $LMCR_BAXTER_URDF, else the built-in model)."),
 ) -> None:
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
     with --audio, the instruction is heard first; with --input/--output, a batch of instructions and
@@ -520,6 +522,7 @@ def execute(
     from lmcr.jsonl import check_text, read_bytes, write_jsonl_atomic
 
     ws = Workspace.from_env()
+    urdf = urdf or ws.baxter_urdf
     batch = input is not None or output is not None
     if batch and (input is None or output is None or instruction is not None or scene is not None or render):
         fail("the batch form takes --input IN.jsonl and --output OUT.jsonl (no instruction, --scene or --render)")
@@ -554,7 +557,7 @@ def execute(
             return
         instruction = heard["text"]
     if batch:
-        run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, ws.robot)  # noqa: E731
+        run = lambda text, layout: run_instruction(text, layout, parser, scorer, config, ws.robot, urdf=urdf)  # noqa: E731
         results = list(execute_batch(input, run))
         write_jsonl_atomic(output, results)
         ok = sum(1 for r in results if r.get("success"))
@@ -562,7 +565,7 @@ def execute(
         console.print(f"{len(results):,} lines -> {output}: {ok} succeeded, {errors} errors")
         return
     frames: list | None = [] if render else None
-    result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, frames)
+    result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, frames, urdf=urdf)
     if render:
         result["render"] = str(save_render(frames, render))
     if heard is not None:

@@ -1,7 +1,7 @@
 """One LMCR installation: where it reads and writes, and what every command and flow builds from it.
 
 `Workspace.from_env()` is the one place the environment is read (`LMCR_DATA_DIR`, `LMCR_DB`,
-`LMCR_SQL_DIR`, `LMCR_SPACY_MODEL`, `LMCR_VECTORS`, `LMCR_CONCEPTNET`, `LMCR_PAPER`); explicit
+`LMCR_SQL_DIR`, `LMCR_SPACY_MODEL`, `LMCR_VECTORS`, `LMCR_CONCEPTNET`, `LMCR_PAPER`, `LMCR_BAXTER_URDF`); explicit
 arguments win over it. The CLI builds one per command and each flow one per run, then asks it for a
 folder, a store connection, the scorers' resources, the parser or a scorer.
 """
@@ -46,6 +46,7 @@ class Workspace:
     vectors: Path | None = None  # word vectors for the w2v baseline (else trained on the corpus)
     conceptnet: Path | None = None  # ConceptNet edges or Numberbatch for the conceptnet baseline
     paper: Path | None = None  # the paper's LaTeX source: its Table I beside ours in the report
+    baxter_urdf: Path | None = None  # the official Baxter description (else the built-in one)
 
     @classmethod
     def from_env(cls, data_dir: str | Path | None = None, db: str | Path | None = None) -> Workspace:
@@ -54,7 +55,8 @@ class Workspace:
         return cls(data_dir=data, db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
                    sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or SQL_DIR),
                    spacy_model=spacy_model_from_env(), vectors=_env_path("LMCR_VECTORS"),
-                   conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"))
+                   conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"),
+                   baxter_urdf=_env_path("LMCR_BAXTER_URDF"))
 
     @property
     def srl_dir(self) -> Path:

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.baxter import FINGER_TRAVEL, JOINTS
+from lmcr.executor.baxter import JOINTS
 
 DOWN = p.getQuaternionFromEuler((math.pi, 0, 0))  # gripper pointing at the table
 ORIENTATION_WEIGHT = 0.3  # metres of position error one radian of orientation error is worth
@@ -23,6 +23,7 @@ IK_POSITION = 0.003  # metres: a pose counts as reachable when IK gets this clos
 IK_ROTATION = 0.03  # ... and this close in orientation (radians)
 JOINT_STEP = 0.012  # radians per control tick pair while following a path (about 1.4 rad/s)
 SETTLED = 0.002  # radians: the joints have arrived
+FINGER_THICKNESS = 0.01  # metres, both grippers' finger pads
 GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside the object's box to hold it
 
 
@@ -59,7 +60,9 @@ class Arm:
     def __post_init__(self) -> None:
         names = joint_index(self.robot)
         self.joints = [names[f"{self.side}_{j}"] for j in JOINTS]
-        self.fingers = [names[f"{self.side}_gripper_l_finger_joint"], names[f"{self.side}_gripper_r_finger_joint"]]
+        # ours: left_gripper_l_finger_joint; the official electric gripper's: l_gripper_l_finger_joint
+        self.fingers = [names.get(f"{self.side}_gripper_{f}_finger_joint", names.get(f"{self.side[0]}_gripper_{f}_finger_joint"))
+                        for f in "lr"]
         self.ee = names[f"{self.side}_endpoint"]
         self.movable = [i for i in range(p.getNumJoints(self.robot)) if p.getJointInfo(self.robot, i)[2] != p.JOINT_FIXED]
         self.columns = [self.movable.index(j) for j in self.joints]  # this arm's columns of the Jacobian
@@ -69,6 +72,26 @@ class Arm:
         self.home = np.array([0.08 * sign, -1.0, -1.19 * sign, 1.94, 0.67 * sign, 1.03, -0.5 * sign])
         # out of the other arm's way: the shoulder turned outwards, the hand raised
         self.parked = np.array([0.9 * sign, -0.6, -1.19 * sign, 1.94, 0.67 * sign, 1.03, -0.5 * sign])
+        self.finger_open, self.finger_shut, self.gaps = self._finger_range()
+        self.opening = self.gaps[0] - FINGER_THICKNESS  # the widest object that fits between the open fingers
+
+    def _finger_range(self) -> tuple[list[float], list[float], tuple[float, float]]:
+        """Finger joint targets that open and shut the gripper, and the distance between the fingers'
+        middles open and shut (measured: grippers differ in which way their joints move)."""
+        limits = [p.getJointInfo(self.robot, j)[8:10] for j in self.fingers]
+        saved = [p.getJointState(self.robot, j)[0] for j in self.fingers]
+
+        def gap(targets) -> float:
+            for j, v in zip(self.fingers, targets):
+                p.resetJointState(self.robot, j, v)
+            a, b = (np.mean(p.getAABB(self.robot, j), axis=0) for j in self.fingers)
+            return float(np.linalg.norm(a - b))
+
+        one, other = [limits[0][0], limits[1][1]], [limits[0][1], limits[1][0]]
+        (wide, d_wide), (narrow, d_narrow) = sorted([(one, gap(one)), (other, gap(other))], key=lambda t: -t[1])
+        for j, v in zip(self.fingers, saved):
+            p.resetJointState(self.robot, j, v)
+        return wide, narrow, (d_wide, d_narrow)
 
     # kinematics (planning)
     def config(self) -> np.ndarray:
@@ -160,9 +183,11 @@ class Arm:
     def grasp(self, body: int, half_width: float) -> bool:
         """Close the fingers on an object `half_width` wide and attach it where it is; False when the
         object is not under the fingertips (knocked away or never reached)."""
-        # finger centres start 4.5 cm out and are 1 cm thick: stop 2 mm short of the object's sides
-        close = float(np.clip(0.040 - half_width - 0.002, 0.0, FINGER_TRAVEL))
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=[close, -close])
+        # the fingers stop 2 mm short of the object's sides
+        wide, narrow = self.gaps
+        shut = float(np.clip((wide - FINGER_THICKNESS - 2 * half_width - 0.004) / (wide - narrow), 0.0, 1.0))
+        targets = [o + (s - o) * shut for o, s in zip(self.finger_open, self.finger_shut)]
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=targets)
         for _ in range(60):
             p.stepSimulation()
         ee_pos, _ = self.ee_pose()
@@ -189,7 +214,7 @@ class Arm:
         away (turned back on while it still overlaps the fingers, contact would throw it off the table)."""
         if self.constraint is not None:
             p.removeConstraint(self.constraint)
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=[0.0, 0.0])  # open
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=self.finger_open)
         settle(240)
         if self.held is not None:
             robot_collisions(self.robot, self.held, True)

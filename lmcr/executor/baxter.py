@@ -4,13 +4,13 @@ pybullet ships no Baxter. Joint origins, axes and limits below are those of Reth
 `baxter_description` (arm mounts on the torso at +-45 degrees, seven revolute joints per arm
 s0 s1 e0 e1 w0 w1 w2, each about its local z axis), then the hand, the electric gripper base and a
 parallel gripper with two prismatic fingers. Links are cylinders and boxes of roughly the real size;
-masses are the published ones rounded. `LMCR_BAXTER_URDF` points at an official description instead.
+masses are the published ones rounded. `LMCR_BAXTER_URDF` / `--urdf` use the official description instead
+(`official.py`).
 """
 
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 from lmcr.files import atomic_path
@@ -99,13 +99,15 @@ def urdf_text() -> str:
     return "\n".join(parts)
 
 
-def baxter_urdf(cache_dir: Path) -> Path:
-    """`$LMCR_BAXTER_URDF` if set, else our URDF written (atomically) under `cache_dir`."""
-    official = os.environ.get("LMCR_BAXTER_URDF")
-    if official:
-        if not Path(official).exists():
-            raise FileNotFoundError(f"LMCR_BAXTER_URDF={official}: no such file")
-        return Path(official)
+def baxter_urdf(cache_dir: Path, official: Path | None = None) -> Path:
+    """Our URDF written (atomically) under `cache_dir`, or the official description at `official`
+    (`baxter_common/baxter_description/urdf/baxter.urdf`) made loadable there."""
+    if official is not None:
+        from lmcr.executor.official import RobotModelError, official_urdf
+
+        if not Path(official).is_file():
+            raise RobotModelError(f"{official}: no such robot description")
+        return official_urdf(Path(official), cache_dir)
     path = Path(cache_dir) / "baxter.urdf"
     text = urdf_text()
     if not path.exists() or path.read_text(encoding="utf-8") != text:

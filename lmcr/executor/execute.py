@@ -31,15 +31,16 @@ def _connect() -> None:
 
 
 def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
-            frames: list | None = None, answer: dict[str, str] | None = None) -> dict:
+            frames: list | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
     """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success, and
     whether the plan was feasible. The robot moves only when the whole plan is feasible. When the
     language model's choice is not but another candidate is, nothing moves and the result asks
     (`question`, `suggestion`). With `frames` (a list), camera images are appended at every waypoint for
-    rendering. `answer` (role -> object) is what a person answered: it fills those roles instead."""
+    rendering. `answer` (role -> object) is what a person answered: it fills those roles instead.
+    `urdf`: the official Baxter description to use instead of ours."""
     started = time.perf_counter()
     _connect()
-    robot = build_world(scene, cache_dir)
+    robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config)
     completed = time.perf_counter()

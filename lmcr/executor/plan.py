@@ -72,7 +72,7 @@ class Planner:
                 g = Geometry.measure(held, target)
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
-                for variant in _variants(held, task, holding):
+                for variant in _variants(held, task, holding, arm.opening):
                     grasp = (variant.yaw, variant.pitch, variant.side)
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
@@ -141,12 +141,12 @@ def _pick_steps(steps: list[Step]) -> int:
     return kinds.index("grasp") + 2 if "grasp" in kinds else 0
 
 
-def _variants(held: SceneObject, task: Task, holding: bool) -> list[Variant]:
+def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> list[Variant]:
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
     over in (tilting either way)."""
     if holding:
         return [v for v in variants(held) if v.yaw == 0.0 and not v.side]
-    return variants(held, task.pours)
+    return variants(held, task.pours, opening)
 
 
 def _grasped(arm: Arm, q, held: SceneObject) -> tuple:

@@ -215,8 +215,9 @@ def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     return body
 
 
-def build_world(scene: Scene, cache_dir: Path) -> int:
-    """Reset a DIRECT pybullet world with floor, table, robot and the scene's objects; returns the robot."""
+def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
+    """Reset a DIRECT pybullet world with floor, table, robot (the official Baxter description at `urdf`,
+    else ours) and the scene's objects; returns the robot."""
     p.resetSimulation()
     p.setGravity(0, 0, -9.81)
     p.setTimeStep(1 / 240)
@@ -226,7 +227,7 @@ def build_world(scene: Scene, cache_dir: Path) -> int:
     scene.table = p.createMultiBody(0, p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
                                     p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
                                     [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02])
-    robot = p.loadURDF(str(baxter_urdf(cache_dir)), [0, 0, PEDESTAL_HEIGHT], useFixedBase=True)
+    robot = p.loadURDF(str(baxter_urdf(cache_dir, urdf)), [0, 0, PEDESTAL_HEIGHT], useFixedBase=True)
     scene.bodies = {}
     for obj in scene.objects:
         x, y = world_xy(obj.xy)

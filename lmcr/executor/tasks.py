@@ -22,8 +22,8 @@ from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, h
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
 TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
 POUR_HEIGHT = 0.10  # the opening this far above the target's rim: low enough to aim, high enough for the hand
+SHAKE_HEIGHT = 0.18  # a shaker's opening above the target: flat targets (pizza, steak) leave the hand no room lower
 SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
-SIDE_GRIP_WIDTH = 0.07  # objects at most this wide fit between the open fingers
 SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
 PITCHES = (0.0, 0.5)
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
@@ -142,17 +142,18 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
     return np.asarray(goal) - offset
 
 
-def variants(held: SceneObject, pours: bool = False) -> list[Variant]:
+def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object), upright or leaning
     forward, each tilting either way; for pouring, side grasps first where the object fits between the
-    fingers (the hand then stays high while it pours), headed from the robot towards the object."""
+    fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
+    robot towards the object."""
     shape = solid_shape(held.label) if held.label not in CONTAINERS else ("box", *CONTAINERS[held.label])
     yaws = [0.0, math.pi / 2, -math.pi / 2]
     if shape[0] == "box" and abs(shape[1] - shape[2]) > 0.02:
         yaws = [0.0, math.pi] if shape[1] > shape[2] else [math.pi / 2, -math.pi / 2]
     signs = (1, -1) if pours else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn) for pitch in PITCHES for yaw in yaws for turn in TURNS for sign in signs]
-    if not pours or 2 * footprint(held.label) > SIDE_GRIP_WIDTH:
+    if not pours or 2 * footprint(held.label) > opening - 0.01:
         return top
     x, y = world_xy(held.xy)
     heading = math.atan2(y, x)
@@ -202,7 +203,7 @@ def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Hold the shaker's opening above the target, tilted, and shake three times."""
     tilt = tilted(v)
-    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, POUR_HEIGHT + 0.02])
+    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, SHAKE_HEIGHT])
     steps = [*pick(g, v, holding), over_target(g, v), move("tilt", spout, tilt)]
     for k in range(3):
         steps += [move(f"shake {k + 1} down", spout - [0, 0, 0.02], tilt), Step("spill", "shake", particles=8),
