@@ -14,6 +14,7 @@ import pytest
 from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
 from lmcr.executor.detect import detect
 from lmcr.executor.scene import build_world, load_scene, make_scene, scene_from_json, world_xy
+from lmcr.config import REPO_ROOT
 from lmcr.jsonl import InputError
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
@@ -51,11 +52,15 @@ def test_urdf_has_the_published_arm_kinematics(tmp_path, monkeypatch):
     assert joints["left_torso_arm_mount"].find("origin").get("xyz") == "0.024645 0.219645 0.118588"
     assert sum(j.get("type") == "prismatic" for j in joints.values()) == 4
     path = baxter_urdf(tmp_path)
-    monkeypatch.setenv("LMCR_BAXTER_URDF", str(tmp_path / "missing.urdf"))
-    with pytest.raises(FileNotFoundError, match="LMCR_BAXTER_URDF"):
-        baxter_urdf(tmp_path)
-    monkeypatch.setenv("LMCR_BAXTER_URDF", str(path))
-    assert baxter_urdf(tmp_path / "elsewhere") == path
+    assert path == tmp_path / "baxter.urdf" and ET.parse(path).getroot().get("name") == "baxter"
+    from lmcr.executor.official import RobotModelError
+
+    with pytest.raises(RobotModelError, match="missing.urdf: no such robot description"):
+        baxter_urdf(tmp_path, tmp_path / "missing.urdf")
+    monkeypatch.setenv("LMCR_BAXTER_URDF", str(tmp_path / "x.urdf"))
+    from lmcr.workspace import Workspace
+
+    assert Workspace.from_env(data_dir=tmp_path).baxter_urdf == tmp_path / "x.urdf"
 
 
 def test_scene_validation(tmp_path):
@@ -213,3 +218,24 @@ def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply
                    said.append)
     assert "robot: I can't reach the cup. Should I pour water into the glass instead?" in said
     assert len(out) == 1 and (out[0].get("success") is True) == taken and out[0].get("left", False) != taken
+
+
+SHARED_URDF = REPO_ROOT.parent / "shared" / "robots" / "baxter_common" / "baxter_description" / "urdf" / "baxter.urdf"
+
+
+@pytest.mark.skipif(not SHARED_URDF.exists(), reason="needs ../shared (the official Baxter description)")
+def test_the_official_baxter_loads_and_pours(sim, tmp_path):
+    from lmcr.executor.arm import Arm
+    from lmcr.executor.plan import Plan, Planner
+    from lmcr.executor.run import run_plan
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    scene = make_scene([("water", [0.0, -0.1]), ("cup", [0.1, 0.2])])
+    robot = build_world(scene, tmp_path, SHARED_URDF)
+    text = next(tmp_path.glob("baxter-official-*.urdf")).read_text()
+    assert "package://" not in text and ".DAE" not in text and "l_gripper_l_finger_joint" in text
+    assert 0.05 < Arm(robot, "left").opening < 0.07  # the electric gripper's extended narrow fingers, slot 2
+    plan = Planner(robot, scene, scene.table).plan(PROGRAMS["pour"], *scene.objects, holding=False)
+    assert isinstance(plan, Plan), plan
+    out = run_plan(plan, PROGRAMS["pour"], *scene.objects, others=[])
+    assert out["success"], out
