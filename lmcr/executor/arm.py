@@ -21,8 +21,7 @@ DOWN = p.getQuaternionFromEuler((math.pi, 0, 0))  # gripper pointing at the tabl
 ORIENTATION_WEIGHT = 0.3  # metres of position error one radian of orientation error is worth
 IK_POSITION = 0.003  # metres: a pose counts as reachable when IK gets this close ...
 IK_ROTATION = 0.03  # ... and this close in orientation (radians)
-JOINT_STEP = 0.012  # radians per TICKS simulation steps while following a path (about 1 rad/s) ...
-TICKS = 3  # ... slow enough for the joints to track the planned path within its clearance
+JOINT_STEP = 0.012  # radians per control tick pair while following a path (about 1.4 rad/s)
 SETTLED = 0.002  # radians: the joints have arrived
 FINGER_THICKNESS = 0.01  # metres, both grippers' finger pads
 GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside the object's box to hold it
@@ -166,8 +165,8 @@ class Arm:
             n = max(1, math.ceil(float(np.max(np.abs(b - a))) / JOINT_STEP))
             for k in range(1, n + 1):
                 self.hold(a + (b - a) * k / n)
-                for _ in range(TICKS):
-                    p.stepSimulation()
+                p.stepSimulation()
+                p.stepSimulation()
         for _ in range(240):
             if float(np.max(np.abs(self.config() - path[-1]))) < SETTLED:
                 break

@@ -10,7 +10,7 @@ import pybullet as p
 
 from lmcr.executor.arm import Arm
 
-CLEARANCE = 0.015  # metres kept from obstacles while moving freely (the joints track the path within less)
+CLEARANCE = 0.01  # metres kept from obstacles while moving freely
 CONTACT_CLEARANCE = 0.003  # ... and on the last centimetres to a grasp or into the target
 
 

@@ -18,7 +18,6 @@ from lmcr.executor.scene import Scene, SceneObject
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, variants
 
 SIDES = ("left", "right")
-APPROACH_STEP = 0.03  # metres between IK solutions on a straight approach
 
 
 @dataclass
@@ -123,8 +122,7 @@ class Planner:
                 if hit:
                     why = f"'{step.name}' would put the {arm.side} arm against {hit}"
                     continue
-                path = _straight_in(arm, clash, q, goal, position, step) if step.touches else \
-                    joint_path(clash, q, goal, arm.limits)
+                path = joint_path(clash, q, goal, arm.limits)
                 if path is None:
                     why = f"no clear way for the {arm.side} arm to '{step.name}' ({segment_clash(clash, q, goal)} is in the way)"
                     continue
@@ -135,25 +133,6 @@ class Planner:
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
-
-
-def _straight_in(arm: Arm, clash, q, goal, position, step: Step) -> list[np.ndarray] | None:
-    """The last centimetres to a grasp or into the target along a straight line of the gripper (IK every
-    APPROACH_STEP metres, each solved from the last): a joint-space straight line could swing the
-    fingers into the object they close around."""
-    arm.set_config(q)
-    start = arm.ee_pose()[0]
-    n = max(1, int(np.ceil(np.linalg.norm(np.asarray(position) - start) / APPROACH_STEP)))
-    path, last = [np.asarray(q)], np.asarray(q)
-    for k in range(1, n):
-        last, err_pos, err_rot = arm.solve(start + (np.asarray(position) - start) * k / n, step.orientation, [last])
-        if err_pos > IK_POSITION or err_rot > IK_ROTATION:
-            return None
-        path.append(last)
-    path.append(np.asarray(goal))
-    if any(segment_clash(clash, a, b) for a, b in zip(path, path[1:])):
-        return None
-    return path
 
 
 def _pick_steps(steps: list[Step]) -> int:

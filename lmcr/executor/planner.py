@@ -13,7 +13,7 @@ from ompl import util as ou
 
 ou.setLogLevel(ou.LogLevel.LOG_NONE)  # OMPL's console chatter is no use to a CLI user
 
-RESOLUTION = 0.015  # radians between checked states along a motion (a carried bottle's far end moves ~1.5 cm)
+RESOLUTION = 0.04  # radians between checked states along a motion
 PLAN_SECONDS = 1.5  # RRT-Connect's budget for one segment
 
 
