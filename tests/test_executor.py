@@ -11,10 +11,10 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from lmcr.config import REPO_ROOT
 from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
 from lmcr.executor.detect import detect
 from lmcr.executor.scene import build_world, load_scene, make_scene, scene_from_json, world_xy
-from lmcr.config import REPO_ROOT
 from lmcr.jsonl import InputError
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
