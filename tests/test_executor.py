@@ -57,6 +57,12 @@ def test_urdf_has_the_published_arm_kinematics(tmp_path, monkeypatch):
 
     with pytest.raises(RobotModelError, match="missing.urdf: no such robot description"):
         baxter_urdf(tmp_path, tmp_path / "missing.urdf")
+    broken = tmp_path / "a" / "b" / "baxter.urdf"
+    broken.parent.mkdir(parents=True)
+    for text in ("", "<robot", '<!DOCTYPE r [<!ENTITY e "x">]><robot>&e;</robot>', b"\xff\xfe<robot/>"):
+        broken.write_bytes(text if isinstance(text, bytes) else text.encode())
+        with pytest.raises(RobotModelError, match="cannot read the robot description"):
+            baxter_urdf(tmp_path, broken)
     monkeypatch.setenv("LMCR_BAXTER_URDF", str(tmp_path / "x.urdf"))
     from lmcr.workspace import Workspace
 
@@ -201,6 +207,8 @@ def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
     assert "water" not in [d["label"] for d in out["detections"]]
     with pytest.raises(InputError, match="'holding' must be a known object"):
         scene_from_json({"objects": [], "holding": "unicorn"}, "scene")
+    with pytest.raises(InputError, match="both in the hand"):
+        scene_from_json({"objects": [{"label": "water"}], "holding": "water"}, "scene")
 
 
 @pytest.mark.parametrize("reply, taken", [("yes please", True), ("no, leave it", False)])

@@ -43,6 +43,12 @@ def rotation_error(current, target) -> np.ndarray:
     return axis / norm * angle
 
 
+def relative_pose(frame_pos, frame_orn, pos, orn) -> tuple[tuple, tuple]:
+    """The pose (`pos`, `orn`) expressed in the frame at (`frame_pos`, `frame_orn`)."""
+    inv_pos, inv_orn = p.invertTransform(list(frame_pos), frame_orn)
+    return p.multiplyTransforms(inv_pos, inv_orn, pos, orn)
+
+
 def joint_index(robot: int) -> dict[str, int]:
     """Joint name -> pybullet joint index."""
     return {p.getJointInfo(robot, i)[1].decode(): i for i in range(p.getNumJoints(robot))}
@@ -199,10 +205,7 @@ class Arm:
 
     def attach(self, body: int) -> None:
         """Hold `body` rigidly where it is relative to the gripper."""
-        ee_pos, ee_orn = self.ee_pose()
-        obj_pos, obj_orn = p.getBasePositionAndOrientation(body)
-        inv_pos, inv_orn = p.invertTransform(ee_pos.tolist(), ee_orn)
-        rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
+        rel_pos, rel_orn = relative_pose(*self.ee_pose(), *p.getBasePositionAndOrientation(body))
         self.constraint = p.createConstraint(self.robot, self.ee, body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos,
                                              [0, 0, 0], rel_orn)
         p.changeConstraint(self.constraint, maxForce=500)

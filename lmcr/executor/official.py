@@ -18,11 +18,11 @@ from pathlib import Path
 from defusedxml import ElementTree as SafeET
 
 from lmcr.errors import LMCRError
+from lmcr.executor.baxter import FINGER_TRAVEL
 from lmcr.files import atomic_path
 
 XACRO = "{http://www.ros.org/wiki/xacro}"
 SLOT_PITCH, SLOT_ZERO = 0.0095, 0.011  # electric gripper: finger slot spacing and first-slot offset (xacro)
-FINGER_TRAVEL = 0.020833
 
 
 class RobotModelError(LMCRError, ValueError):
@@ -33,19 +33,22 @@ def official_urdf(urdf: Path, cache_dir: Path) -> Path:
     """A pybullet-loadable copy of the official URDF at `urdf` (inside `baxter_common/`), written once
     per source under `cache_dir`."""
     urdf = Path(urdf).resolve()
+    if len(urdf.parents) < 3:
+        raise RobotModelError(f"{urdf}: expected baxter_common/baxter_description/urdf/baxter.urdf")
     root = urdf.parents[2]  # baxter_common/ holding baxter_description/ and rethink_ee_description/
-    try:
-        tree = SafeET.parse(urdf)
-    except (OSError, SafeET.ParseError) as exc:
-        raise RobotModelError(f"{urdf}: cannot read the robot description ({exc})") from exc
-    robot = tree.getroot()
-    for mesh in robot.iter("mesh"):
-        mesh.set("filename", str(_mesh_file(root, mesh.get("filename", ""), urdf)))
-    for tag in ("gazebo", "transmission"):
-        for element in robot.findall(tag):
-            robot.remove(element)
-    for side in ("left", "right"):
-        _replace_gripper(robot, root, side)
+    try:  # defusedxml refuses entity tricks with a ValueError; a missing xacro or number is a KeyError/OSError
+        robot = SafeET.parse(urdf).getroot()
+        for mesh in robot.iter("mesh"):
+            mesh.set("filename", str(_mesh_file(root, mesh.get("filename", ""), urdf)))
+        for tag in ("gazebo", "transmission"):
+            for element in robot.findall(tag):
+                robot.remove(element)
+        for side in ("left", "right"):
+            _replace_gripper(robot, root, side)
+    except RobotModelError:
+        raise
+    except (OSError, SafeET.ParseError, KeyError, ValueError) as exc:
+        raise RobotModelError(f"{urdf}: cannot read the robot description ({exc!r:.120})") from exc
     for link in robot.findall("link"):  # frames without mass: pybullet would warn and make them 1 kg
         if link.find("inertial") is None:
             link.append(ET.fromstring('<inertial><origin xyz="0 0 0"/><mass value="0.0001"/>'

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm
+from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
 from lmcr.executor.collision import CLEARANCE, CONTACT_CLEARANCE, Carried, Clearance
 from lmcr.executor.planner import joint_path, segment_clash
 from lmcr.executor.scene import Scene, SceneObject
@@ -152,9 +152,7 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
 def _grasped(arm: Arm, q, held: SceneObject) -> tuple:
     """The held object's pose in the hand when grasped at joints `q`, as it stands now."""
     arm.set_config(q)
-    ee_pos, ee_orn = arm.ee_pose()
-    inv_pos, inv_orn = p.invertTransform(ee_pos.tolist(), ee_orn)
-    return p.multiplyTransforms(inv_pos, inv_orn, *p.getBasePositionAndOrientation(held.body))
+    return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
 
 
 def _put_in_hand(arm: Arm, held: SceneObject) -> None:

@@ -42,7 +42,7 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
             arm.release()
             released = True
         elif step.kind == "spill":
-            out.particles += spill(held, plan.geometry.held_top[2] - plan.geometry.held_pos[2], step.particles)
+            out.particles += spill(held, plan.geometry.opening, step.particles)
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
     checks = task.check(held, target, out) if grasped else {"ok": False}
@@ -54,16 +54,16 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
                        "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved}}
 
 
-def spill(held: SceneObject, top: float, n: int) -> list[int]:
-    """A stream of particles (liquid or powder) leaving the held container's opening (`top` above its
-    origin), one at a time: particles created on top of each other would push each other apart."""
+def spill(held: SceneObject, opening: float, n: int) -> list[int]:
+    """A stream of particles (liquid or powder) leaving the held container's opening (`opening` above
+    its origin), one at a time: particles created on top of each other would push each other apart."""
     shape = p.createCollisionShape(p.GEOM_SPHERE, radius=0.006)
     visual = p.createVisualShape(p.GEOM_SPHERE, radius=0.006, rgbaColor=[0.2, 0.4, 0.9, 1])
     rng = np.random.default_rng(n)
     bodies = []
     for _ in range(n):
         pos, orn = p.getBasePositionAndOrientation(held.body)
-        mouth = np.asarray(p.multiplyTransforms(pos, orn, [0, 0, top + 0.012], [0, 0, 0, 1])[0])
+        mouth = np.asarray(p.multiplyTransforms(pos, orn, [0, 0, opening], [0, 0, 0, 1])[0])
         body = p.createMultiBody(0.002, shape, visual, list(mouth + rng.normal(0, 0.002, 3)))
         p.changeDynamics(body, -1, lateralFriction=1.0, rollingFriction=0.02, spinningFriction=0.02)  # grains stay put
         bodies.append(body)

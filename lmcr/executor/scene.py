@@ -133,6 +133,8 @@ def scene_from_json(data: object, where: str) -> Scene:
     holding = data.get("holding")
     if holding is not None and (not isinstance(holding, str) or holding not in load_lexicon().objects):
         raise InputError(f"{where}: 'holding' must be a known object label, not {holding!r:.60}")
+    if holding in [label for label, _ in items]:
+        raise InputError(f"{where}: the {holding} cannot be both in the hand ('holding') and on the table")
     return make_scene(items, seed, where, holding)
 
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.arm import DOWN
+from lmcr.executor.arm import DOWN, relative_pose
 from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, solid_shape, world_xy
 
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
@@ -99,18 +99,21 @@ class Geometry:
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
         """The held object's pose relative to the gripper after the grasp."""
-        pos, orn = self.grip_pose(variant)
-        inv_pos, inv_orn = p.invertTransform(pos.tolist(), orn)
-        return p.multiplyTransforms(inv_pos, inv_orn, self.held_pos, self.held_orn)
+        return relative_pose(*self.grip_pose(variant), self.held_pos, self.held_orn)
 
     def point_in_hand(self, variant: Variant, local) -> np.ndarray:
         """A point given in the held object's frame, in the gripper's frame."""
         rel_pos, rel_orn = self.in_hand(variant)
         return np.asarray(p.multiplyTransforms(rel_pos, rel_orn, local, [0, 0, 0, 1])[0])
 
+    @property
+    def opening(self) -> float:
+        """How far the held object's opening (just above its top) is above its origin, in its own frame."""
+        return self.held_top[2] - self.held_pos[2] + 0.012
+
     def mouth(self, variant: Variant) -> np.ndarray:
-        """The held object's opening (just above its top) in the gripper's frame."""
-        return self.point_in_hand(variant, [0, 0, self.held_top[2] - self.held_pos[2] + 0.012])
+        """The held object's opening in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.opening])
 
     def bottom(self, variant: Variant) -> np.ndarray:
         """The middle of the held object's underside in the gripper's frame."""
@@ -327,6 +330,3 @@ TASKS = {
     "rub": Task("Theme", "Destination", program_stroke, check_stroke),
 }
 
-
-def held_half_width(held: SceneObject) -> float:
-    return footprint(held.label)
