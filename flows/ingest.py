@@ -36,14 +36,15 @@ def load_task(ws: Workspace, staged: list[StagedFile]) -> list[dict]:
 def ingest_flow(
     youcook2: list[str] | None = None,
     recipes: list[str] | None = None,
+    household: list[str] | None = None,
     fmt: str | None = None,
     db: str | None = None,
     data_dir: str | None = None,
 ) -> list[dict]:
-    """Ingest YouCook2 and recipe corpora; unchanged sources are skipped; publishes a summary table."""
+    """Ingest YouCook2, recipe and household corpora; unchanged sources are skipped; publishes a summary table."""
     ws = Workspace.from_env(data_dir=data_dir, db=db)
-    sources = expand_inputs([Path(p) for p in youcook2 or []], "youcook2", fmt)
-    sources += expand_inputs([Path(p) for p in recipes or []], "recipes", fmt)
+    sources = [s for corpus, paths in (("youcook2", youcook2), ("recipes", recipes), ("household", household))
+               for s in expand_inputs([Path(p) for p in paths or []], corpus, fmt)]
     with ws.connect() as con:
         todo, skipped = plan(con, sources)
     get_run_logger().info("%d sources to ingest, %d unchanged", len(todo), len(skipped))

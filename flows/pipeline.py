@@ -44,6 +44,7 @@ class PipelineParams(BaseModel):
     youcook2: list[str] = Field(default_factory=lambda: [str(SAMPLE / "youcook2")])
     recipes: list[str] = Field(default_factory=lambda: [str(SAMPLE / p) for p in (
         "nyc", "recipes_json/recipes_sample.jsonl", "recipes_json/folder", "feeding_america")])
+    household: list[str] = Field(default_factory=lambda: [str(SAMPLE / "household")])
     ratings: list[str] = Field(default_factory=lambda: [str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")])
     conceptnet: str | None = str(SAMPLE / "conceptnet" / "edges.txt")
     vectors: str | None = None
@@ -79,7 +80,7 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     """Run every stage; returns where the report and the checkpoints are."""
     logger = get_run_logger()
     data_dir = params.data_dir
-    ingest_flow(youcook2=params.youcook2, recipes=params.recipes, data_dir=data_dir)
+    ingest_flow(youcook2=params.youcook2, recipes=params.recipes, household=params.household, data_dir=data_dir)
     frames_flow(shard_size=params.shard_size, data_dir=data_dir)
     speech_flow(data_dir=data_dir)
     trained = train_flow(settings=params.settings, embedding=params.embedding, max_epochs=params.max_epochs,

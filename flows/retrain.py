@@ -41,6 +41,7 @@ def decide_task(candidate: str, config: RetrainConfig, inputs: str, ws: Workspac
 def retrain_flow(
     youcook2: list[str] | None = None,
     recipes: list[str] | None = None,
+    household: list[str] | None = None,
     ratings: list[str] | None = None,
     config: RetrainConfig = RetrainConfig(),
     embedding: int = LMConfig.embedding,
@@ -52,8 +53,8 @@ def retrain_flow(
     """Notice new or changed corpora and ratings (content hashes); retrain and promote if not worse."""
     logger = get_run_logger()
     ws = Workspace.from_env(data_dir=data_dir, db=db)
-    if youcook2 or recipes:
-        ingest_flow(youcook2=youcook2, recipes=recipes, db=db, data_dir=data_dir)
+    if youcook2 or recipes or household:
+        ingest_flow(youcook2=youcook2, recipes=recipes, household=household, db=db, data_dir=data_dir)
     for path in ratings or []:
         ingest_task(path, ws)
     with ws.connect() as con:

@@ -24,7 +24,8 @@ from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS
-from lmcr.setting import ALL_SETTINGS, CORPORA, LINEARIZATIONS
+from lmcr.mixture import GRID as MIXTURE_GRID
+from lmcr.setting import ALL_SETTINGS, CORPORA, LINEARIZATIONS, SOURCE_CORPORA
 from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.store import check_contracts
 from lmcr.workspace import Workspace
@@ -108,20 +109,22 @@ def print_rows(title: str, rows: list[dict]) -> None:
 def ingest(
     youcook2: list[Path] = typer.Option([], "--youcook2", help="YouCook2 annotations JSON."),
     recipes: list[Path] = typer.Option([], "--recipes", help="Recipe JSONL(.gz)/folder, Meal-Master/NYC text, Feeding America XML (file or folder)."),
-    fmt: Literal["youcook2", "recipe_json", "mealmaster", "feeding_america"] | None = typer.Option(
+    household: list[Path] = typer.Option([], "--household", help="EPIC-KITCHENS narration CSVs and VirtualHome program JSON (files or a folder)."),
+    fmt: Literal["youcook2", "recipe_json", "mealmaster", "feeding_america", "epic_kitchens", "virtualhome"] | None = typer.Option(
         None, "--format", help="Force the adapter."),
     encoding: str | None = typer.Option(None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
     workers: int = typer.Option(2, help="Parallel parser processes."),
     db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
 ) -> None:
-    """Ingest cooking corpora into the sentence table; unchanged inputs are skipped."""
+    """Ingest cooking and household corpora into the sentence table; unchanged inputs are skipped."""
     from lmcr.ingest.run import corpus_summary, ingest_sources
 
-    if not youcook2 and not recipes:
-        fail("nothing to ingest: give --youcook2 PATH and/or --recipes PATH")
+    if not youcook2 and not recipes and not household:
+        fail("nothing to ingest: give --youcook2, --recipes and/or --household PATH")
     ws = Workspace.from_env(db=db)
     started = time.perf_counter()
-    sources = expand_inputs(youcook2, "youcook2", fmt, encoding) + expand_inputs(recipes, "recipes", fmt, encoding)
+    sources = [s for corpus, paths in (("youcook2", youcook2), ("recipes", recipes), ("household", household))
+               for s in expand_inputs(paths, corpus, fmt, encoding)]
     con = ws.connect()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
@@ -349,6 +352,41 @@ def evaluate(
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
+
+
+@app.command()
+def mixture(
+    ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
+    corpus: Literal[SOURCE_CORPORA] = typer.Option("household", help="The corpus whose weight is chosen."),
+    method: str = typer.Option(COMPLETION_METHOD, help="The method whose Table I accuracy decides."),
+    grid: str = typer.Option(",".join(f"{w:g}" for w in MIXTURE_GRID), help="Candidate weights."),
+    checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
+    per_verb: int = typer.Option(50, help="Scenarios per verb."),
+) -> None:
+    """Choose how much a corpus counts in the pooled `all` setting, on rated frames; saves mixture.json
+    (read by every command that scores, and part of the completion calibration's fingerprint)."""
+    from lmcr.evaluate.mixture import choose_mixture
+    from lmcr.evaluate.protocol import EvalConfig
+    from lmcr.evaluate.ratings import load_ratings
+    from lmcr.files import file_sha256
+    from lmcr.lexicon import load_lexicon
+    from lmcr.mixture import save
+
+    ws = Workspace.from_env()
+    try:
+        weights = tuple(float(w) for w in _split(grid))
+    except ValueError:
+        fail(f"--grid: not a list of numbers: {grid!r}")
+    rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
+    if not rated:
+        fail(f"{ratings}: no rated frames of the robot's predicates")
+    chosen, accuracy = choose_mixture(rated, ws.resources(checkpoint), method, corpus, weights,
+                                      EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False))
+    path = save(ws.data_dir, chosen, {"chosen_for": method, "corpus": corpus, "ratings": str(ratings),
+                                      "ratings_sha256": file_sha256(ratings),
+                                      "accuracy": {f"{w:g}": round(a, 4) for w, a in accuracy.items()}})
+    console.print(f"{corpus} weight {chosen.weight(corpus):g} saved to {path}; run `lmcr evaluate` to calibrate "
+                  "completion under it")
 
 
 def _split(names: str) -> list[str]:

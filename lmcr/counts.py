@@ -22,15 +22,18 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from lmcr.frame import Frame
+from lmcr.mixture import Mixture
+from lmcr.setting import SOURCE_CORPORA
 from lmcr.store import named_query, read_connection
 
 
 class FrameCountScorer:
     """Smoothed conditional filler probabilities from (predicate, role, value) and pair counts."""
 
-    def __init__(self, fillers: Iterable[tuple[str, str, str, int]],
-                 pairs: Iterable[tuple[str, str, str, str, str, int]], alpha: float = 5.0):
+    def __init__(self, fillers: Iterable[tuple[str, str, str, float]],
+                 pairs: Iterable[tuple[str, str, str, str, str, float]], alpha: float = 5.0):
         self.alpha = alpha
+        # Counts may be weighted (a mixture), hence floats.
         self.filler: Counter[tuple[str, str, str]] = Counter()  # (v, role, value)
         self.role_total: Counter[tuple[str, str]] = Counter()  # (v, role)
         self.value: Counter[str] = Counter()
@@ -46,13 +49,19 @@ class FrameCountScorer:
         self.n, self.types = sum(self.value.values()), len(self.value)
 
     @classmethod
-    def from_store(cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = 5.0) -> FrameCountScorer:
-        """Counts of the store's frames in one corpus setting (`all` for every corpus)."""
+    def from_store(cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = 5.0,
+                   mixture: Mixture = Mixture()) -> FrameCountScorer:
+        """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
+        corpus's frames count as often as the mixture weighs it."""
+        parts = [corpus] if corpus != "all" or mixture.plain else list(SOURCE_CORPORA)
+        fillers, pairs = [], []
         con = read_connection(db)
         try:
-            params = {"corpus": corpus}
-            fillers = con.execute(named_query(sql_dir, "frame_fillers"), params).fetchall()
-            pairs = con.execute(named_query(sql_dir, "frame_filler_pairs"), params).fetchall()
+            for part in parts:
+                w = mixture.weight(part) if part != "all" else 1.0
+                params = {"corpus": part}
+                fillers += [(*row[:-1], w * row[-1]) for row in con.execute(named_query(sql_dir, "frame_fillers"), params).fetchall()]
+                pairs += [(*row[:-1], w * row[-1]) for row in con.execute(named_query(sql_dir, "frame_filler_pairs"), params).fetchall()]
         finally:
             con.close()
         if not fillers:

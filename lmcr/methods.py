@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import math
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -14,6 +15,7 @@ from lmcr.files import atomic_path, file_sha256
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
 from lmcr.lexicon import load_lexicon
+from lmcr.mixture import Mixture
 from lmcr.setting import LM_METHODS, Setting
 from lmcr.store import read_connection
 from lmcr.workspace import SPACY_MODEL
@@ -42,6 +44,12 @@ class MethodResources:
     spacy_model: str = SPACY_MODEL
     cache_dir: Path | None = None
     seed: int = 0
+    mixture: Mixture = Mixture()  # per-corpus weights of the `all` setting (lmcr/mixture.py)
+
+    @property
+    def mixed(self) -> bool:
+        """True when the scorers pool the corpora with weights other than 1."""
+        return self.corpus == "all" and not self.mixture.plain
 
 
 @dataclass(frozen=True)
@@ -67,42 +75,72 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
 
 class Scorer(Protocol):
     """Complete frames in, one float each out (higher = more plausible; log-probabilities for the LMs
-    and frame_counts, so that 'a+b' sums are products of experts)."""
+    and frame_counts, so that 'a+b' sums are products of experts). `context` is the rest of the
+    instruction ("for my tea", `srl.context`): scorers that can read text take it, the others ignore it,
+    and "" scores as if there were none."""
 
-    def __call__(self, frames: list[Frame]) -> list[float]: ...
+    def __call__(self, frames: list[Frame], context: str = "") -> list[float]: ...
 
 
 @dataclass(frozen=True)
 class ScorerSpec:
-    """How to build a method's scorer from the resources, and what a completion calibration of it is
-    valid for (None: its completion is not calibrated)."""
+    """How to build a method's scorer from the resources (a function of the frames, and of the context
+    when `reads_context`), and what a completion calibration of it is valid for (None: not calibrated)."""
 
-    build: Callable[[MethodResources], Scorer]
+    build: Callable[[MethodResources], Callable[..., list[float]]]
     fingerprint: Callable[[MethodResources], str | None] = lambda res: None
+    reads_context: bool = False
 
 
-def _lm_scorer(linearization: str) -> Callable[[MethodResources], Scorer]:
-    def build(res: MethodResources) -> Scorer:
-        from lmcr.lm import checkpoint as ckpt
-        from lmcr.lm.score import LMScorer
+def _load_lm(res: MethodResources, linearization: str, corpus: str):
+    from lmcr.lm import checkpoint as ckpt
+    from lmcr.lm.score import LMScorer
 
-        loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
-        if loaded.linearization != linearization:
-            raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {linearization}")
-        return LMScorer(loaded).score_frames
+    loaded = ckpt.load(lm_checkpoint_dir(res.checkpoints, linearization, corpus))
+    if loaded.linearization != linearization:
+        raise ckpt.CheckpointError(f"{loaded.path} is a {loaded.linearization} model, not {linearization}")
+    return LMScorer(loaded)
+
+
+def lm_experts(res: MethodResources) -> list[tuple[str, float]]:
+    """(corpus, interpolation weight) of the LMs an LM scorer mixes: the setting's own alone, or under a
+    mixture the all-corpora LM and each weighted corpus's LM at its share of the weighted words."""
+    if not res.mixed:
+        return [(res.corpus, 1.0)]
+    shares = res.mixture.shares(corpus_words(res))
+    return [("all", 1.0 - sum(shares.values())), *shares.items()]
+
+
+def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
+    def build(res: MethodResources):
+        experts = [(math.log(w), _load_lm(res, linearization, corpus).score_frames)
+                   for corpus, w in lm_experts(res) if w > 0]
+        if len(experts) == 1:
+            return experts[0][1]
+
+        def mixed(frames: list[Frame], **kwargs) -> list[float]:  # log sum_i w_i P_i(text)
+            columns = [[log_w + s for s in score(frames, **kwargs)] for log_w, score in experts]
+            return [_logsumexp(values) for values in zip(*columns)]
+        return mixed
     return build
 
 
-def lm_version_dir(res: MethodResources, linearization: str) -> Path:
+def _logsumexp(values: tuple[float, ...]) -> float:
+    top = max(values)
+    return top + math.log(sum(math.exp(v - top) for v in values))
+
+
+def lm_version_dir(res: MethodResources, linearization: str, corpus: str | None = None) -> Path:
     """The checkpoint version folder an LM scorer of `linearization` loads (a setting's LATEST resolved)."""
     from lmcr.lm import checkpoint as ckpt
 
-    return ckpt.resolve(lm_checkpoint_dir(res.checkpoints, linearization, res.corpus))
+    return ckpt.resolve(lm_checkpoint_dir(res.checkpoints, linearization, corpus or res.corpus))
 
 
 def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     def fingerprint(res: MethodResources) -> str:
-        return file_sha256(lm_version_dir(res, linearization) / "manifest.json")
+        return ",".join(file_sha256(lm_version_dir(res, linearization, corpus) / "manifest.json")
+                        for corpus, _ in lm_experts(res))
     return fingerprint
 
 
@@ -111,7 +149,7 @@ def _frame_counts(res: MethodResources) -> Scorer:
 
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
-    return FrameCountScorer.from_store(res.db, res.sql_dir, res.corpus).score_frames
+    return FrameCountScorer.from_store(res.db, res.sql_dir, res.corpus, mixture=res.mixture).score_frames
 
 
 def _frame_corpus_hash(res: MethodResources) -> str:
@@ -131,18 +169,39 @@ def _cooccur(res: MethodResources) -> Scorer:
     return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model), robot_terms()).score_frames
 
 
+def word_vectors(res: MethodResources) -> Path:
+    """The word vectors of the baselines: the given file, else the full GloVe of the `vectors` extra, else
+    word2vec trained on the corpus."""
+    from lmcr.baselines.vectors import installed_glove
+
+    return res.vectors or installed_glove() or corpus_word2vec(res)
+
+
 def _word2vec(res: MethodResources) -> Scorer:
     from lmcr.baselines.vectors import VectorScorer, load_vectors
 
-    return VectorScorer(load_vectors(res.vectors or corpus_word2vec(res))).score_frames
+    return VectorScorer(load_vectors(word_vectors(res))).score_frames
+
+
+def _conceptnet_edges(res: MethodResources) -> Path:
+    if res.conceptnet is None:
+        raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+    return res.conceptnet
 
 
 def _conceptnet(res: MethodResources) -> Scorer:
     from lmcr.baselines.conceptnet import ConceptNetScorer
 
-    if res.conceptnet is None:
-        raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
-    return ConceptNetScorer.from_path(res.conceptnet).score_frames
+    return ConceptNetScorer.from_path(_conceptnet_edges(res)).score_frames
+
+
+def _conceptnet_retrofit(res: MethodResources) -> Scorer:
+    from lmcr.baselines.conceptnet import read_edges, relatedness
+    from lmcr.baselines.retrofit import retrofit
+    from lmcr.baselines.vectors import VectorScorer, load_vectors
+
+    retrofitted = VectorScorer(retrofit(read_edges(_conceptnet_edges(res)), load_vectors(word_vectors(res))))
+    return relatedness(retrofitted.vector)
 
 
 def _random(res: MethodResources) -> Scorer:
@@ -150,13 +209,17 @@ def _random(res: MethodResources) -> Scorer:
     return lambda frames: [rng.random() for _ in frames]
 
 
-# The methods, in the order reports list them: a new method is one entry here.
+# The methods, in the order reports list them: a new method is one entry here. The sentence LM reads
+# the instruction's context after the filled frame, as one more stretch of text; the frame LM learned
+# bare frames, where a purpose clause never occurs.
 SCORERS: dict[str, ScorerSpec] = {
-    **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin)) for method, lin in LM_METHODS.items()},
+    **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
+       for method, lin in LM_METHODS.items()},
     "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
     "cooccur": ScorerSpec(_cooccur),
     "word2vec": ScorerSpec(_word2vec),
     "conceptnet": ScorerSpec(_conceptnet),
+    "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
 }
 
@@ -170,23 +233,40 @@ def make_scorer(method: str, res: MethodResources) -> Scorer:
     a product of experts)."""
     if "+" in method:
         parts = [make_scorer(m, res) for m in method.split("+")]
-        return lambda frames: [sum(scores) for scores in zip(*(part(frames) for part in parts))]
+        return lambda frames, context="": [sum(s) for s in zip(*(part(frames, context) for part in parts))]
     if method not in SCORERS:
         raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
-    return SCORERS[method].build(res)
+    spec = SCORERS[method]
+    score = spec.build(res)
+    if spec.reads_context:
+        return lambda frames, context="": score(frames, context=context)
+    return lambda frames, context="": score(frames)
 
 
 def scorer_fingerprint(method: str, res: MethodResources) -> str | None:
     """What a completion calibration of `method` is valid for: each part's fingerprint (an LM's
     checkpoint manifest sha256, the frame corpus hash), joined; None when any part is not calibrated."""
     parts = [SCORERS[m].fingerprint(res) if m in SCORERS else None for m in method.split("+")]
-    return None if None in parts else "+".join(parts)
+    if None in parts:
+        return None
+    return "+".join(parts) + (f"@{res.mixture.label}" if res.mixed else "")
 
 
 def robot_terms() -> set[str]:
     """The predicates and the detector's object vocabulary: indexed up front by count-based scorers."""
     lex = load_lexicon()
     return set(lex.predicates) | set(lex.objects)
+
+
+def corpus_words(res: MethodResources) -> dict[str, int]:
+    """Words per source corpus in the store: the sizes a mixture's shares are taken of."""
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"a corpus mixture needs the store's corpus sizes: no store at {res.db}")
+    con = read_connection(res.db)
+    try:
+        return dict(con.execute("select corpus, sum(n_words)::bigint from sentences group by corpus").fetchall())
+    finally:
+        con.close()
 
 
 def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:

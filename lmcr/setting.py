@@ -7,7 +7,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 LINEARIZATIONS = ("sentence", "frame")
-CORPORA = ("youcook2", "recipes", "all")
+# What ingest loads each input as; a setting trains on one of them or on all together.
+SOURCE_CORPORA = ("youcook2", "recipes", "household")
+CORPORA = (*SOURCE_CORPORA, "all")
 # The scorer (method) name of each linearisation's language model.
 LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
 METHOD_OF = {linearization: method for method, linearization in LM_METHODS.items()}

@@ -20,6 +20,7 @@ if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first 
 
     from lmcr.complete import CompletionConfig
     from lmcr.methods import MethodResources, Scorer
+    from lmcr.mixture import Mixture
     from lmcr.speech.recognize import Recognizer
     from lmcr.srl.parser import FrameParser
 
@@ -94,6 +95,13 @@ class Workspace:
         return self.data_dir / "speech" / "en-us"
 
     @property
+    def mixture(self) -> Mixture:
+        """The corpus mixture chosen by `lmcr mixture` (plain when none was chosen)."""
+        from lmcr.mixture import load
+
+        return load(self.data_dir)
+
+    @property
     def baselines(self) -> Path:
         """Baseline caches (word2vec trained on the corpus)."""
         return self.data_dir / "baselines"
@@ -118,7 +126,8 @@ class Workspace:
         return MethodResources(checkpoints=Path(checkpoint) if checkpoint else self.checkpoints, corpus=corpus,
                                db=self.db, sql_dir=self.sql_dir, vectors=Path(vectors) if vectors else self.vectors,
                                conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
-                               spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed)
+                               spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed,
+                               mixture=self.mixture)
 
     def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:
         """The SRL parser with this workspace's learned compounds and role priors."""

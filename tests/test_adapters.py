@@ -158,3 +158,83 @@ def test_detect_and_expand(sample_dir, tmp_path):
     odd.write_text("hello")
     with pytest.raises(IngestError, match="unrecognised format"):
         detect_format(odd)
+
+
+# --- household: EPIC-KITCHENS narrations and VirtualHome programs ---------------------------------
+
+def test_epic_kitchens_sample_folder(sample_dir):
+    from lmcr.ingest.epic_kitchens import parse_epic_kitchens
+
+    parsed = parse_epic_kitchens(sample_dir / "household" / "epic_kitchens")
+    assert_balanced(parsed)
+    # 43 narrations in the EPIC-100-style file (5 listed twice), 7 more only in the EPIC-55-style file,
+    # its 4 P90_01 rows the same narrations in older words; the class list is skipped.
+    assert (parsed.records_in, parsed.records_loaded) == (52, 50)
+    assert [r[1] for r in reasons(parsed)] == ["EPIC_sample_100.csv:50: bad narration_id 'not-an-id' (want P01_01_0)",
+                                               "EPIC_sample_100.csv:51: empty narration"]
+    docs = {d["doc_id"]: d for d in parsed.documents}
+    assert sorted(docs) == ["epic:P90_01", "epic:P90_02", "epic:P91_01", "epic:P92_03"]
+    assert (docs["epic:P92_03"]["subset"], docs["epic:P90_01"]["category"]) == ("epic-55", "P90")
+    first = [s["text"] for s in parsed.sentences if s["doc_id"] == "epic:P90_01"][:2]
+    assert first == ["open cupboard", "take glass"]  # the EPIC-100 file's words win over "pick up glass"
+
+
+def test_epic_kitchens_ids_from_video_order_and_bad_lines(tmp_path):
+    from lmcr.ingest.epic_kitchens import parse_epic_kitchens
+
+    path = tmp_path / "narrations.csv"
+    path.write_bytes(b"participant_id,video_id,start_timestamp,stop_timestamp,narration\n"
+                     b"P01,P01_01,0,1,open door\nP01,P01_01,1,2,pour water into glass\n"
+                     b"P01,bad,2,3,take cup\nP01,P01_01,3,4,too,many\nP01,P01_01,4,5,caf\xe9\n\n")
+    parsed = parse_epic_kitchens(path)
+    assert_balanced(parsed)
+    assert [(s["doc_id"], s["sent_id"], s["text"]) for s in parsed.sentences] == [
+        ("epic:P01_01", 0, "open door"), ("epic:P01_01", 1, "pour water into glass")]
+    assert [(p, r.split(": ", 1)[1][:18]) for p, r in reasons(parsed)] == [
+        (4, "no narration_id an"), (5, "6 fields, the head"), (6, "not UTF-8 (byte 0x")]
+    not_narrations = tmp_path / "classes.csv"
+    not_narrations.write_text("id,key\n0,take\n")
+    with pytest.raises(IngestError, match="classes.csv:1: no 'narration' column"):
+        parse_epic_kitchens(not_narrations)
+    with pytest.raises(IngestError, match="no EPIC-KITCHENS narration CSV"):
+        parse_epic_kitchens(_folder_with(tmp_path / "empty", not_narrations))
+
+
+def _folder_with(folder, file):
+    folder.mkdir()
+    (folder / file.name).write_bytes(file.read_bytes())
+    return folder
+
+
+def test_virtualhome_sample(sample_dir):
+    from lmcr.ingest.virtualhome import parse_virtualhome
+
+    parsed = parse_virtualhome(sample_dir / "household" / "virtualhome" / "programs_sample.json")
+    assert_balanced(parsed)
+    assert (parsed.records_in, len(parsed.documents)) == (8, 5)  # two repeats are the same records
+    assert [r for _, r in reasons(parsed)] == ["entry 8: not a program string",
+                                               "entry 9: does not start with 'Task: <title>'", "entry 10: has no steps"]
+    serve = next(d for d in parsed.documents if d["title"] == "Serve milk")
+    texts = [(s["kind"], s["text"]) for s in parsed.sentences if s["doc_id"] == serve["doc_id"]]
+    assert texts[0] == ("title", "Serve milk") and ("instruction", "Pour milk into cup") in texts
+
+
+def test_virtualhome_not_a_program_list(tmp_path):
+    from lmcr.ingest.virtualhome import parse_virtualhome
+
+    path = tmp_path / "p.json"
+    for body, message in ((b'{"Task": 1}', "a JSON dict, not a list"), (b"[1,", "not valid JSON"),
+                          (b'["Task: x\xff"]', "not UTF-8")):
+        path.write_bytes(body)
+        with pytest.raises(IngestError, match=message):
+            parse_virtualhome(path)
+
+
+def test_household_folder_expands_to_both_adapters(sample_dir):
+    sources = expand_inputs([sample_dir / "household"], "household")
+    assert [(s.format, s.path.name) for s in sources] == [("epic_kitchens", "household"),
+                                                          ("virtualhome", "programs_sample.json")]
+    assert detect_format(sample_dir / "household" / "epic_kitchens" / "EPIC_sample_55.csv") == "epic_kitchens"
+    assert detect_format(sample_dir / "household" / "virtualhome" / "programs_sample.json") == "virtualhome"
+    # The folder source's hash covers its narration files, so an edit to one is noticed.
+    assert sources[0].files() == sorted(sources[0].files(), key=lambda f: "55" in f.name)

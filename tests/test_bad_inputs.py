@@ -374,6 +374,37 @@ def test_ingest_feeding_america_never_tracebacks(inner, tag, garbage):
     _count("Feeding America XML")
 
 
+EPIC_FIELDS = st.lists(st.one_of(st.sampled_from(["P01", "P01_01", "P01_01_3", "pour water into glass", "", '"', ","]),
+                                 st.text(max_size=6)), min_size=1, max_size=6)
+
+
+@FUZZ
+@given(header=st.sampled_from([b"narration_id,video_id,narration\n", b"participant_id,video_id,start_timestamp,narration\n",
+                               b"id,key\n", b""]),
+       rows=st.lists(EPIC_FIELDS, max_size=4), garbage=st.binary(max_size=4))
+def test_ingest_epic_kitchens_never_tracebacks(header, rows, garbage):
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        path = tmp / "narrations.csv"
+        body = "".join(",".join(row) + "\n" for row in rows).encode("utf-8", "surrogatepass")
+        path.write_bytes(header + body + garbage)
+        _ingest_and_check(tmp, path, "--household")
+    _count("EPIC-KITCHENS CSV")
+
+
+@FUZZ
+@given(programs=st.one_of(ANY_JSON, st.lists(st.one_of(
+    ANY_JSON, st.just("Task: Serve milk\nStep 1: Pour milk into cup"), st.just("Task: x\nStep 1: a\ud800"),
+    st.text(max_size=20).map(lambda t: "Task: " + t)), max_size=4)), garbage=st.binary(max_size=3))
+def test_ingest_virtualhome_never_tracebacks(programs, garbage):
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        path = tmp / "programs.json"
+        path.write_bytes(json.dumps(programs).encode() + garbage)
+        _ingest_and_check(tmp, path, "--household", ["--format", "virtualhome"])
+    _count("VirtualHome JSON")
+
+
 # --- batch execute: a bad line is reported in its output line, the run goes on ------------------
 
 BAD_EXECUTE_LINES = st.one_of(

@@ -62,7 +62,7 @@ def test_conceptnet_relatedness_from_an_edge_list(tmp_path):
     assert len(read_edges(tmp_path)) == 10
     scorer = ConceptNetScorer.from_path(tmp_path, dim=4)
     cup, scissors, unknown = scorer.score_frames([frame("cup"), frame("scissors"), frame("spatula")])
-    assert cup > scissors and scorer.rel("water", "spatula") == 0.0
+    assert cup > scissors and scorer.vector("spatula") is None
     assert scorer.vector("soy sauce") is not None
 
 
@@ -103,3 +103,43 @@ def test_a_malformed_vector_file_is_a_vector_file_error(tmp_path):
     bad.write_bytes(b"pour 1 0\nwater 1 nope\n")
     with pytest.raises(VectorFileError, match="v.txt"):
         load_vectors(bad)
+
+
+def _tiny_vectors(words: dict[str, list[float]]):
+    from gensim.models import KeyedVectors
+
+    kv = KeyedVectors(2)
+    kv.add_vectors(list(words), np.array(list(words.values()), dtype=np.float32))
+    return kv
+
+
+def test_retrofitting_pulls_neighbours_together_and_lends_vectors():
+    from lmcr.baselines.retrofit import retrofit
+
+    glove = _tiny_vectors({"milk": [1, 0], "mug": [0, 1], "bowl": [0.6, -0.8], "tea": [-1, 0], "sky": [0.3, 0.3]})
+    edges = [("milk", "mug", 1.0), ("mug", "tea", 1.0), ("milk", "mug", 1.0), ("tea", "teapot lid", 1.0)]
+    out = retrofit(edges, glove)
+
+    def cos(kv, a, b):
+        x, y = kv[a], kv[b]
+        return float(x @ y / np.linalg.norm(x) / np.linalg.norm(y))
+
+    assert cos(out, "milk", "mug") > cos(glove, "milk", "mug") + 0.2  # neighbours move together
+    assert cos(out, "milk", "bowl") < cos(out, "milk", "mug")
+    assert cos(out, "teapot lid", "tea") > 0.99  # no word known: (nearly) its one neighbour
+    assert np.allclose(out["sky"], glove["sky"]) and np.allclose(out["bowl"], glove["bowl"])  # off the graph
+
+
+def test_npy_vectors_with_a_parquet_word_index(tmp_path):
+    import duckdb
+
+    from lmcr.baselines.vectors import VectorFileError, load_vectors
+
+    np.save(tmp_path / "emb.npy", np.array([[1, 0], [0, 1], [1, 1]], dtype=np.float32))
+    duckdb.sql("copy (select * from (values ('milk'), ('mug'), ('soy')) t(index)) to "
+               f"'{tmp_path / 'index.parquet'}' (format parquet)")
+    kv = load_vectors(tmp_path / "emb.npy")
+    assert kv.index_to_key == ["milk", "mug", "soy"] and np.allclose(kv["soy"], [1, 1])
+    duckdb.sql(f"copy (select 1 as a) to '{tmp_path / 'index.parquet'}' (format parquet)")
+    with pytest.raises(VectorFileError, match="one text column"):
+        load_vectors(tmp_path / "emb.npy")

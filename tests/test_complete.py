@@ -13,7 +13,7 @@ pytestmark = pytest.mark.model
 LIKES = {"cup": 3.0, "glass": 2.9, "bowl": 0.0, "scissors": -5.0, "water": 1.0, "milk": 0.5}
 
 
-def scorer(frames):
+def scorer(frames, context=""):
     """Prefers objects by LIKES, summed over roles (a stand-in for an LM)."""
     return [sum(LIKES.get(v, -1.0) for v in roles.values()) for _, roles in frames]
 
@@ -45,7 +45,7 @@ def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
                    "missing": None, "missing_roles": [], "unresolved": {}, "ignored_objects": [], "candidates": [],
-                   "question": None}
+                   "question": None, "context": ""}
 
 
 def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):

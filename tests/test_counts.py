@@ -7,6 +7,7 @@ import math
 import pytest
 
 from lmcr.counts import FrameCountScorer
+from lmcr.mixture import Mixture, MixtureError, load, save
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 
@@ -54,3 +55,29 @@ def test_counts_come_from_the_stores_robot_frames(tmp_path):
     assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "recipes").value == {"milk": 1}
     with pytest.raises(ValueError, match="no robot-predicate frames for corpus 'nyc'"):
         FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "nyc")
+    # A mixture weighs each corpus's frames: recipes counting 3 times, youcook2 once.
+    mixed = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", mixture=Mixture.of({"recipes": 3}))
+    assert mixed.value == {"water": 1, "cup": 1, "milk": 3} and mixed.n == 5
+    assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "youcook2",
+                                       mixture=Mixture.of({"recipes": 3})).value == {"water": 1, "cup": 1}
+
+
+def test_mixture_weights_parse_label_and_shares():
+    mixture = Mixture.parse("household=30, youcook2=1")
+    assert (mixture.weights, mixture.label, mixture.weight("recipes")) == ((("household", 30.0),), "household=30", 1.0)
+    assert Mixture.parse("plain").plain and Mixture.parse("").plain and Mixture.of({"household": 1}).plain
+    # household 1% of the words, weighted 30: its share of the weighted text is 30/129
+    assert mixture.shares({"recipes": 90, "youcook2": 9, "household": 1}) == {"household": pytest.approx(30 / 129)}
+    for bad, message in (("household", "write corpus=weight"), ("household=x", "must be a number"),
+                         ("household=0", "positive"), ("nyc=2", "unknown corpus 'nyc'"), ("household=inf", "positive")):
+        with pytest.raises(MixtureError, match=message):
+            Mixture.parse(bad)
+
+
+def test_mixture_file_round_trip_and_bad_file(tmp_path):
+    assert load(tmp_path).plain
+    save(tmp_path, Mixture.of({"household": 10}), {"accuracy": {"1": 0.8, "10": 0.9}})
+    assert load(tmp_path) == Mixture.of({"household": 10})
+    (tmp_path / "mixture.json").write_text('{"weights": {"household": -1}}')
+    with pytest.raises(MixtureError, match="mixture.json: not a mixture file"):
+        load(tmp_path)

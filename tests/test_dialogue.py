@@ -33,7 +33,7 @@ def robot_parts(tmp_path_factory):
     from lmcr.srl.parser import load_parser
 
     client = p.connect(p.DIRECT)
-    yield load_parser(), (lambda frames: [0.0] * len(frames)), CompletionConfig(), tmp_path_factory.mktemp("robot")
+    yield load_parser(), (lambda frames, context="": [0.0] * len(frames)), CompletionConfig(), tmp_path_factory.mktemp("robot")
     p.disconnect(client)
 
 

@@ -164,7 +164,7 @@ def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
 def _prefers(best: str):
     """A model-free scorer: every frame scores 0 except those naming `best` (what a language model
     trained on kitchen text would prefer)."""
-    return lambda frames: [1.0 if best in f.role_map.values() else 0.0 for f in frames]
+    return lambda frames, context="": [1.0 if best in f.role_map.values() else 0.0 for f in frames]
 
 
 def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):

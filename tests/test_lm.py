@@ -130,6 +130,17 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     assert cup > scissors
 
 
+def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, tmp_path):
+    model, vocab, _ = overfit
+    frame = ("pour", {"Theme": "water", "Destination": "cup"})
+    kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    assert kept.score_frames([frame], context="") == kept.score(["pour water into the cup"])
+    assert kept.score_frames([frame], context="for my tea") == kept.score(["pour water into the cup for my tea"])
+    dropped = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}, articles=False))
+    assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == ["pour", "milk", "into", "cup"]
+    assert LMScorer(dropped).score_frames([frame]) == kept.score(["pour water into cup"])
+
+
 @pytest.mark.parametrize("texts", [
     ["pour water into the cup", "pour water into the glass", "pour water into the bell pepper"],  # shared prefix
     ["pour water into the cup"],  # one text: all prefix
@@ -176,7 +187,7 @@ def test_setting_reads_both_spellings():
 
     assert Setting.parse("sentence-all") == Setting.parse("sentence_lm/all") == Setting("sentence", "all")
     assert Setting.parse("frame_lm/recipes").name == "frame-recipes" and Setting.parse("frame").label == "frame_lm/all"
-    assert len(ALL_SETTINGS) == 6 and all(Setting.parse(s.name) == s == Setting.parse(s.label) for s in ALL_SETTINGS)
+    assert len(ALL_SETTINGS) == 8 and all(Setting.parse(s.name) == s == Setting.parse(s.label) for s in ALL_SETTINGS)
     for bad, reason in (("nope-all", "unknown setting"), ("sentence-recipe", "corpus must be one of"),
                         ("frame_lm/x", "corpus must be one of")):
         with pytest.raises(ValueError, match=reason):

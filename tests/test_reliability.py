@@ -340,7 +340,7 @@ def test_unknown_objects_are_never_chosen():
     from lmcr.srl.parser import load_parser
 
     parser = load_parser()
-    prefer_unknown = lambda frames: [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
+    prefer_unknown = lambda frames, context="": [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
     out = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor", "cup"])
     assert out["frame"]["roles"]["Destination"] == "cup" and out["ignored_objects"] == ["flux capacitor"]
     with pytest.raises(CompletionError, match="not in the robot's object vocabulary"):
@@ -354,7 +354,7 @@ def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monke
     path.write_text(json.dumps({"id": "long", "instruction": "pour " + "🥛" * 3000, "objects": ["cup"]}) + "\n",
                     encoding="utf-8")
     monkeypatch.setattr(completion, "completion_scorer",
-                        lambda *a: (lambda frames: [0.0] * len(frames), completion.CompletionConfig()))
+                        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()))
     result = runner.invoke(app, ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
                            env={"LMCR_DATA_DIR": str(tmp_path / "data")})
     assert result.exit_code == 0, result.output

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import gzip
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -113,11 +114,15 @@ class ConceptNetScorer:
             self.cache[term] = found
         return self.cache[term]
 
-    def rel(self, x: str, y: str) -> float:
-        a, b = self.vector(x), self.vector(y)
+    def score_frames(self, frames: list[Frame]) -> list[float]:
+        return relatedness(self.vector)(frames)
+
+
+def relatedness(vector: Callable[[str], np.ndarray | None]) -> Callable[[list[Frame]], list[float]]:
+    """The ConceptNet score of frames from a term's unit vector: summed cosines, 0 for an unknown term."""
+    def rel(x: str, y: str) -> float:
+        a, b = vector(x), vector(y)
         # Rounded: an SVD basis is unique only up to rotations inside degenerate subspaces, so cosines of
         # two builds differ in the last bits, and a tie (credit 1/t) must not depend on those bits.
         return 0.0 if a is None or b is None else round(float(a @ b), 9)
-
-    def score_frames(self, frames: list[Frame]) -> list[float]:
-        return [pair_sum(f, self.rel) for f in frames]
+    return lambda frames: [pair_sum(f, rel) for f in frames]

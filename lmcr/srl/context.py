@@ -1,0 +1,71 @@
+"""The rest of an instruction: what is said besides its frame ("pour the milk for my tea", "fill the
+bowl, the dog is thirsty", "heat the butter so it melts"). The purpose tells a listener which object is
+meant; completion hands it to the scorer, which reads it after the filled frame ("pour milk into mug for
+my tea"). Left out: the predicate, its stated roles with their determiners and prepositions, and the
+request around the predicate ("could you", "I need you to", "go ahead and", "please"). What is left is
+context only when it holds a content word: "for me" or "a little" leave the instruction as it was.
+"""
+
+from __future__ import annotations
+
+from spacy.tokens import Doc, Token
+
+from lmcr.srl.frames import FrameMention
+
+CONTENT_TAGS = ("NN", "VB", "JJ")  # nouns, verbs, adjectives (Penn tags: hand-built Docs have no POS)
+CLAUSE_BREAKS = frozenset({",", ";", ":", ".", "!", "?"})
+
+
+def _covered(token: Token, spans: list[tuple[int, int]]) -> bool:
+    return any(start <= token.idx < end for start, end in spans)
+
+
+def _predicate(doc: Doc, mention: FrameMention) -> Token | None:
+    return next((t for t in doc if t.idx <= mention.start < t.idx + max(len(t), 1)), None)
+
+
+def _request_before(doc: Doc, predicate: Token) -> set[int]:
+    """Indices of the words before the predicate in its clause: the request wrapped around it."""
+    request = set()
+    for token in reversed(doc[: predicate.i]):
+        if token.text in CLAUSE_BREAKS and token.sent == predicate.sent and request:
+            break
+        if token.sent != predicate.sent:
+            break
+        request.add(token.i)
+    return request
+
+
+def _role_words(doc: Doc, mention: FrameMention, predicate: Token) -> set[int]:
+    """The stated roles' words, their left modifiers ("some oil") and the prepositions heading them; the
+    predicate's particle ("rub it in") and its object when that is no role ("dip a few", "dump some")."""
+    heads = [t for t in doc if _covered(t, list(mention.spans.values()))]
+    words = {t.i for t in heads}
+    for child in predicate.children:
+        if child.dep_ == "prt" or child.tag_ == "RP":
+            words.add(child.i)
+        elif child.dep_ == "dobj" and child.i not in words:
+            words |= {t.i for t in child.subtree}
+    for head in heads:
+        words |= {t.i for t in head.lefts}
+        if head.head.dep_ == "prep" or head.head.tag_ in ("IN", "RP"):
+            words.add(head.head.i)
+    return words
+
+
+def is_content(token: Token) -> bool:
+    """A word that can say what the instruction is for: a noun, verb or adjective, not a stop word."""
+    return token.tag_.startswith(CONTENT_TAGS) and not token.is_stop and token.is_alpha
+
+
+def utterance_context(doc: Doc, mention: FrameMention) -> str:
+    """The instruction's words besides the frame and the request, lowercased in their order ("for my
+    tea"); "" when none of them is a content word. `doc` is a parse of the text `mention` came from."""
+    predicate = _predicate(doc, mention)
+    if predicate is None:
+        return ""
+    skip = _request_before(doc, predicate) | _role_words(doc, mention, predicate) | {predicate.i}
+    words = [t for t in doc if t.i not in skip and not t.is_punct and not t.is_space]
+    if not any(is_content(t) for t in words):
+        return ""
+    return " ".join(t.lower_ for t in words)

@@ -1,0 +1,62 @@
+"""The rest of an instruction as context, on hand-built parses (no model): what is kept, what is the
+request or the frame itself, and that context reaches only the scorers that read text."""
+
+from __future__ import annotations
+
+from srl_docs import make_doc
+
+from lmcr.srl.context import utterance_context
+from lmcr.srl.frames import FrameMention
+
+
+def mention(doc, predicate: int, roles: dict[str, int | None]) -> FrameMention:
+    """A frame whose predicate and role heads are the tokens at these indices."""
+    pred = doc[predicate]
+    spans = {r: (doc[i].idx, doc[i].idx + len(doc[i])) for r, i in roles.items() if i is not None}
+    values = {r: (doc[i].lower_ if i is not None else None) for r, i in roles.items()}
+    return FrameMention(pred.lemma_, values, True, pred.idx, pred.idx + len(pred), spans)
+
+
+def test_purpose_phrase_is_context():
+    doc = make_doc("heat/VB/ROOT/0 the/DT/det/2 water/NN/dobj/0 for/IN/prep/0 my/PRP$/poss/5 tea/NN/pobj/3")
+    assert utterance_context(doc, mention(doc, 0, {"Theme": 2, "Instrument": None})) == "for my tea"
+
+
+def test_request_and_function_words_alone_are_no_context():
+    doc = make_doc("could/MD/aux/2 you/PRP/nsubj/2 pour/VB/ROOT/2 the/DT/det/4 milk/NN/dobj/2 for/IN/prep/2 "
+                   "me/PRP/pobj/5 ?/./punct/2")
+    assert utterance_context(doc, mention(doc, 2, {"Theme": 4, "Destination": None})) == ""
+
+
+def test_a_second_clause_is_context_and_the_request_is_not():
+    doc = make_doc("I/PRP/nsubj/1 need/VBP/ROOT/1 you/PRP/nsubj/4 to/TO/aux/4 fill/VB/xcomp/1 the/DT/det/6 "
+                   "bowl/NN/dobj/4 ,/,/punct/1 the/DT/det/9 dog/NN/nsubj/10 is/VBZ/ccomp/1 thirsty/JJ/acomp/10")
+    assert utterance_context(doc, mention(doc, 4, {"Destination": 6, "Theme": None})) == "the dog is thirsty"
+
+
+def test_placeholder_object_particle_and_stated_role_prepositions_are_the_frame():
+    doc = make_doc("dump/VB/ROOT/0 some/DT/dobj/0 into/IN/prep/0 the/DT/det/4 pot/NN/pobj/2 to/TO/aux/6 "
+                   "boil/VB/advcl/0")
+    assert utterance_context(doc, mention(doc, 0, {"Theme": None, "Destination": 4})) == "to boil"
+    doc = make_doc("rub/VB/ROOT/0 the/DT/det/2 salt/NN/dobj/0 in/RP/prt/0")
+    assert utterance_context(doc, mention(doc, 0, {"Theme": 2, "Destination": None})) == ""
+
+
+def test_only_text_reading_scorers_see_the_context(monkeypatch):
+    from lmcr import methods
+
+    seen = {}
+
+    def fake(name, reads):
+        def build(res):
+            def score(frames, context=None):
+                seen[name] = context
+                return [0.0] * len(frames)
+            return score
+        return methods.ScorerSpec(build, reads_context=reads)
+
+    monkeypatch.setitem(methods.SCORERS, "reader", fake("reader", True))
+    monkeypatch.setitem(methods.SCORERS, "counter", fake("counter", False))
+    scorer = methods.make_scorer("reader+counter", methods.MethodResources(checkpoints=__import__("pathlib").Path(".")))
+    assert scorer([("pour", {"Theme": "milk", "Destination": "mug"})], "for my tea") == [0.0]
+    assert seen == {"reader": "for my tea", "counter": None}
