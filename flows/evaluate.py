@@ -20,7 +20,8 @@ from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.files import file_sha256
 from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import EVALUATED, MethodResources
+from lmcr.methods import COMPLETION_METHOD, EVALUATED, MethodResources
+from lmcr.setting import Setting
 from lmcr.store import read_connection
 from lmcr.workspace import Workspace
 
@@ -57,6 +58,19 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
     return results.to_json()
 
 
+@task(name="choose-mixture")
+def mixture_task(ratings: str, res: MethodResources, ws: Workspace) -> str:
+    """Choose the household weight of the pooled setting on the ratings (`lmcr mixture`) and save it."""
+    from lmcr.evaluate.mixture import choose_mixture
+    from lmcr.mixture import save
+
+    rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
+    chosen, accuracy = choose_mixture(rated, res, COMPLETION_METHOD, log=get_run_logger().info)
+    save(ws.data_dir, chosen, {"chosen_for": COMPLETION_METHOD, "corpus": "household", "ratings": ratings,
+                               "accuracy": {f"{w:g}": round(a, 4) for w, a in accuracy.items()}})
+    return chosen.label or "plain"
+
+
 @flow(name="evaluate")
 def evaluate_flow(
     ratings: str | None = None,
@@ -70,13 +84,21 @@ def evaluate_flow(
     corpus: str = "all",
     data_dir: str | None = None,
     paper: str | None = None,
+    mixture: bool = True,
 ) -> dict:
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
-    (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods."""
+    (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods. With `mixture`
+    and a household sentence LM published, the household weight is chosen on the same ratings first,
+    so the default completion is evaluated and calibrated under it."""
     ws = Workspace.from_env(data_dir=data_dir)
     if paper:
         ws = replace(ws, paper=Path(paper))
     res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
+    if mixture and corpus == "all" and (ws.checkpoints / Setting("sentence", "household").name / "LATEST").exists():
+        get_run_logger().info("household weight: %s", mixture_task(ratings or str(ws.db), res, ws))
+        res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
+        if not res.mixture.plain:  # the report shows what the mixture changed
+            methods = [*methods, f"{COMPLETION_METHOD}@plain"]
     report = Path(out or ws.report)
     results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws)
     create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",

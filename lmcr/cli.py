@@ -287,7 +287,9 @@ def train(
     console.print(f"published {path}")
 
 
-VECTORS_HELP = "word2vec vectors (GloVe/word2vec text, word2vec .bin, or .npy + .words.txt); default: trained on the corpus, cached."
+VECTORS_HELP = ("word vectors (GloVe/word2vec text, word2vec .bin, or .npy + .words.txt or a Parquet word index), or "
+                "'corpus' for word2vec trained on the corpus (cached); default: the full GloVe of the vectors extra "
+                "when installed, else 'corpus'.")
 CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions CSV) or a Numberbatch file."
 
 

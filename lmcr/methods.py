@@ -169,11 +169,16 @@ def _cooccur(res: MethodResources) -> Scorer:
     return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model), robot_terms()).score_frames
 
 
+CORPUS_VECTORS = Path("corpus")  # `--vectors corpus`: word2vec trained on the setting's sentences
+
+
 def word_vectors(res: MethodResources) -> Path:
     """The word vectors of the baselines: the given file, else the full GloVe of the `vectors` extra, else
-    word2vec trained on the corpus."""
+    (or when asked for with 'corpus') word2vec trained on the corpus."""
     from lmcr.baselines.vectors import installed_glove
 
+    if res.vectors == CORPUS_VECTORS:
+        return corpus_word2vec(res)
     return res.vectors or installed_glove() or corpus_word2vec(res)
 
 

@@ -3,10 +3,9 @@ request or the frame itself, and that context reaches only the scorers that read
 
 from __future__ import annotations
 
-from srl_docs import make_doc
-
 from lmcr.srl.context import utterance_context
 from lmcr.srl.frames import FrameMention
+from tests.srl_docs import make_doc
 
 
 def mention(doc, predicate: int, roles: dict[str, int | None]) -> FrameMention:

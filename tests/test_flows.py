@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import duckdb
 import pytest
 from prefect.testing.utilities import prefect_test_harness
@@ -119,7 +121,10 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
 
     params = PipelineParams(data_dir=str(tmp_path), embedding=16, max_epochs=2, per_verb=5)
     first = pipeline_flow(params)
-    assert (tmp_path / "report" / "report.html").exists() and set(first["checkpoints"]) == {"sentence-all", "frame-all"}
+    assert (tmp_path / "report" / "report.html").exists()
+    assert set(first["checkpoints"]) == {"sentence-all", "frame-all", "sentence-household"}
+    chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on the ratings
+    assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == "sentence_lm+frame_counts"
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
     assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
     # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.

@@ -141,6 +141,29 @@ def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, t
     assert LMScorer(dropped).score_frames([frame]) == kept.score(["pour water into cup"])
 
 
+def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monkeypatch):
+    from lmcr import methods
+    from lmcr.mixture import Mixture
+
+    model, vocab, _ = overfit
+    torch.manual_seed(3)
+    untrained = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
+    ckpt.publish(tmp_path, "sentence-all", model, vocab, "sentence", {}, {})
+    ckpt.publish(tmp_path, "sentence-household", untrained, vocab, "sentence", {}, {})
+    monkeypatch.setattr(methods, "corpus_words", lambda res: {"recipes": 99, "household": 1})
+    frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors")]
+    plain = methods.MethodResources(checkpoints=tmp_path)
+    mixed = methods.MethodResources(checkpoints=tmp_path, mixture=Mixture.of({"household": 9}))
+    share = 9 / (99 + 9)  # household weighted 9 is 9 of 108 weighted words
+    p_all = [math.exp(x) for x in methods.make_scorer("sentence_lm", plain)(frames, "for tea")]
+    p_house = [math.exp(x) for x in LMScorer(ckpt.load(tmp_path / "sentence-household")).score_frames(frames, context="for tea")]
+    expected = [math.log((1 - share) * a + share * h) for a, h in zip(p_all, p_house)]
+    assert methods.make_scorer("sentence_lm", mixed)(frames, "for tea") == pytest.approx(expected, rel=1e-5)
+    assert methods.lm_experts(mixed) == [("all", pytest.approx(1 - share)), ("household", pytest.approx(share))]
+    assert methods.scorer_fingerprint("sentence_lm", mixed).endswith("@household=9")
+    assert "@" not in methods.scorer_fingerprint("sentence_lm", plain)
+
+
 @pytest.mark.parametrize("texts", [
     ["pour water into the cup", "pour water into the glass", "pour water into the bell pepper"],  # shared prefix
     ["pour water into the cup"],  # one text: all prefix

@@ -76,7 +76,7 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     for r in rows:  # log-probabilities, and a+b is their sum
         assert float(r["frame_counts"]) < 0
         assert float(r["sentence_lm+frame_counts"]) == pytest.approx(float(r["sentence_lm"]) + float(r["frame_counts"]), abs=1e-5)
-    baselines = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur,word2vec"])
+    baselines = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", "cooccur,word2vec", "--vectors", "corpus"])
     assert baselines.exit_code == 0, baselines.output
     rows = list(csv.DictReader(out.open()))
     assert float(rows[0]["cooccur"]) > 0 and -3 <= float(rows[0]["word2vec"]) <= 0  # the sample pours water into cups

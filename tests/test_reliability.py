@@ -159,7 +159,7 @@ def test_a_failed_run_record_leaves_latest_where_it_was(tmp_path, monkeypatch):
     paths_db = tmp_path / "lmcr.duckdb"
     text = TrainingText(["pour water into the cup".split()] * 4, ["pour water into the cup".split()],
                         {"linearization": "sentence", "corpus": "all", "corpus_sha256": "x"})
-    monkeypatch.setattr(lm_run, "training_text", lambda con, lin, corpus: text)
+    monkeypatch.setattr(lm_run, "training_text", lambda con, lin, corpus, **kwargs: text)
     opened = []
 
     def open_store():
@@ -200,7 +200,7 @@ from lmcr.store import connect
 root, db = Path(sys.argv[1]), Path(sys.argv[2])
 text = TrainingText([["pour", "water"]] * 4, [["pour", "water"]], {"linearization": "sentence", "corpus": "all",
                     "corpus_sha256": "x"})
-lm_run.training_text = lambda con, lin, corpus: text
+lm_run.training_text = lambda con, lin, corpus, **kwargs: text
 print("ready", flush=True)
 for _ in range(int(sys.argv[4])):
     train_setting(lambda: connect(db, Path(sys.argv[3])), root, "sentence", "all", LMConfig(0, 8, 1, 0.0),

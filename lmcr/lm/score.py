@@ -98,7 +98,7 @@ class LMScorer:
             raise ValueError(f"norm must be one of {NORMS}")
         return [total / max(n, 1) if norm == "mean" else total for total, n in self.logprobs(texts)]
 
-    def score_frames(self, frames: list[tuple[str, dict[str, str]]], norm: str = "sum", context: str = "") -> list[float]:
+    def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum") -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
         `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"), so the
         score adds log P(context | frame): how well the frame serves what was said around it."""
