@@ -65,6 +65,7 @@ def main() -> None:
     parser_.add_argument("--corpus", default="all")
     parser_.add_argument("--mixture", default=None, help="corpus weights (household=30, plain); default: the chosen one")
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
+    parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
     args = parser_.parse_args()
     ws = Workspace.from_env()
     res = ws.resources(corpus=args.corpus)
@@ -75,8 +76,8 @@ def main() -> None:
     print(f"{args.method} ({args.corpus}, mixture {res.mixture.label or 'plain'}, context "
           f"{'on' if config.context else 'off'}); {config.source}")
     print(accuracy(parser, scorer, config, args.instructions))
-    for instruction in ("pour me some water", "pour me some water for my tea"):
-        print(latency(parser, scorer, config, instruction))
+    for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
+        print(latency(parser, scorer, config, instruction, runs=args.runs))
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
-from lmcr.lm.score import LMScorer
+from lmcr.lm.score import CONTEXT_TOP, LMScorer
 from lmcr.lm.train import TrainConfig, pick_precision, train_lm
 from lmcr.lm.vocab import Vocab
 
@@ -135,7 +135,12 @@ def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, t
     frame = ("pour", {"Theme": "water", "Destination": "cup"})
     kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
     assert kept.score_frames([frame], context="") == kept.score(["pour water into the cup"])
-    assert kept.score_frames([frame], context="for my tea") == kept.score(["pour water into the cup for my tea"])
+    assert kept.score_frames([frame], context="for my tea") == pytest.approx(kept.score(["pour water into the cup for my tea"]))
+    # Past the LM's best CONTEXT_TOP frames, a frame gets the lowest context term of those.
+    many = [("pour", {"Theme": "water", "Destination": f"cup{i}"}) for i in range(CONTEXT_TOP + 2)]
+    bare, read = kept.score_frames(many), kept.score_frames(many, context="for my tea")
+    gains = sorted(zip(bare, [r - b for r, b in zip(read, bare)]), reverse=True)
+    assert all(g == pytest.approx(min(x for _, x in gains[:CONTEXT_TOP])) for _, g in gains[CONTEXT_TOP:])
     dropped = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}, articles=False))
     assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == ["pour", "milk", "into", "cup"]
     assert LMScorer(dropped).score_frames([frame]) == kept.score(["pour water into cup"])

@@ -107,6 +107,8 @@ def provenance_markdown(provenance: dict) -> list[str]:
     lines = [f"- Built {provenance['date']} by lmcr {provenance['lmcr']}, commit `{provenance['git_commit']}`, "
              f"on {provenance['machine']}."]
     lines += [f"- Ratings `{f['file']}` sha256 `{f['sha256'][:16]}`" for f in provenance["ratings"]]
+    if "mixture" in provenance:
+        lines.append(f"- Corpus mixture of the bare method names: {provenance['mixture']} (`lmcr mixture`)")
     lines += [f"- Checkpoint {c['setting']}: `{c['version']}`, manifest sha256 `{c['manifest_sha256'][:16]}`"
               for c in provenance["checkpoints"]]
     corpus = provenance["corpus"]

@@ -121,6 +121,9 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
     if calibration_dir is not None:
         saved = calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
         notes += [calibration_note(method, cal) for method, (_, _, cal) in saved.items()]
+    if published:
+        notes.append("The paper's Fig. 4 (accuracy against lambda and k) is drawn without its values in the LaTeX "
+                     "source, so only Table I is set beside ours; our Fig. 4 has no paper series.")
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     evaluated = [m for m in methods if m in scores], [s for s in settings if s in scores]
     origin = ({**provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res)),

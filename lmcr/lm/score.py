@@ -29,6 +29,9 @@ from lmcr.lm.linearize import linearize, tokens
 from lmcr.lm.vocab import UNK
 
 NORMS = ("sum", "mean")
+# Frames whose score reads the instruction's context (`LMScorer.score_frames`). A dev scene holds 5-7
+# objects, so there every frame reads it; the cap bounds the cost in large scenes (40 objects: the bench).
+CONTEXT_TOP = 10
 
 
 @contextmanager
@@ -100,11 +103,21 @@ class LMScorer:
 
     def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum") -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
-        `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"), so the
-        score adds log P(context | frame): how well the frame serves what was said around it."""
-        lin = self.checkpoint.linearization
-        tail = f" {context}" if context.strip() else ""
-        return self.score([linearize(lin, predicate, roles) + tail for predicate, roles in frames], norm)
+        `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"): the score
+        adds log P(context | frame), how well the frame serves what was said around it.
+
+        The context is read after the CONTEXT_TOP frames this model scores best, the others get the
+        lowest context term of those: past the shared frame prefix every candidate's context costs a
+        softmax over the vocabulary per word, and a frame this far down is not what was meant."""
+        texts = [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
+        scores = self.score(texts, norm)
+        if not context.strip() or not frames:
+            return scores
+        top = sorted(range(len(texts)), key=lambda i: -scores[i])[:CONTEXT_TOP]
+        with_context = self.score([f"{texts[i]} {context}" for i in top], norm)
+        gains = {i: after - scores[i] for i, after in zip(top, with_context)}
+        floor = min(gains.values())
+        return [s + gains.get(i, floor) for i, s in enumerate(scores)]
 
     @torch.no_grad()
     def _score(self, seqs: list[list[int]]) -> list[float]:
