@@ -73,7 +73,7 @@ def main() -> None:
     scorer, config = ws.completion_scorer(args.method, res)
     config = replace(config, context=not args.no_context)
     parser = ws.parser()
-    print(f"{args.method} ({args.corpus}, mixture {res.mixture.label or 'plain'}, context "
+    print(f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
           f"{'on' if config.context else 'off'}); {config.source}")
     print(accuracy(parser, scorer, config, args.instructions))
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():

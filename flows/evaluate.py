@@ -61,14 +61,11 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 @task(name="choose-mixture")
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace) -> str:
     """Choose the household weight of the pooled setting on the ratings (`lmcr mixture`) and save it."""
-    from lmcr.evaluate.mixture import choose_mixture
-    from lmcr.mixture import save
+    from lmcr.evaluate.mixture import choose_and_save
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-    chosen, accuracy = choose_mixture(rated, res, COMPLETION_METHOD, log=get_run_logger().info)
-    save(ws.data_dir, chosen, {"chosen_for": COMPLETION_METHOD, "corpus": "household", "ratings": ratings,
-                               "accuracy": {f"{w:g}": round(a, 4) for w, a in accuracy.items()}})
-    return chosen.label or "plain"
+    chosen, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info)
+    return chosen.label
 
 
 @flow(name="evaluate")

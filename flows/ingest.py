@@ -8,7 +8,7 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner
 
-from lmcr.ingest import Source, StagedFile, expand_inputs
+from lmcr.ingest import Source, StagedFile, expand_corpora
 from lmcr.ingest.run import corpus_summary, parse_and_stage, plan
 from lmcr.ingest.stage import load_staged
 from lmcr.workspace import Workspace
@@ -43,8 +43,7 @@ def ingest_flow(
 ) -> list[dict]:
     """Ingest YouCook2, recipe and household corpora; unchanged sources are skipped; publishes a summary table."""
     ws = Workspace.from_env(data_dir=data_dir, db=db)
-    sources = [s for corpus, paths in (("youcook2", youcook2), ("recipes", recipes), ("household", household))
-               for s in expand_inputs([Path(p) for p in paths or []], corpus, fmt)]
+    sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt)
     with ws.connect() as con:
         todo, skipped = plan(con, sources)
     get_run_logger().info("%d sources to ingest, %d unchanged", len(todo), len(skipped))

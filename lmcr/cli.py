@@ -21,7 +21,7 @@ from lmcr.annotate.hits import HitSettings
 from lmcr.errors import LMCRError, one_line
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.frames.config import FrameCorpusConfig
-from lmcr.ingest import expand_inputs
+from lmcr.ingest import expand_corpora
 from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, METHODS
 from lmcr.mixture import GRID as MIXTURE_GRID
@@ -123,8 +123,7 @@ def ingest(
         fail("nothing to ingest: give --youcook2, --recipes and/or --household PATH")
     ws = Workspace.from_env(db=db)
     started = time.perf_counter()
-    sources = [s for corpus, paths in (("youcook2", youcook2), ("recipes", recipes), ("household", household))
-               for s in expand_inputs(paths, corpus, fmt, encoding)]
+    sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt, encoding)
     con = ws.connect()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True) as progress:
@@ -363,16 +362,13 @@ def mixture(
     method: str = typer.Option(COMPLETION_METHOD, help="The method whose Table I accuracy decides."),
     grid: str = typer.Option(",".join(f"{w:g}" for w in MIXTURE_GRID), help="Candidate weights."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
-    per_verb: int = typer.Option(50, help="Scenarios per verb."),
+    per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
 ) -> None:
     """Choose how much a corpus counts in the pooled `all` setting, on rated frames; saves mixture.json
     (read by every command that scores, and part of the completion calibration's fingerprint)."""
-    from lmcr.evaluate.mixture import choose_mixture
-    from lmcr.evaluate.protocol import EvalConfig
+    from lmcr.evaluate.mixture import choose_and_save
     from lmcr.evaluate.ratings import load_ratings
-    from lmcr.files import file_sha256
     from lmcr.lexicon import load_lexicon
-    from lmcr.mixture import save
 
     ws = Workspace.from_env()
     try:
@@ -382,11 +378,8 @@ def mixture(
     rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
-    chosen, accuracy = choose_mixture(rated, ws.resources(checkpoint), method, corpus, weights,
-                                      EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False))
-    path = save(ws.data_dir, chosen, {"chosen_for": method, "corpus": corpus, "ratings": str(ratings),
-                                      "ratings_sha256": file_sha256(ratings),
-                                      "accuracy": {f"{w:g}": round(a, 4) for w, a in accuracy.items()}})
+    chosen, path = choose_and_save(rated, ratings, ws.resources(checkpoint), method, ws.data_dir, corpus, weights,
+                                   EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False))
     console.print(f"{corpus} weight {chosen.weight(corpus):g} saved to {path}; run `lmcr evaluate` to calibrate "
                   "completion under it")
 

@@ -27,6 +27,12 @@ from lmcr.setting import SOURCE_CORPORA
 from lmcr.store import named_query, read_connection
 
 
+def _weighted_counts(con, sql_dir: Path, query: str, corpus: str, weight: float) -> list[tuple]:
+    """A count query's rows for one corpus, the count (last column) times the corpus's weight."""
+    rows = con.execute(named_query(sql_dir, query), {"corpus": corpus}).fetchall()
+    return [(*row[:-1], weight * row[-1]) for row in rows]
+
+
 class FrameCountScorer:
     """Smoothed conditional filler probabilities from (predicate, role, value) and pair counts."""
 
@@ -57,11 +63,9 @@ class FrameCountScorer:
         fillers, pairs = [], []
         con = read_connection(db)
         try:
-            for part in parts:
-                w = mixture.weight(part) if part != "all" else 1.0
-                params = {"corpus": part}
-                fillers += [(*row[:-1], w * row[-1]) for row in con.execute(named_query(sql_dir, "frame_fillers"), params).fetchall()]
-                pairs += [(*row[:-1], w * row[-1]) for row in con.execute(named_query(sql_dir, "frame_filler_pairs"), params).fetchall()]
+            for part in parts:  # 'all' is never weighted: its weight is 1
+                fillers += _weighted_counts(con, sql_dir, "frame_fillers", part, mixture.weight(part))
+                pairs += _weighted_counts(con, sql_dir, "frame_filler_pairs", part, mixture.weight(part))
         finally:
             con.close()
         if not fillers:

@@ -70,8 +70,8 @@ class Mixture:
 
     @property
     def label(self) -> str:
-        """'household=30', '' when plain: how method names and fingerprints carry it."""
-        return ",".join(f"{c}={w:g}" for c, w in self.weights)
+        """'household=30', or 'plain': how method names, fingerprints and reports name it (`parse` reads it)."""
+        return ",".join(f"{c}={w:g}" for c, w in self.weights) or "plain"
 
     def shares(self, words: dict[str, int]) -> dict[str, float]:
         """Each weighted corpus's share of the weighted words: its LM's interpolation weight."""

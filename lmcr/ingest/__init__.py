@@ -7,11 +7,11 @@ single writer, replacing that source's earlier rows in one transaction.
 
 from __future__ import annotations
 
-from lmcr.ingest.detect import FORMATS, Source, detect_format, expand_inputs, parse_source
+from lmcr.ingest.detect import FORMATS, Source, detect_format, expand_corpora, expand_inputs, parse_source
 from lmcr.ingest.records import IngestError, ParsedFile
 from lmcr.ingest.stage import StagedFile, already_loaded, load_staged, stage
 
 __all__ = [
     "FORMATS", "IngestError", "ParsedFile", "Source", "StagedFile", "already_loaded", "detect_format",
-    "expand_inputs", "load_staged", "parse_source", "stage",
+    "expand_corpora", "expand_inputs", "load_staged", "parse_source", "stage",
 ]

@@ -124,6 +124,14 @@ def expand_inputs(
     return sources
 
 
+def expand_corpora(paths: dict[str, list], fmt: str | None = None, encoding: str | None = None) -> list[Source]:
+    """Sources for each corpus's user paths ({"recipes": [...], "household": [...]}), corpus by corpus."""
+    unknown = set(paths) - set(CORPORA)
+    if unknown:
+        raise ValueError(f"corpus must be one of {CORPORA}, not {sorted(unknown)[0]!r}")
+    return [s for corpus in CORPORA for s in expand_inputs([Path(p) for p in paths.get(corpus) or []], corpus, fmt, encoding)]
+
+
 def _household_sources(path: Path, encoding: str | None) -> list[Source]:
     """A household folder: its EPIC-KITCHENS narration CSVs as one source (their overlap is settled
     together), each VirtualHome program file as its own."""

@@ -85,7 +85,6 @@ def parse_epic_kitchens(path: Path, corpus: str = "household") -> ParsedFile:
     texts: dict[str, tuple[str, str]] = {}  # narration id -> (text, subset)
     for file in files:
         label = file.relative_to(path).as_posix() if path.is_dir() else str(file)
-        subset = "epic-100" if "narration_id" in _header(file) else "epic-55"
         place: Counter[str] = Counter()
         for line, row, problem in _rows(file, label):
             nid, problem = (None, problem) if problem else _narration_id(row, place)
@@ -95,7 +94,7 @@ def parse_epic_kitchens(path: Path, corpus: str = "household") -> ParsedFile:
             if problem:
                 parsed.reject(line, f"{label}:{line}: {problem}", row or "")
                 continue
-            texts.setdefault(nid, (text, subset))
+            texts.setdefault(nid, (text, "epic-100" if "narration_id" in row else "epic-55"))
     videos: dict[str, list[tuple[int, str, str]]] = defaultdict(list)
     for nid, (text, subset) in texts.items():
         match = ID.match(nid)
