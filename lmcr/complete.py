@@ -60,12 +60,24 @@ def _candidate_frames(missing: list[str], objects: list[str]) -> list[dict[str, 
     return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
 
 
-def _unresolved(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) -> dict[str, str]:
-    """Stated fillers the robot cannot ground: neither a detected object nor a word of its object
-    vocabulary ("fry two sunny side up" -> Theme 'side'). They are filled from the objects like a
-    missing role. Without a vocabulary in the lexicon every stated filler is kept."""
+def _grounded(value: str, known: set[str]) -> str | None:
+    """The longest ending of a stated filler that names a known object ("leftover pizza" -> pizza: a
+    modifier the parser kept does not hide the object), or None."""
+    words = value.split()
+    return next((" ".join(words[i:]) for i in range(len(words)) if " ".join(words[i:]) in known), None)
+
+
+def _ground(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) \
+        -> tuple[dict[str, str | None], dict[str, str]]:
+    """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
+    the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
+    objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept."""
+    if not vocabulary:
+        return roles, {}
     known = set(vocabulary) | set(detected)
-    return {r: v for r, v in roles.items() if vocabulary and v and v not in known}
+    grounded = {r: v and _grounded(v, known) for r, v in roles.items()}
+    unresolved = {r: v for r, v in roles.items() if v and grounded[r] is None}
+    return grounded, unresolved
 
 
 def _question(template: str, roles: dict[str, str | None], missing: list[str], choices: list[dict]) -> str:
@@ -93,8 +105,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     pool = [o for o in pool if o not in ignored]
     pronouns = parser.lex.object_pronouns
     roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
-    unresolved = _unresolved(roles, parser.lex.objects, pool)
-    roles = {r: (None if r in unresolved else v) for r, v in roles.items()}
+    roles, unresolved = _ground(roles, parser.lex.objects, pool)
     missing = [r for r, v in roles.items() if v is None]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],

@@ -21,7 +21,7 @@ class PredicateSpec:
     roles: tuple[str, str]
     object_role: str
     with_role: str | None
-    preps: dict[str, frozenset[str]]
+    preps: dict[str, tuple[str, ...]]  # per role, the most usual preposition first
     particles: frozenset[str]
     alternating: bool
     sentence: str  # "pour {Theme} into the {Destination}": the sentence-LM linearisation
@@ -31,6 +31,13 @@ class PredicateSpec:
         if prep == "with" and self.with_role:
             return self.with_role
         return next((role for role, preps in self.preps.items() if prep in preps), None)
+
+    def prep_rank(self, prep: str) -> int:
+        """How usual `prep` is for the role it fills (0 = the most usual; "with" of the with-role is 0):
+        which of two phrases for one role names it ("fry on both sides in hot oil": in)."""
+        if prep == "with" and self.with_role:
+            return 0
+        return next((preps.index(prep) for preps in self.preps.values() if prep in preps), 99)
 
     def other(self, role: str) -> str:
         return self.roles[1] if role == self.roles[0] else self.roles[0]
@@ -53,7 +60,7 @@ def load_lexicon(path: str | None = None) -> Lexicon:
     predicates = {
         name: PredicateSpec(
             name=name, roles=tuple(spec["roles"]), object_role=spec["object"], with_role=spec.get("with"),
-            preps={role: frozenset(p) for role, p in spec.get("preps", {}).items()},
+            preps={role: tuple(p) for role, p in spec.get("preps", {}).items()},
             particles=frozenset(spec.get("particles", [])), alternating=bool(spec.get("alternating")),
             sentence=spec["sentence"],
         )

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from lmcr.complete import CompletionConfig, CompletionError, calibrate, complete, load_config, save_config, softmax
-from lmcr.srl.parser import NoPredicateError, load_parser
+from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
 
 pytestmark = pytest.mark.model
 LIKES = {"cup": 3.0, "glass": 2.9, "bowl": 0.0, "scissors": -5.0, "water": 1.0, "milk": 0.5}
@@ -104,3 +104,11 @@ def test_a_scorer_is_one_registry_entry(monkeypatch):
     assert methods.make_scorer("verb_length+verb_length", res)(frames) == [8.0, 12.0]
     assert methods.scorer_fingerprint("verb_length+verb_length", res) == "len-v1+len-v1"
     assert methods.scorer_fingerprint("verb_length+random", res) is None  # random is never calibrated
+
+
+def test_a_modifier_the_parser_kept_does_not_hide_a_detected_object(parser):
+    """Without learned compounds the parser keeps "leftover pizza" whole; the robot sees a pizza."""
+    assert parse_instruction(parser, "heat the leftover pizza").roles["Theme"] == "leftover pizza"
+    out = complete(parser, scorer, "heat the leftover pizza", ["pizza", "microwave", "cup"])
+    assert out["unresolved"] == {} and out["missing"] == "Instrument"
+    assert out["frame"]["roles"]["Theme"] == "pizza" and "pizza" not in [c["object"] for c in out["candidates"]]

@@ -362,6 +362,29 @@ def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monke
     assert line["id"] == "long" and "the limit is 1,000" in line["error"]
 
 
+def test_a_line_that_cannot_be_completed_gets_its_error_and_the_batch_goes_on(tmp_path, monkeypatch):
+    """A well-formed line in the middle that cannot be parsed (no predicate) or completed (no objects)."""
+    import lmcr.complete as completion
+
+    lines = [{"id": "a", "instruction": "pour me some water", "objects": ["cup", "bowl"]},
+             {"id": "b", "instruction": "wash the dishes", "objects": ["cup"]},
+             {"id": "c", "instruction": "fry the chicken", "objects": []},
+             {"id": "d", "instruction": "heat the leftover pizza", "objects": ["pizza", "microwave"]}]
+    path = tmp_path / "in.jsonl"
+    path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
+    monkeypatch.setattr(completion, "completion_scorer",
+                        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()))
+    result = runner.invoke(app, ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
+                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    assert result.exit_code == 0, result.output
+    out = [json.loads(line) for line in (tmp_path / "o.jsonl").read_text().splitlines()]
+    assert [o["id"] for o in out] == ["a", "b", "c", "d"]
+    assert "error" not in out[0] and out[0]["frame"]["roles"]["Theme"] == "water"
+    assert out[1]["error"].startswith("no known predicate in 'wash the dishes'")
+    assert "no usable objects" in out[2]["error"]
+    assert out[3]["frame"]["roles"] == {"Theme": "pizza", "Instrument": "microwave"}
+
+
 def test_ratings_that_are_neither_csv_nor_a_store_are_one_line_and_untouched(tmp_path):
     """A read that fails on a non-store file must not fall back to opening it read-write."""
     path = tmp_path / "ratings.txt"

@@ -5,15 +5,18 @@ from __future__ import annotations
 import json
 
 import pytest
+from spacy.tokens import Doc
 from typer.testing import CliRunner
 
 from lmcr.cli import app
+from lmcr.config import REPO_ROOT
 from lmcr.frames.build import build_frame_corpus, process_pool
 from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
+from lmcr.srl.lemmas import LazyLemmas, lemma
 from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
 from lmcr.store import check_contracts
 
@@ -103,3 +106,49 @@ def test_frame_corpus_on_sample(con, paths, sample_dir):
     before = con.execute("select * from frame_roles order by all").fetchall()
     assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2)) is None  # unchanged: skipped
     assert con.execute("select * from frame_roles order by all").fetchall() == before
+
+
+def _tagged(parser, words_tags: str):
+    words = [wt.split("/")[0] for wt in words_tags.split()]
+    tags = [wt.split("/")[1] for wt in words_tags.split()]
+    deps = [wt.split("/")[2] for wt in words_tags.split()]
+    heads = [int(wt.split("/")[3]) for wt in words_tags.split()]
+    return Doc(parser.nlp.vocab, words=words, tags=tags, deps=deps, heads=heads)
+
+
+def test_lemmas_are_chosen_by_the_corpus_and_stable(parser):
+    doc = _tagged(parser, "cookies/NNS/dobj/0 leaves/NNS/dobj/1 pancakes/NN/dobj/2 glass/NN/dobj/3")
+    plain = LazyLemmas(parser.nlp).fill(doc)
+    # several candidates: the least stripped one (the rules return them in set order, which varies by run)
+    assert [lemma(t) for t in plain] == ["cookie", "leave", "pancake", "glass"]
+    counted = LazyLemmas(parser.nlp, {"leaf": 40, "leave": 1, "pancake": 9}).fill(
+        _tagged(parser, "cookies/NNS/dobj/0 leaves/NNS/dobj/1 pancakes/NN/dobj/2 glass/NN/dobj/3"))
+    assert [lemma(t) for t in counted] == ["cookie", "leaf", "pancake", "glass"]
+
+
+def test_participle_modifiers_are_marked(parser):
+    doc = LazyLemmas(parser.nlp).fill(_tagged(
+        parser, "chopped/JJ/amod/3 frying/NN/amod/3 frozen/JJ/amod/3 peas/NNS/ROOT/3 red/JJ/amod/5 wine/NN/dobj/3"))
+    assert [t._.participle for t in doc] == [True, False, True, False, False, False]
+
+
+def test_own_srl_set_without_learned_resources(parser):
+    """The set written for this repository (data/eval): the model alone; the learned resources of the
+    full corpora take it to 0.978 role F1 and 50/50 instructions (README)."""
+    gold = [r for _, r in read_jsonl(REPO_ROOT / "data" / "eval" / "srl_own.jsonl", {"text": str, "frames": list})]
+    assert len(gold) >= 150
+    predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in gold)]
+    table = {row["predicate"]: row for row in score_frames([r["frames"] for r in gold], predicted,
+                                                           set(parser.lex.predicates)).table()}
+    assert table["all"]["pred_f1"] == 1.0 and table["all"]["role_f1"] >= 0.91
+
+
+def test_srl_eval_prints_the_error_classes(tmp_path, monkeypatch):
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    gold = tmp_path / "gold.jsonl"
+    gold.write_text(json.dumps({"id": "1", "text": "pour the water into the cups", "frames": [
+        {"predicate": "pour", "roles": {"Theme": "peanut water", "Destination": "cup"}}]}) + "\n", encoding="utf-8")
+    result = runner.invoke(app, ["srl-eval", "--gold", str(gold), "--show"])
+    assert result.exit_code == 0, result.output
+    assert "boundary 1" in result.output and "missed predicate 0" in result.output
+    assert "'pour the water into the cups': boundary (pour.Theme)" in result.output

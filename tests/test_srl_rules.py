@@ -145,3 +145,48 @@ def test_imperative_repair_triggers():
     clause = make_doc("brush/VB/ROOT/0 bread/NN/dobj/0 and/CC/cc/1 season/NN/conj/1 with/IN/prep/3 salt/NN/pobj/4")
     assert find_split(clause[:], LEX).text == "season"
     assert find_split(make_doc("add/VB/ROOT/0 salt/NN/dobj/0 and/CC/cc/1 pepper/NN/conj/1")[:], LEX) is None
+
+
+def _participles(doc_spec: str, words: set[str]):
+    doc = make_doc(doc_spec)
+    for token in doc:
+        token._.participle = token.lower_ in words  # what LazyLemmas marks with the model's lemmatizer
+    return doc
+
+
+def test_participles_and_predicative_adjectives_are_never_name_parts():
+    strong = Compounds(strong_bigrams=frozenset({"grated parmesan", "hot sauce", "sesame oil"}),
+                       predicative=frozenset({"hot"}))
+    doc = _participles("sprinkle/VB/ROOT/0 the/DT/det/3 grated/JJ/amod/3 parmesan/NN/dobj/0", {"grated"})
+    assert extract_frames(doc, LEX, strong)[0].roles["Theme"] == "parmesan"  # strong bigram, still a participle
+    assert frames("pour/VB/ROOT/0 the/DT/det/3 boiled/VBN/amod/3 water/NN/dobj/0", strong)[0][1]["Theme"] == "water"
+    assert frames("pour/VB/ROOT/0 hot/JJ/amod/2 sauce/NN/dobj/0", strong)[0][1]["Theme"] == "sauce"
+    assert frames("heat/VB/ROOT/0 sesame/JJ/amod/2 oil/NN/dobj/0", strong)[0][1]["Theme"] == "sesame oil"
+
+
+def test_proper_noun_tagged_modifiers_are_judged_by_the_corpus():
+    doc = "heat/VB/ROOT/0 the/DT/det/3 leftover/NNP/compound/3 pizza/NN/dobj/0"
+    assert frames(doc)[0][1]["Theme"] == "leftover pizza"  # no statistics: the parser's compound label stands
+    assert frames(doc, Compounds())[0][1]["Theme"] == "pizza"
+    # a common-noun modifier of a modifier is part of the name too
+    doc = "fill/VB/ROOT/0 the/DT/det/4 ice/NN/compound/3 cube/NN/compound/4 tray/NN/dobj/0"
+    assert frames(doc)[0][1]["Destination"] == "ice cube tray"
+
+
+def test_quantities_and_phrases_hung_on_other_phrases():
+    # the quantity read as an adverbial noun phrase is still the object
+    doc = ("fry/VB/ROOT/0 a/DT/det/2 couple/NN/npadvmod/0 of/IN/prep/2 eggs/NNS/pobj/3/egg in/IN/prep/0 "
+           "the/DT/det/7 skillet/NN/pobj/5")
+    assert frames(doc) == [("fry", {"Theme": "egg", "Instrument": "skillet"})]
+    # a destination hung on the of-object of a quantity
+    doc = ("pour/VB/ROOT/0 some/DT/dobj/0 of/IN/prep/1 the/DT/det/4 sauce/NN/pobj/2 over/IN/prep/4 "
+           "the/DT/det/7 meatballs/NNS/pobj/5/meatball")
+    assert frames(doc) == [("pour", {"Theme": "sauce", "Destination": "meatball"})]
+    # a role phrase hung on the object of a time phrase
+    doc = ("fry/VB/ROOT/0 the/DT/det/2 onions/NNS/dobj/0/onion for/IN/prep/0 five/CD/nummod/5 "
+           "minutes/NNS/pobj/3/minute in/IN/prep/5 the/DT/det/8 butter/NN/pobj/6")
+    assert frames(doc) == [("fry", {"Theme": "onion", "Instrument": "butter"})]
+    # two phrases for one role: the more usual preposition names it ("in" before "on" for fry)
+    doc = ("fry/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 on/IN/prep/0 both/DT/det/5 sides/NNS/pobj/3/side "
+           "in/IN/prep/5 hot/JJ/amod/8 oil/NN/pobj/6")
+    assert frames(doc) == [("fry", {"Theme": "fish", "Instrument": "oil"})]

@@ -48,12 +48,18 @@ def resolve_head(token: Token, lex: Lexicon) -> Token | None:
 def _is_name_part(child: Token, head: Token, compounds: Compounds | None) -> bool:
     if child.dep_ not in ("compound", "amod", "nmod") or not child.is_alpha:
         return False
-    # The parser's compound label stands ("piping/VBG bag"); spaCy also often marks the first word of
-    # a fixed compound as amod with a noun tag ("frying/NN pan").
-    if child.dep_ == "compound" or child.tag_ in NOUN_TAGS:
+    # A past participle describes the thing ("boiled water", "chopped garlic"), whatever its tag.
+    if child._.participle or child.tag_ in ("VBN", "VBD"):
+        return False
+    # A common-noun tag stands ("bell/NN pepper", spaCy often marks it amod: "frying/NN pan"); so does
+    # the parser's compound label on a word without the corpus statistics to judge it ("piping/VBG bag").
+    if child.tag_ in ("NN", "NNS"):
         return True
-    # Adjective-tagged modifiers: the corpus decides ("olive oil" joins, "hot oil" does not).
-    return compounds is not None and compounds.joins(child.lower_, head.lower_)
+    if compounds is None:
+        return child.dep_ == "compound"
+    # Adjective-, gerund- and proper-noun-tagged modifiers ("olive/JJ oil", "leftover/NNP rice"): the
+    # corpus decides ("olive oil" joins, "hot oil" does not).
+    return compounds.joins(child.lower_, head.lower_)
 
 
 def _singular(token: Token) -> str:
@@ -69,8 +75,10 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
     if head.tag_ == "PRP" or head.lower_ in lex.object_pronouns:
         return head.lower_, head.idx, head.idx + len(head)
     parts: list[Token] = []
-    for child in reversed(list(head.lefts)):
-        if child.i != (parts[0].i if parts else head.i) - 1 or not _is_name_part(child, head, compounds):
+    # Name parts right before the head, each a modifier of the head or of a part ("ice cube tray").
+    while head.i - len(parts) > 0:
+        child = head.doc[head.i - len(parts) - 1]
+        if child.head.i not in {head.i, *(p.i for p in parts)} or not _is_name_part(child, head, compounds):
             break
         parts.insert(0, child)
     start = parts[0].idx if parts else head.idx

@@ -1,12 +1,16 @@
-"""Fixed compounds learned from the corpus: which adjective-tagged modifiers are part of a name.
+"""Fixed compounds learned from the corpus: which modifiers are part of a name.
 
-The small tagger calls many noun modifiers adjectives ("olive/JJ oil", "cinnamon/JJ sugar"), so the
-tag cannot tell "olive oil" (a name) from "hot oil" (oil that is hot). Two corpus statistics can:
+The small tagger calls many noun modifiers adjectives ("olive/JJ oil", "cinnamon/JJ sugar") and
+some adjectives proper nouns ("leftover/NNP rice"), so the tag cannot tell "olive oil" (a name) from
+"hot oil" (oil that is hot). Corpus statistics can:
 - head rate: how often the word itself heads a noun phrase ("add the cinnamon," "with the tart.")
   among its uses after a determiner; nouns do this often, adjectives almost never;
-- NPMI of the bigram: fixed phrases of adjective-like words ("olive oil", "black pepper") stick
-  together far more than chance.
-A modifier is part of the name when either is high. Both come from `sentences`, nothing by hand.
+- unit strength of the bigram: fixed phrases ("olive oil", "black pepper", "sesame oil", "frying
+  pan") stick together far more than chance (NPMI), or the modifier mostly comes with this head;
+- predicative use: adjectives of state ("hot", "warm", "softened") follow "until", "is", "very"...
+  often; a modifier used that way describes the thing and is never part of its name.
+Past participles ("chopped", "boiled") are never part of a name either (`arguments`), whatever the
+statistics say. Everything here comes from `sentences`, nothing by hand.
 """
 
 from __future__ import annotations
@@ -21,8 +25,17 @@ from lmcr.files import atomic_path
 
 HEAD_RATE_MIN = 0.10  # nouns measured 0.10-0.49, adjectives/participles 0.00-0.08 (closing note)
 NPMI_MIN = 0.65  # "black pepper" 0.75, "olive oil" 0.84; "salted water" 0.61, "melted butter" 0.52
+# A weaker NPMI is enough when the modifier mostly comes with this head: "sesame oil" (NPMI 0.54,
+# P(oil | sesame) 0.55), "frying pan" (0.54, 0.44); "large bowl" (0.56, 0.22) stays out.
+NPMI_WITH_HEAD = 0.5
+HEAD_GIVEN_MODIFIER_MIN = 0.3
+# Predicative adjectives: share of a word's uses right after "until", "is", "very", ... ("hot" 0.15,
+# "softened" 0.23, "cold" 0.12; "sesame" 0.00, "brown" 0.06, "large" 0.01).
+PREDICATIVE_MIN = 0.1
+MIN_PREDICATIVE_USES = 50
 MIN_DETERMINED = 20  # uses after a determiner before a head rate is trusted
 MIN_BIGRAM = 5
+MIN_SINGULAR = 3  # uses after a singular determiner before a word's count is kept (`singular_counts`)
 
 _TOKENS = """
 create temp table _cmp_tokens as
@@ -53,9 +66,28 @@ bi as (
     from (select w, unnest(range(1, len(w))) as i from _cmp_tokens)
     group by all having count(*) >= ?
 )
-select a || ' ' || b, ln(bi.n * total.n / (ua.n * ub.n)) / -ln(bi.n / total.n) as npmi
+select a || ' ' || b, ln(bi.n * total.n / (ua.n * ub.n)) / -ln(bi.n / total.n) as npmi, bi.n / ua.n as p_head
 from bi, total join uni ua on ua.w = a join uni ub on ub.w = b
 where a not in ('.', ',', ';') and b not in ('.', ',', ';')
+"""
+_PREDICATIVE = """
+with uni as (select w1 as w, count(*) as n from (select unnest(w) as w1 from _cmp_tokens) group by 1),
+after as (
+    select w[i] as x, count(*) as n
+    from (select w, unnest(range(2, len(w) + 1)) as i from _cmp_tokens)
+    where w[i - 1] in ('until', 'is', 'are', 'be', 'very', 'too', 'so', 'become', 'becomes', 'remain', 'remains',
+                       'stay', 'stays', 'still', 'get', 'gets', 'keep', 'slightly', 'quite', 'rather', 'fairly')
+    group by x
+)
+select x from after join uni on uni.w = x where uni.n >= ? and after.n / uni.n >= ?
+"""
+
+
+_SINGULAR_USES = """
+select w[i] as x, count(*) as n
+from (select w, unnest(range(2, len(w) + 1)) as i from _cmp_tokens)
+where w[i - 1] in ('a', 'an', 'each', 'every', 'another', 'this', 'that') and w[i] not in ('.', ',', ';')
+group by x having count(*) >= ?
 """
 
 
@@ -65,20 +97,28 @@ class Compounds:
 
     head_rates: dict[str, float] = field(default_factory=dict)
     strong_bigrams: frozenset[str] = frozenset()
+    predicative: frozenset[str] = frozenset()
+    # How often each word follows a singular determiner ("a cookie"): which lemma of a plural is the
+    # noun the corpus uses (`lemmas.LazyLemmas`); None in files written before it was learned.
+    singular_counts: dict[str, int] | None = None
 
     def joins(self, modifier: str, head: str) -> bool:
         """Whether `modifier head` is a fixed compound by the corpus statistics."""
+        if modifier in self.predicative:
+            return False
         return (self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
                 or f"{modifier} {head}" in self.strong_bigrams)
 
     def save(self, path: Path) -> None:
         with atomic_path(path) as tmp:
-            tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams)}))
+            tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams),
+                                       "predicative": sorted(self.predicative), "singular_counts": self.singular_counts}))
 
     @classmethod
     def load(cls, path: Path) -> Compounds:
         data = json.loads(Path(path).read_text("utf-8"))
-        return cls(data["head_rates"], frozenset(data["strong_bigrams"]))
+        return cls(data["head_rates"], frozenset(data["strong_bigrams"]),
+                   frozenset(data.get("predicative", ())), data.get("singular_counts"))
 
 
 def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Compounds:
@@ -87,8 +127,10 @@ def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Comp
     try:
         rates = {w: round(r, 4) for w, r in con.execute(_HEAD_RATES, [MIN_DETERMINED]).fetchall()
                  if r >= HEAD_RATE_MIN}
-        bigrams = frozenset(b for b, npmi in con.execute(_STRONG_BIGRAMS, [MIN_BIGRAM]).fetchall()
-                            if npmi >= NPMI_MIN)
+        bigrams = frozenset(b for b, npmi, p_head in con.execute(_STRONG_BIGRAMS, [MIN_BIGRAM]).fetchall()
+                            if npmi >= NPMI_MIN or npmi >= NPMI_WITH_HEAD and p_head >= HEAD_GIVEN_MODIFIER_MIN)
+        predicative = frozenset(w for (w,) in con.execute(_PREDICATIVE, [MIN_PREDICATIVE_USES, PREDICATIVE_MIN]).fetchall())
+        singular = dict(con.execute(_SINGULAR_USES, [MIN_SINGULAR]).fetchall())
     finally:
         con.execute("drop table _cmp_tokens")
-    return Compounds(rates, bigrams)
+    return Compounds(rates, bigrams, predicative, singular)

@@ -77,3 +77,57 @@ def instruction_correct(frame: dict | None, expected: dict, missing: str | None)
         if frame["roles"].get(role) != want:
             return False
     return True
+
+
+# Error classes a regression is reported under (`classify_errors`), in the order `lmcr srl-eval` prints them.
+ERROR_CLASSES = ("missed predicate", "extra predicate", "boundary", "lemma", "role", "missed role", "extra role",
+                 "wrong filler")
+
+
+def _value_error(gold: str, pred: str) -> str:
+    """How a predicted filler differs from the gold one: the span's edges, the head's lemma, or the word."""
+    g, p = gold.split(), pred.split()
+    if g[-1] == p[-1] or g[-len(p):] == p or p[-len(g):] == g:
+        return "boundary"  # same head, modifiers kept or lost ("leftover pizza", "butter" for "peanut butter")
+    if len(g) == len(p) and g[:-1] == p[:-1] and g[-1][:3] == p[-1][:3]:
+        return "lemma"  # "cooky" for "cookie", "leave" for "leaf"
+    return "wrong filler"
+
+
+def frame_errors(gold: dict, pred: dict | None) -> list[tuple[str, str]]:
+    """(class, role) for each way a predicted frame of the same predicate misses its gold frame."""
+    if pred is None:
+        return [("missed predicate", "")]
+    errors = []
+    g_roles, p_roles = gold["roles"], pred["roles"]
+    for role, want in g_roles.items():
+        got = p_roles.get(role)
+        if want == got:
+            continue
+        swapped = got is not None and got in [v for r, v in g_roles.items() if r != role]
+        if swapped or want is not None and want in [v for r, v in p_roles.items() if r != role]:
+            errors.append(("role", role))
+        elif want is None:
+            errors.append(("extra role", role))
+        elif got is None:
+            errors.append(("missed role", role))
+        else:
+            errors.append((_value_error(want, got), role))
+    return errors
+
+
+def classify_errors(gold: list[list[dict]], predicted: list[list[dict]], known: set[str]) -> list[list[tuple[str, str]]]:
+    """For each sentence, its errors as (class, detail): gold and predicted frames of a predicate aligned
+    in order as `score_frames` does; extra predicted frames are "extra predicate"."""
+    out = []
+    for gold_frames, pred_frames in zip(gold, predicted, strict=True):
+        g = _by_predicate([f for f in gold_frames if f["predicate"] in known])
+        p = _by_predicate([f for f in pred_frames if f["predicate"] in known])
+        errors = []
+        for name in sorted(set(g) | set(p)):
+            gs, ps = g.get(name, []), p.get(name, [])
+            for i, frame in enumerate(gs):
+                errors += [(c, f"{name}.{r}" if r else name) for c, r in frame_errors(frame, ps[i] if i < len(ps) else None)]
+            errors += [("extra predicate", name)] * max(0, len(ps) - len(gs))
+        out.append(errors)
+    return out

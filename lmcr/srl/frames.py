@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from spacy.tokens import Doc, Span, Token
 
 from lmcr.lexicon import Lexicon, PredicateSpec
-from lmcr.srl.arguments import argument_value
+from lmcr.srl.arguments import argument_value, resolve_head
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
 
@@ -69,10 +69,24 @@ def _pobj(prep: Token) -> Token | None:
     return None
 
 
+def _measured(token: Token, lex: Lexicon) -> bool:
+    """A quantity or measure noun with an of-phrase ("a couple of eggs"), whatever the parser called it."""
+    return (lemma_of(token) in lex.quantity_nouns or lemma_of(token) in lex.measure_nouns) \
+        and any(c.dep_ == "prep" and c.lower_ == "of" for c in token.children)
+
+
+def _attached_preps(token: Token, skip: frozenset[str]) -> list[tuple[str, Token]]:
+    """PPs the parser hung on `token` rather than on the verb, other than `skip` ("of" of a measure)."""
+    return [(c.lower_, p) for c in token.children
+            if c.dep_ == "prep" and c.lower_ not in skip and (p := _pobj(c)) is not None]
+
+
 def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
     objects = [c for c in verb.children if c.dep_ in OBJECT_DEPS]
     if not objects and any(c.dep_ == "dative" for c in verb.children):
         objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i]  # "fry me an egg"
+    if not objects:  # "fry a couple of eggs": the quantity read as an adverbial noun phrase
+        objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i and _measured(c, lex)][:1]
     if len(objects) > 1:  # "fry me an egg" parsed as two objects: the recipient is not the theme
         objects = [o for o in objects if o.lower_ not in lex.recipient_pronouns] or objects[:1]
     preps: list[tuple[str, Token]] = []
@@ -97,9 +111,17 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
         prep, obj = preps[0]
         if prep in spec.particles and obj.head.i == verb.i + 1:
             objects, preps, particles = [obj], preps[1:], particles + [prep]
-    # PPs the parser hung on the object ("heat some oil in the wok") still belong to the verb.
+    # PPs the parser hung on the object ("heat some oil in the wok", "pour some of the sauce over the
+    # meatballs": on the of-object) still belong to the verb.
     for obj in objects:
-        preps += [(c.lower_, p) for c in obj.children if c.dep_ == "prep" and (p := _pobj(c)) is not None]
+        head = resolve_head(obj, lex) or obj
+        preps += _attached_preps(obj, frozenset({"of"}) if head.i != obj.i else frozenset())
+        preps += _attached_preps(head, frozenset()) if head.i != obj.i else []
+    # A PP hung on the object of another PP ("for five minutes in the butter", "with a ladle over the
+    # pasta", "on both sides in hot oil") belongs to the verb too; which one names a role is decided
+    # by how usual its preposition is (`_known_frame`).
+    if spec:
+        preps += [more for _, obj in list(preps) for more in _attached_preps(obj, frozenset({"of"}))]
     return _Args(objects, preps, particles)
 
 
@@ -121,7 +143,8 @@ def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, co
         frame.roles[role], frame.spans[role] = found[0], found[1:]
         return True
 
-    for prep, obj in args.preps:
+    # Two phrases for one role: the more usual preposition names it, then the first in the text.
+    for prep, obj in sorted(args.preps, key=lambda p: (spec.prep_rank(p[0]), p[1].i)):
         role = spec.prep_role(prep)
         if role:
             fill(role, obj)

@@ -27,6 +27,7 @@ from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
 from lmcr.srl.priors import RolePriors
+from lmcr.srl.repair import rejoin_split_compounds
 from lmcr.workspace import spacy_model_from_env
 
 # Tried in order; "You should" forces a verb reading where "Please" leaves a bare "season" a noun.
@@ -134,12 +135,13 @@ class FrameParser:
     repair: bool = True  # off only to measure what the imperative repair is worth
 
     def __post_init__(self) -> None:
-        self.lemmas = LazyLemmas(self.nlp)
+        self.lemmas = LazyLemmas(self.nlp, self.compounds.singular_counts if self.compounds else None)
         # first word -> (times repaired, times it started as a verb (repaired or not), times seen)
         self.first_words: dict[str, tuple[int, int, int]] = {}
 
     def _parse(self, texts: Iterable[str]) -> Iterator[Doc]:
-        return (self.lemmas.fill(doc) for doc in self.nlp.pipe(texts, batch_size=self.batch_size))
+        return (self.lemmas.fill(rejoin_split_compounds(doc, self.compounds))
+                for doc in self.nlp.pipe(texts, batch_size=self.batch_size))
 
     def parse(self, text: str) -> list[FrameMention]:
         return next(self.pipe([text]))

@@ -1,0 +1,51 @@
+"""Parse repair: a compound whose plural head the small parser read as a verb or a second object.
+
+"sprinkle the bay leaves over the stew" comes out as "bay" subject of a verb "leaves"; "pour the hot
+oil over the chili flakes" as "flakes" a verb coordinated with "pour"; "sprinkle the bread crumbs"
+as two objects. When the two words are a strong bigram of the corpus (`Compounds.strong_bigrams`:
+"bay leaves", "chili flakes", "bread crumbs"), the plural is the head noun and the word before it a
+modifier, and the tree is mended so: the plural takes the place of the noun phrase, the noun becomes
+its compound. Without learned compounds nothing is changed.
+"""
+
+from __future__ import annotations
+
+from spacy.tokens import Doc, Token
+
+from lmcr.srl.compounds import Compounds
+
+CLAUSE_DEPS = frozenset({"ccomp", "conj", "dep", "xcomp", "advcl"})
+PHRASE_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "obj"})
+
+
+def _split(noun: Token, plural: Token) -> str | None:
+    """Which misreading `noun plural` is, or None: 'subject' (bay/nsubj leaves/VBZ), 'verb' (chili/pobj
+    flakes/VBZ, a clause of its own), 'objects' (bread/dobj crumbs/dobj, siblings)."""
+    if plural.tag_ == "VBZ" and noun.head.i == plural.i and noun.dep_ == "nsubj" and plural.dep_ in CLAUSE_DEPS:
+        return "subject"
+    if plural.tag_ == "VBZ" and noun.dep_ in PHRASE_DEPS and plural.dep_ in CLAUSE_DEPS \
+            and plural.n_lefts + plural.n_rights == 0:
+        return "verb"
+    if plural.tag_ == "NNS" and noun.dep_ == plural.dep_ == "dobj" and noun.head.i == plural.head.i:
+        return "objects"
+    return None
+
+
+def rejoin_split_compounds(doc: Doc, compounds: Compounds | None) -> Doc:
+    """Mend the three misreadings of a corpus compound with a plural head (module docstring)."""
+    if compounds is None:
+        return doc
+    for noun, plural in zip(doc[:-1], doc[1:]):
+        if noun.tag_ not in ("NN", "NNP") or not plural.lower_.endswith("s") \
+                or f"{noun.lower_} {plural.lower_}" not in compounds.strong_bigrams:
+            continue
+        kind = _split(noun, plural)
+        if kind is None:
+            continue
+        if kind == "subject":
+            plural.dep_ = "dobj"
+        elif kind == "verb":
+            plural.head, plural.dep_ = noun.head, noun.dep_
+        noun.head, noun.dep_ = plural, "compound"
+        plural.tag_, plural.pos_ = "NNS", "NOUN"
+    return doc

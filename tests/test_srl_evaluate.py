@@ -1,0 +1,40 @@
+"""SRL error classes and the learned lexical statistics (no spaCy model)."""
+
+from __future__ import annotations
+
+import duckdb
+
+from lmcr.srl.compounds import learn_compounds
+from lmcr.srl.evaluate import classify_errors
+
+
+def frame(pred: str, a: str | None, b: str | None, roles=("Theme", "Destination")) -> dict:
+    return {"predicate": pred, "roles": dict(zip(roles, (a, b)))}
+
+
+def test_every_error_has_its_class():
+    gold = [[frame("pour", "water", "cup")], [frame("pour", "peanut butter", "cookie")],
+            [frame("dip", "bread", None), frame("pour", "oil", "bowl")], [frame("pour", "milk", "glass")]]
+    pred = [[frame("pour", "cup", "water")], [frame("pour", "butter", "cooky")],
+            [frame("dip", "bread", "soup"), frame("fry", "egg", None, ("Theme", "Instrument"))],
+            [frame("pour", "leftover milk", None)]]
+    errors = classify_errors(gold, pred, {"pour", "dip", "fry"})
+    assert errors[0] == [("role", "pour.Theme"), ("role", "pour.Destination")]
+    assert errors[1] == [("boundary", "pour.Theme"), ("lemma", "pour.Destination")]
+    assert errors[2] == [("extra role", "dip.Destination"), ("extra predicate", "fry"), ("missed predicate", "pour")]
+    assert errors[3] == [("boundary", "pour.Theme"), ("missed role", "pour.Destination")]
+
+
+def test_lexical_statistics_are_learned_from_sentences():
+    con = duckdb.connect()
+    con.execute("create table sentences (text varchar, kind varchar, corpus varchar)")
+    rows = (["heat the sesame oil in a large bowl."] * 30 + ["add sesame seeds to a large pan."] * 20
+            + ["add a large egg."] * 60 + ["cook until hot."] * 30 + ["pour hot oil over a cookie."] * 40
+            + ["serve with a spring roll."] * 10)
+    con.executemany("insert into sentences values (?, 'instruction', 'recipes')", [[r] for r in rows])
+    learned = learn_compounds(con)
+    assert "sesame oil" in learned.strong_bigrams  # sesame comes with oil 60% of the time
+    assert "large bowl" not in learned.strong_bigrams  # large comes with many heads
+    assert "hot" in learned.predicative and "sesame" not in learned.predicative
+    assert learned.singular_counts["cookie"] == 40 and "cookies" not in learned.singular_counts
+    assert not learned.joins("hot", "oil") and learned.joins("sesame", "oil")
