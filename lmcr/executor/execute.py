@@ -11,8 +11,9 @@ import pybullet as p
 
 from lmcr.complete import CompletionConfig, complete
 from lmcr.errors import LMCRError, one_line
-from lmcr.executor.detect import capture, detect
+from lmcr.executor.detect import detect
 from lmcr.executor.plan import Infeasible, Plan, Planner
+from lmcr.executor.render import Recorder
 from lmcr.executor.run import run_plan
 from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
 from lmcr.executor.tasks import TASKS
@@ -31,12 +32,11 @@ def _connect() -> None:
 
 
 def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
-            frames: list | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
+            recorder: Recorder | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
     """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success, and
     whether the plan was feasible. The robot moves only when the whole plan is feasible. When the
     language model's choice is not but another candidate is, nothing moves and the result asks
-    (`question`, `suggestion`). With `frames` (a list), camera images are appended at every waypoint for
-    rendering. `answer` (role -> object) is what a person answered: it fills those roles instead.
+    (`question`, `suggestion`). A `recorder` takes a picture at the start and at every waypoint. `answer` (role -> object) is what a person answered: it fills those roles instead.
     `urdf`: the official Baxter description to use instead of ours."""
     started = time.perf_counter()
     _connect()
@@ -60,13 +60,17 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
     if isinstance(result, Infeasible):
         out.update(_refusal(frame, result, tried, parser))
     else:
-        if frames is not None:
-            result.arm.on_waypoint = lambda: frames.append(capture()[0])
-            frames.append(capture()[0])
         task = TASKS[frame["predicate"]]
         roles = frame["roles"]
+        if recorder is not None:
+            recorder.target, recorder.held = roles[task.target_role], roles[task.held_role]
+            log = result.arm.log
+            result.arm.on_waypoint = lambda: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
+            recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
         held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
         out.update(run_plan(result, task, held, target, [o for o in scene.objects if o not in (held, target)]))
+        if recorder is not None:  # what was poured or put down, once it has come to rest
+            recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
         out["arm"] = result.arm.side
     done = time.perf_counter()
     out["seconds"] = {"perceive_and_complete": round(completed - started, 3), "plan": round(planned - completed, 3),
@@ -151,19 +155,3 @@ def _batch_scene(record: dict, base: Path, where: str) -> Scene:
     if isinstance(record.get("scene_file"), str):
         return load_scene(base / record["scene_file"])
     raise InputError(f"{where}: needs a 'scene' object or a 'scene_file' path")
-
-
-def save_render(frames: list, path: Path) -> Path:
-    """The last frame as PNG, or every waypoint's frame as an animated GIF."""
-    from PIL import Image
-
-    from lmcr.files import atomic_path
-
-    images = [Image.fromarray(f) for f in frames]
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        if path.suffix.lower() == ".gif":
-            images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], duration=300, loop=0)
-        else:
-            images[-1].save(tmp, format="PNG")
-    return path
