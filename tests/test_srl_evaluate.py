@@ -30,7 +30,8 @@ def test_lexical_statistics_are_learned_from_sentences():
     con.execute("create table sentences (text varchar, kind varchar, corpus varchar)")
     rows = (["heat the sesame oil in a large bowl."] * 30 + ["add sesame seeds to a large pan."] * 20
             + ["add a large egg."] * 60 + ["cook until hot."] * 30 + ["pour hot oil over a cookie."] * 40
-            + ["serve with a spring roll."] * 10)
+            + ["serve with a spring roll."] * 10 + ["Serve with French toast and Dijon mustard."] * 20
+            + ["Dijon is best."] * 5)
     con.executemany("insert into sentences values (?, 'instruction', 'recipes')", [[r] for r in rows])
     learned = learn_compounds(con)
     assert "sesame oil" in learned.strong_bigrams  # sesame comes with oil 60% of the time
@@ -38,3 +39,5 @@ def test_lexical_statistics_are_learned_from_sentences():
     assert "hot" in learned.predicative and "sesame" not in learned.predicative
     assert learned.singular_counts["cookie"] == 40 and "cookies" not in learned.singular_counts
     assert not learned.joins("hot", "oil") and learned.joins("sesame", "oil")
+    # written capitalised inside sentences: a proper adjective, part of a name (not at a sentence's start)
+    assert learned.proper == frozenset({"french", "dijon"}) and learned.joins("french", "fries")

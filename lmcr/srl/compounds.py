@@ -9,6 +9,8 @@ some adjectives proper nouns ("leftover/NNP rice"), so the tag cannot tell "oliv
   pan") stick together far more than chance (NPMI), or the modifier mostly comes with this head;
 - predicative use: adjectives of state ("hot", "warm", "softened") follow "until", "is", "very"...
   often; a modifier used that way describes the thing and is never part of its name.
+- proper adjectives: a word written capitalised inside sentences most of the time ("French toast",
+  "Dijon mustard") names a kind, so it is part of the name;
 Past participles ("chopped", "boiled") are never part of a name either (`arguments`), whatever the
 statistics say. Everything here comes from `sentences`, nothing by hand.
 """
@@ -33,6 +35,9 @@ HEAD_GIVEN_MODIFIER_MIN = 0.3
 # "softened" 0.23, "cold" 0.12; "sesame" 0.00, "brown" 0.06, "large" 0.01).
 PREDICATIVE_MIN = 0.1
 MIN_PREDICATIVE_USES = 50
+# Proper adjectives: share of a word's uses after a sentence's first word written capitalised.
+PROPER_MIN = 0.8
+MIN_PROPER_USES = 20
 MIN_DETERMINED = 20  # uses after a determiner before a head rate is trusted
 MIN_BIGRAM = 5
 MIN_SINGULAR = 3  # uses after a singular determiner before a word's count is kept (`singular_counts`)
@@ -91,6 +96,16 @@ group by x having count(*) >= ?
 """
 
 
+_PROPER = """
+with words as (
+    select unnest(list_filter(string_split_regex(text, '[^A-Za-z]+'), lambda x: x <> '')[2:]) as word
+    from sentences where kind = 'instruction' and (? = 'all' or corpus = ?)
+)
+select lower(word) as x from words where length(word) > 1
+group by x having count(*) >= ? and avg((word[1] between 'A' and 'Z' and word[2:] = lower(word[2:]))::int) >= ?
+"""
+
+
 @dataclass
 class Compounds:
     """Head rates of words and NPMI-strong bigrams; empty means "trust the tagger only"."""
@@ -98,6 +113,7 @@ class Compounds:
     head_rates: dict[str, float] = field(default_factory=dict)
     strong_bigrams: frozenset[str] = frozenset()
     predicative: frozenset[str] = frozenset()
+    proper: frozenset[str] = frozenset()
     # How often each word follows a singular determiner ("a cookie"): which lemma of a plural is the
     # noun the corpus uses (`lemmas.LazyLemmas`); None in files written before it was learned.
     singular_counts: dict[str, int] | None = None
@@ -106,19 +122,21 @@ class Compounds:
         """Whether `modifier head` is a fixed compound by the corpus statistics."""
         if modifier in self.predicative:
             return False
-        return (self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
+        return (modifier in self.proper or self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
                 or f"{modifier} {head}" in self.strong_bigrams)
 
     def save(self, path: Path) -> None:
         with atomic_path(path) as tmp:
             tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams),
-                                       "predicative": sorted(self.predicative), "singular_counts": self.singular_counts}))
+                                       "predicative": sorted(self.predicative), "proper": sorted(self.proper),
+                                       "singular_counts": self.singular_counts}))
 
     @classmethod
     def load(cls, path: Path) -> Compounds:
         data = json.loads(Path(path).read_text("utf-8"))
         return cls(data["head_rates"], frozenset(data["strong_bigrams"]),
-                   frozenset(data.get("predicative", ())), data.get("singular_counts"))
+                   frozenset(data.get("predicative", ())), frozenset(data.get("proper", ())),
+                   data.get("singular_counts"))
 
 
 def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Compounds:
@@ -131,6 +149,7 @@ def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Comp
                             if npmi >= NPMI_MIN or npmi >= NPMI_WITH_HEAD and p_head >= HEAD_GIVEN_MODIFIER_MIN)
         predicative = frozenset(w for (w,) in con.execute(_PREDICATIVE, [MIN_PREDICATIVE_USES, PREDICATIVE_MIN]).fetchall())
         singular = dict(con.execute(_SINGULAR_USES, [MIN_SINGULAR]).fetchall())
+        proper = frozenset(w for (w,) in con.execute(_PROPER, [corpus, corpus, MIN_PROPER_USES, PROPER_MIN]).fetchall())
     finally:
         con.execute("drop table _cmp_tokens")
-    return Compounds(rates, bigrams, predicative, singular)
+    return Compounds(rates, bigrams, predicative, proper, singular)
