@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import duckdb
 
-from lmcr.srl.compounds import learn_compounds
+from lmcr.srl.compounds import Compounds, learn_compounds
 from lmcr.srl.evaluate import classify_errors
 
 
@@ -41,3 +41,12 @@ def test_lexical_statistics_are_learned_from_sentences():
     assert not learned.joins("hot", "oil") and learned.joins("sesame", "oil")
     # written capitalised inside sentences: a proper adjective, part of a name (not at a sentence's start)
     assert learned.proper == frozenset({"french", "dijon"}) and learned.joins("french", "fries")
+
+
+def test_saved_statistics_do_not_depend_on_the_order_they_came_in(tmp_path):
+    """The frames stage is skipped when the compounds file's hash is unchanged."""
+    a = Compounds({"olive": 0.2, "cream": 0.3}, frozenset({"b c", "a b"}), singular_counts={"x": 3, "y": 4})
+    b = Compounds({"cream": 0.3, "olive": 0.2}, frozenset({"a b", "b c"}), singular_counts={"y": 4, "x": 3})
+    a.save(tmp_path / "a.json")
+    b.save(tmp_path / "b.json")
+    assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()

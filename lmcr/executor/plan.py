@@ -13,7 +13,7 @@ import pybullet as p
 
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
 from lmcr.executor.collision import CLEARANCE, CONTACT_CLEARANCE, Carried, Clearance
-from lmcr.executor.planner import RESOLUTION, RESOLUTION_CARRYING, joint_path, segment_clash
+from lmcr.executor.planner import joint_path, segment_clash
 from lmcr.executor.scene import Scene, SceneObject
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, variants
 
@@ -122,11 +122,9 @@ class Planner:
                 if hit:
                     why = f"'{step.name}' would put the {arm.side} arm against {hit}"
                     continue
-                resolution = RESOLUTION_CARRYING if carried is not None else RESOLUTION
-                path = joint_path(clash, q, goal, arm.limits, resolution=resolution)
+                path = joint_path(clash, q, goal, arm.limits)
                 if path is None:
-                    blocker = segment_clash(clash, q, goal, resolution)
-                    why = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)"
+                    why = f"no clear way for the {arm.side} arm to '{step.name}' ({segment_clash(clash, q, goal)} is in the way)"
                     continue
                 found = (path, goal, position)
                 break

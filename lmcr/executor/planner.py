@@ -14,19 +14,15 @@ from ompl import util as ou
 ou.setLogLevel(ou.LogLevel.LOG_NONE)  # OMPL's console chatter is no use to a CLI user
 
 RESOLUTION = 0.04  # radians between checked states along a motion
-# ... while the hand carries something: a bottle's far end sweeps up to ~4 cm per 0.04 rad of shoulder
-# turn, more than the 1 cm clearance, so a knock could slip between two checked states.
-RESOLUTION_CARRYING = 0.012
 PLAN_SECONDS = 1.5  # RRT-Connect's budget for one segment
 
 
 def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
-               seconds: float = PLAN_SECONDS, resolution: float = RESOLUTION) -> list[np.ndarray] | None:
+               seconds: float = PLAN_SECONDS) -> list[np.ndarray] | None:
     """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none in
-    `seconds`. `clash(q)` names what the configuration hits, None when it is clear; states are checked
-    every `resolution` radians along each motion."""
+    `seconds`. `clash(q)` names what the configuration hits, None when it is clear."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
-    if segment_clash(clash, q0, q1, resolution) is None:
+    if segment_clash(clash, q0, q1) is None:
         return [q0, q1]
     space = ob.RealVectorStateSpace(len(q0))
     bounds = ob.RealVectorBounds(len(q0))
@@ -36,7 +32,7 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
     space.setBounds(bounds)
     si = ob.SpaceInformation(space)
     si.setStateValidityChecker(lambda state: clash(np.array([state[k] for k in range(len(q0))])) is None)
-    si.setStateValidityCheckingResolution(resolution / space.getMaximumExtent())
+    si.setStateValidityCheckingResolution(RESOLUTION / space.getMaximumExtent())
     si.setup()
     start, goal = space.allocState(), space.allocState()
     for k in range(len(q0)):
@@ -56,10 +52,10 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
     return path
 
 
-def segment_clash(clash, q0, q1, resolution: float = RESOLUTION) -> str | None:
-    """The first clash on the straight joint-space segment q0 -> q1, checked every `resolution` radians."""
+def segment_clash(clash, q0, q1) -> str | None:
+    """The first clash on the straight joint-space segment q0 -> q1, checked every RESOLUTION radians."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
-    n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / resolution)))
+    n = max(1, int(np.ceil(np.max(np.abs(q1 - q0)) / RESOLUTION)))
     for k in range(1, n + 1):
         hit = clash(q0 + (q1 - q0) * k / n)
         if hit:

@@ -126,10 +126,12 @@ class Compounds:
                 or f"{modifier} {head}" in self.strong_bigrams)
 
     def save(self, path: Path) -> None:
+        """Write as JSON with sorted keys: the frame corpus's fingerprint hashes this file, and the
+        statistics come out of DuckDB in no fixed order."""
         with atomic_path(path) as tmp:
             tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams),
                                        "predicative": sorted(self.predicative), "proper": sorted(self.proper),
-                                       "singular_counts": self.singular_counts}))
+                                       "singular_counts": self.singular_counts}, sort_keys=True))
 
     @classmethod
     def load(cls, path: Path) -> Compounds:
