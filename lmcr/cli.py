@@ -806,6 +806,8 @@ def srl_eval(
     from lmcr.srl.parser import NoPredicateError, parse_instruction
 
     records = [check_record_text(line, r, "text", gold) for line, r in read_jsonl(gold, {"text": str, "frames": list})]
+    if not records:
+        fail(f"{gold}: no gold sentences to score")
     tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
     parser = Workspace.from_env().parser(model, resources)
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]

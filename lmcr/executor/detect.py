@@ -32,6 +32,11 @@ class Camera:
         proj = p.computeProjectionMatrixFOV(self.fov, self.width / self.height, self.near, self.far)
         return view, proj
 
+    def world_to_clip(self) -> np.ndarray:
+        """The 4x4 matrix from world coordinates to clip space (pybullet's matrices are column-major)."""
+        view, proj = self.matrices()
+        return np.asarray(proj).reshape(4, 4, order="F") @ np.asarray(view).reshape(4, 4, order="F")
+
 
 @dataclass(frozen=True)
 class Detection:
@@ -40,19 +45,20 @@ class Detection:
     pixels: int
 
 
-def capture(camera: Camera = Camera()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """RGB (H, W, 3) uint8, depth buffer (H, W) in [0, 1], segmentation (H, W) body ids (-1: none)."""
+def capture(camera: Camera = Camera(), shaded: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """RGB (H, W, 3) uint8, depth buffer (H, W) in [0, 1], segmentation (H, W) body ids (-1: none);
+    `shaded`: lit from the side with shadows, for pictures a person looks at."""
     view, proj = camera.matrices()
+    light = {"lightDirection": [1.0, 0.6, 2.0], "shadow": 1} if shaded else {}
     _, _, rgb, depth, seg = p.getCameraImage(camera.width, camera.height, view, proj,
-                                             renderer=p.ER_TINY_RENDERER)
+                                             renderer=p.ER_TINY_RENDERER, **light)
     rgb = np.reshape(rgb, (camera.height, camera.width, 4))[:, :, :3].astype(np.uint8)
     return rgb, np.reshape(depth, (camera.height, camera.width)), np.reshape(seg, (camera.height, camera.width))
 
 
 def back_project(depth: np.ndarray, camera: Camera) -> np.ndarray:
     """World coordinates (H, W, 3) of every pixel from the depth buffer."""
-    view, proj = camera.matrices()
-    inverse = np.linalg.inv(np.asarray(proj).reshape(4, 4, order="F") @ np.asarray(view).reshape(4, 4, order="F"))
+    inverse = np.linalg.inv(camera.world_to_clip())
     ys, xs = np.mgrid[0:camera.height, 0:camera.width]
     ndc = np.stack([(2 * xs + 1) / camera.width - 1, 1 - (2 * ys + 1) / camera.height, 2 * depth - 1,
                     np.ones_like(depth)], axis=-1)

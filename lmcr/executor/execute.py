@@ -36,7 +36,8 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
     """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success, and
     whether the plan was feasible. The robot moves only when the whole plan is feasible. When the
     language model's choice is not but another candidate is, nothing moves and the result asks
-    (`question`, `suggestion`). A `recorder` takes a picture at the start and at every waypoint. `answer` (role -> object) is what a person answered: it fills those roles instead.
+    (`question`, `suggestion`). A `recorder` takes a picture at the start, at every waypoint and at the
+    end. `answer` (role -> object) is what a person answered: it fills those roles instead.
     `urdf`: the official Baxter description to use instead of ours."""
     started = time.perf_counter()
     _connect()

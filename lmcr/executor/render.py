@@ -15,7 +15,7 @@ import numpy as np
 import pybullet as p
 from PIL import Image, ImageDraw, ImageFont
 
-from lmcr.executor.detect import Camera
+from lmcr.executor.detect import Camera, capture
 from lmcr.executor.scene import TABLE_CENTRE, TABLE_TOP, Scene
 from lmcr.files import atomic_path
 
@@ -36,8 +36,7 @@ def _font(size: int) -> ImageFont.ImageFont:
 
 def _project(point: tuple[float, float, float], camera: Camera) -> tuple[float, float]:
     """Pixel (x, y) of a world point in `camera`'s image."""
-    view, proj = camera.matrices()
-    clip = np.asarray(proj).reshape(4, 4, order="F") @ np.asarray(view).reshape(4, 4, order="F") @ [*point, 1.0]
+    clip = camera.world_to_clip() @ [*point, 1.0]
     ndc = clip[:3] / clip[3]
     return (ndc[0] + 1) / 2 * camera.width, (1 - ndc[1]) / 2 * camera.height
 
@@ -74,13 +73,9 @@ class Recorder:
     captions: list[str] = field(default_factory=list)
 
     def shot(self, caption: str) -> None:
-        cam = self.camera
-        view, proj = cam.matrices()
-        _, _, rgb, _, seg = p.getCameraImage(cam.width, cam.height, view, proj, renderer=p.ER_TINY_RENDERER,
-                                             lightDirection=[1.0, 0.6, 2.0], shadow=1)
-        rgb = np.reshape(rgb, (cam.height, cam.width, 4))[:, :, :3].astype(np.uint8).copy()
-        seg = np.reshape(seg, (cam.height, cam.width))
-        objects = [*self.scene.objects, *([self.scene.holding] if self.scene.holding else [])]
+        rgb, _, seg = capture(self.camera, shaded=True)
+        rgb = rgb.copy()
+        objects = self.scene.present
         for obj in objects:
             if obj.label == self.target and obj.body >= 0:
                 rgb[_outline(seg == obj.body, OUTLINE)] = TARGET_COLOUR
@@ -93,7 +88,7 @@ class Recorder:
             top = ((low[0] + high[0]) / 2, (low[1] + high[1]) / 2, high[2])
             colour = TARGET_COLOUR if obj.label == self.target else HELD_COLOUR if obj.label == self.held \
                 else (235, 235, 235)
-            _label(draw, _project(top, cam), obj.label, colour)
+            _label(draw, _project(top, self.camera), obj.label, colour)
         self.pictures.append(image)
         self.captions.append(caption)
 

@@ -74,8 +74,13 @@ class Scene:
     bodies: dict[int, str] = field(default_factory=dict)  # the table objects' bodies -> labels
     table: int = -1
 
+    @property
+    def present(self) -> list[SceneObject]:
+        """Everything in the scene: the objects on the table and the one in the hand."""
+        return [*self.objects, *([self.holding] if self.holding else [])]
+
     def find(self, label: str) -> SceneObject:
-        for obj in [*self.objects, *([self.holding] if self.holding else [])]:
+        for obj in self.present:
             if obj.label == label:
                 return obj
         raise KeyError(f"no {label!r} on the table (there are: {', '.join(o.label for o in self.objects)})")

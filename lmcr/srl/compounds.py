@@ -47,6 +47,9 @@ create temp table _cmp_tokens as
 select list_filter(string_split_regex(lower(text), '[^a-z]+|([.,;])'), lambda x: x <> '') as w
 from sentences where kind in ('instruction', 'ingredient') and (? = 'all' or corpus = ?)
 """
+_UNIGRAMS = """
+create temp table _cmp_uni as select w1 as w, count(*) as n from (select unnest(w) as w1 from _cmp_tokens) group by 1
+"""
 _HEAD_RATES = """
 with tri as (
     select w[i - 1] as d, w[i] as x, w[i + 1] as f
@@ -64,27 +67,25 @@ counts as (
 select x, heads / determined as rate from counts where determined >= ?
 """
 _STRONG_BIGRAMS = """
-with uni as (select w1 as w, count(*) as n from (select unnest(w) as w1 from _cmp_tokens) group by 1),
-total as (select sum(n) as n from uni),
+with total as (select sum(n) as n from _cmp_uni),
 bi as (
     select w[i] as a, w[i + 1] as b, count(*) as n
     from (select w, unnest(range(1, len(w))) as i from _cmp_tokens)
     group by all having count(*) >= ?
 )
 select a || ' ' || b, ln(bi.n * total.n / (ua.n * ub.n)) / -ln(bi.n / total.n) as npmi, bi.n / ua.n as p_head
-from bi, total join uni ua on ua.w = a join uni ub on ub.w = b
+from bi, total join _cmp_uni ua on ua.w = a join _cmp_uni ub on ub.w = b
 where a not in ('.', ',', ';') and b not in ('.', ',', ';')
 """
 _PREDICATIVE = """
-with uni as (select w1 as w, count(*) as n from (select unnest(w) as w1 from _cmp_tokens) group by 1),
-after as (
+with after as (
     select w[i] as x, count(*) as n
     from (select w, unnest(range(2, len(w) + 1)) as i from _cmp_tokens)
     where w[i - 1] in ('until', 'is', 'are', 'be', 'very', 'too', 'so', 'become', 'becomes', 'remain', 'remains',
                        'stay', 'stays', 'still', 'get', 'gets', 'keep', 'slightly', 'quite', 'rather', 'fairly')
     group by x
 )
-select x from after join uni on uni.w = x where uni.n >= ? and after.n / uni.n >= ?
+select x from after join _cmp_uni uni on uni.w = x where uni.n >= ? and after.n / uni.n >= ?
 """
 
 
@@ -142,9 +143,11 @@ class Compounds:
 
 
 def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Compounds:
-    """Compute head rates and strong bigrams over the ingested sentences of a corpus setting."""
+    """Compute the statistics (head rates, strong bigrams, predicative and proper adjectives, singular
+    uses) over the ingested sentences of a corpus setting."""
     con.execute(_TOKENS, [corpus, corpus])
     try:
+        con.execute(_UNIGRAMS)
         rates = {w: round(r, 4) for w, r in con.execute(_HEAD_RATES, [MIN_DETERMINED]).fetchall()
                  if r >= HEAD_RATE_MIN}
         bigrams = frozenset(b for b, npmi, p_head in con.execute(_STRONG_BIGRAMS, [MIN_BIGRAM]).fetchall()
@@ -153,5 +156,6 @@ def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Comp
         singular = dict(con.execute(_SINGULAR_USES, [MIN_SINGULAR]).fetchall())
         proper = frozenset(w for (w,) in con.execute(_PROPER, [corpus, corpus, MIN_PROPER_USES, PROPER_MIN]).fetchall())
     finally:
+        con.execute("drop table if exists _cmp_uni")
         con.execute("drop table _cmp_tokens")
     return Compounds(rates, bigrams, predicative, proper, singular)

@@ -115,8 +115,10 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
     # meatballs": on the of-object) still belong to the verb.
     for obj in objects:
         head = resolve_head(obj, lex) or obj
-        preps += _attached_preps(obj, frozenset({"of"}) if head.i != obj.i else frozenset())
-        preps += _attached_preps(head, frozenset()) if head.i != obj.i else []
+        if head.i == obj.i:
+            preps += _attached_preps(obj, frozenset())
+        else:  # a measure's "of" leads to the head, whose own PPs count too
+            preps += _attached_preps(obj, frozenset({"of"})) + _attached_preps(head, frozenset())
     # A PP hung on the object of another PP ("for five minutes in the butter", "with a ladle over the
     # pasta", "on both sides in hot oil") belongs to the verb too; which one names a role is decided
     # by how usual its preposition is (`_known_frame`).
