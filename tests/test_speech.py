@@ -188,8 +188,12 @@ def test_the_reading_that_names_the_table_wins():
 
     parser = load_parser()
     heard = Transcript("a few in the chocolate", ["dip them in the bowl", "dip a few in the chocolate"], 0.1)
-    assert understood_reading(parser, heard) == "dip them in the bowl"  # no scene: the first with a predicate
     assert understood_reading(parser, heard, ["chocolate", "strawberry"]) == "dip a few in the chocolate"
+    assert understood_reading(parser, heard, ["bowl", "strawberry"]) == "dip them in the bowl"
+    # no scene: the first naming only objects the robot knows ("them" is none), else the first with a predicate
+    assert understood_reading(parser, heard) == "dip a few in the chocolate"
+    unknown = Transcript("a few in the gravy", ["dip them in the gravy", "dip a few in the gravy"], 0.1)
+    assert understood_reading(parser, unknown) == "dip them in the gravy"
     assert understood_reading(parser, Transcript("hello there", [], 0.5), ["cup"]) == "hello there"
 
 

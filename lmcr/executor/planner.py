@@ -12,15 +12,21 @@ from ompl import geometric as og
 from ompl import util as ou
 
 ou.setLogLevel(ou.LogLevel.LOG_NONE)  # OMPL's console chatter is no use to a CLI user
+# One seed before any planner exists: a process then plans the same paths for the same scenes in the
+# same order (a run, the bench) instead of new random ones each time.
+SEED = 1
+ou.RNG.setSeed(SEED)
 
 RESOLUTION = 0.04  # radians between checked states along a motion
-PLAN_SECONDS = 1.5  # RRT-Connect's budget for one segment
+# RRT-Connect's budget for one segment, in clearance checks (about 1.5 s on one core) rather than in
+# seconds: a time budget makes the found paths, and so the robot's motions, depend on the machine's load.
+PLAN_CHECKS = 6000
 
 
 def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
-               seconds: float = PLAN_SECONDS) -> list[np.ndarray] | None:
-    """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none in
-    `seconds`. `clash(q)` names what the configuration hits, None when it is clear."""
+               budget: int = PLAN_CHECKS) -> list[np.ndarray] | None:
+    """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none within
+    `budget` clearance checks. `clash(q)` names what the configuration hits, None when it is clear."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if segment_clash(clash, q0, q1) is None:
         return [q0, q1]
@@ -31,7 +37,14 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
         bounds.setHigh(k, float(hi))
     space.setBounds(bounds)
     si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda state: clash(np.array([state[k] for k in range(len(q0))])) is None)
+    checks = 0
+
+    def valid(state) -> bool:
+        nonlocal checks
+        checks += 1
+        return clash(np.array([state[k] for k in range(len(q0))])) is None
+
+    si.setStateValidityChecker(valid)
     si.setStateValidityCheckingResolution(RESOLUTION / space.getMaximumExtent())
     si.setup()
     start, goal = space.allocState(), space.allocState()
@@ -42,7 +55,7 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
     planner = og.RRTConnect(si)
     planner.setProblemDefinition(problem)
     planner.setup()
-    solved = planner.solve(seconds) and problem.hasExactSolution()
+    solved = planner.solve(ob.PlannerTerminationCondition(lambda: checks >= budget)) and problem.hasExactSolution()
     path = None
     if solved:
         geometric = problem.getSolutionPath()

@@ -2,8 +2,8 @@
 
 The recogniser's best text is not always the one the robot can act on ("a few in the chocolate" when
 an alternative is "dip a few in the chocolate"); among the best text and its n-best alternatives, the
-first whose robot frame names only objects on the table is taken when the scene is known, else the
-first that parses to a robot predicate. When close alternatives put a
+first whose robot frame names only objects on the table is taken (without a scene: only objects the
+robot knows), else the first that parses to a robot predicate. When close alternatives put a
 different predicate or object word in the same place, the robot asks instead of acting.
 """
 
@@ -19,14 +19,14 @@ from lmcr.srl.parser import FrameParser
 
 def understood_reading(parser: FrameParser, heard: Transcript, objects: list[str] | None = None) -> str:
     """The first of the best text and its n-best alternatives whose robot frame names only objects on the
-    table (`objects`, when the scene is known), else the first with a robot predicate, else the best."""
+    table (`objects`, when the scene is known; else objects the robot knows, the lexicon's), else the
+    first with a robot predicate, else the best."""
     readings = [(text, [f for f in parser.parse(text) if f.known]) for text in (heard.text, *heard.alternatives)]
-    if objects is not None:
-        on_table = set(objects)
-        for text, frames in readings:
-            stated = [v for v in frames[0].roles.values() if v] if frames else []
-            if stated and set(stated) <= on_table:
-                return text
+    on_table = set(parser.lex.objects if objects is None else objects)
+    for text, frames in readings:
+        stated = [v for v in frames[0].roles.values() if v] if frames else []
+        if stated and set(stated) <= on_table:
+            return text
     return next((text for text, frames in readings if frames), heard.text)
 
 
