@@ -6,8 +6,8 @@
 
 Frame accuracy: the first robot frame of a reading has the right predicate, every stated role right
 and the missing role empty (as `lmcr srl-eval --instructions`). `best`: the recogniser's best text;
-`listen`: the reading `lmcr listen` takes without a scene (the first of the n-best texts with a robot
-predicate); `frame`: the reading `lmcr execute --audio` takes with the scene's objects known (the first
+`listen`: the reading `lmcr listen` takes without a scene (the first of the n-best texts naming only
+objects the robot knows, else the first with a robot predicate); `frame`: the reading `lmcr execute --audio` takes with the scene's objects known (the first
 naming only objects on the table); `text`: the written instruction, the ceiling with this parser.
 Decoding runs on one core.
 """

@@ -232,6 +232,10 @@ def test_the_packaged_whisper_model_is_joined_once_and_checked(whisper_model, tm
     assert list(tmp_path.iterdir()) == []  # nothing half-joined is left
     with pytest.raises(SpeechModelError, match="not a CTranslate2 Whisper model"):
         whisper.WhisperRecognizer(tmp_path, None)
+    for name in whisper.MODEL_FILES:  # files of the right names, but not a model
+        (tmp_path / name).write_text("garbage")
+    with pytest.raises(SpeechModelError, match="cannot load the Whisper model"):
+        whisper.WhisperRecognizer(tmp_path, None)
 
 
 def test_whisper_hears_the_robot_words(whisper_model):

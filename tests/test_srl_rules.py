@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections import Counter
 
+import pytest
+
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import extract_frames
@@ -173,20 +175,19 @@ def test_proper_noun_tagged_modifiers_are_judged_by_the_corpus():
     assert frames(doc)[0][1]["Destination"] == "ice cube tray"
 
 
-def test_quantities_and_phrases_hung_on_other_phrases():
+@pytest.mark.parametrize("doc, expected", [
     # the quantity read as an adverbial noun phrase is still the object
-    doc = ("fry/VB/ROOT/0 a/DT/det/2 couple/NN/npadvmod/0 of/IN/prep/2 eggs/NNS/pobj/3/egg in/IN/prep/0 "
-           "the/DT/det/7 skillet/NN/pobj/5")
-    assert frames(doc) == [("fry", {"Theme": "egg", "Instrument": "skillet"})]
+    ("fry/VB/ROOT/0 a/DT/det/2 couple/NN/npadvmod/0 of/IN/prep/2 eggs/NNS/pobj/3/egg in/IN/prep/0 "
+     "the/DT/det/7 skillet/NN/pobj/5", ("fry", {"Theme": "egg", "Instrument": "skillet"})),
     # a destination hung on the of-object of a quantity
-    doc = ("pour/VB/ROOT/0 some/DT/dobj/0 of/IN/prep/1 the/DT/det/4 sauce/NN/pobj/2 over/IN/prep/4 "
-           "the/DT/det/7 meatballs/NNS/pobj/5/meatball")
-    assert frames(doc) == [("pour", {"Theme": "sauce", "Destination": "meatball"})]
+    ("pour/VB/ROOT/0 some/DT/dobj/0 of/IN/prep/1 the/DT/det/4 sauce/NN/pobj/2 over/IN/prep/4 "
+     "the/DT/det/7 meatballs/NNS/pobj/5/meatball", ("pour", {"Theme": "sauce", "Destination": "meatball"})),
     # a role phrase hung on the object of a time phrase
-    doc = ("fry/VB/ROOT/0 the/DT/det/2 onions/NNS/dobj/0/onion for/IN/prep/0 five/CD/nummod/5 "
-           "minutes/NNS/pobj/3/minute in/IN/prep/5 the/DT/det/8 butter/NN/pobj/6")
-    assert frames(doc) == [("fry", {"Theme": "onion", "Instrument": "butter"})]
+    ("fry/VB/ROOT/0 the/DT/det/2 onions/NNS/dobj/0/onion for/IN/prep/0 five/CD/nummod/5 "
+     "minutes/NNS/pobj/3/minute in/IN/prep/5 the/DT/det/8 butter/NN/pobj/6", ("fry", {"Theme": "onion", "Instrument": "butter"})),
     # two phrases for one role: the more usual preposition names it ("in" before "on" for fry)
-    doc = ("fry/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 on/IN/prep/0 both/DT/det/5 sides/NNS/pobj/3/side "
-           "in/IN/prep/5 hot/JJ/amod/8 oil/NN/pobj/6")
-    assert frames(doc) == [("fry", {"Theme": "fish", "Instrument": "oil"})]
+    ("fry/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 on/IN/prep/0 both/DT/det/5 sides/NNS/pobj/3/side "
+     "in/IN/prep/5 hot/JJ/amod/8 oil/NN/pobj/6", ("fry", {"Theme": "fish", "Instrument": "oil"})),
+])
+def test_quantities_and_phrases_hung_on_other_phrases(doc, expected):
+    assert frames(doc) == [expected]

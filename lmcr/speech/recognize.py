@@ -80,16 +80,16 @@ class Recognizer:
 
     def transcribe(self, samples: np.ndarray) -> Transcript:
         """Decode one utterance (int16, 16 kHz)."""
-        level = level_dbfs(samples)
-        if level < SILENCE_DBFS:
-            return Transcript("", reason=f"no speech: the audio is silent ({level:.0f} dBFS)")
+        silent = silence(samples)
+        if silent is not None:
+            return silent
         d = self.decoder
         d.start_utt()
         d.process_raw(samples.tobytes(), full_utt=True)
         d.end_utt()
         hyp = d.hyp()
         if hyp is None or not hyp.hypstr.strip():
-            return Transcript("", reason=f"no words recognised ({level:.0f} dBFS)")
+            return no_words(samples)
         best_score = None
         alternatives, close = [], []
         for _, alt in zip(range(NBEST), d.nbest()):
@@ -103,6 +103,16 @@ class Recognizer:
                     close.append(text)
         return Transcript(hyp.hypstr, alternatives, float(hyp.prob), doubts=doubts(hyp.hypstr, close, self.key_words))
 
+
+def silence(samples: np.ndarray) -> Transcript | None:
+    """The empty transcript, with its reason, of audio too quiet to hold speech; None otherwise."""
+    level = level_dbfs(samples)
+    return Transcript("", reason=f"no speech: the audio is silent ({level:.0f} dBFS)") if level < SILENCE_DBFS else None
+
+
+def no_words(samples: np.ndarray) -> Transcript:
+    """The empty transcript, with its reason, of audio in which the recogniser heard no words."""
+    return Transcript("", reason=f"no words recognised ({level_dbfs(samples):.0f} dBFS)")
 
 
 def doubts(best: str, close: list[str], key_words: set[str]) -> list[list[str]]:

@@ -24,9 +24,9 @@ import numpy as np
 
 from lmcr.files import atomic_dir, file_sha256
 from lmcr.lexicon import Lexicon
-from lmcr.speech.audio import RATE, SILENCE_DBFS, level_dbfs
+from lmcr.speech.audio import RATE
 from lmcr.speech.domain_lm import lexicon_words, request_forms
-from lmcr.speech.recognize import SpeechModelError, Transcript, doubts
+from lmcr.speech.recognize import SpeechModelError, Transcript, doubts, no_words, silence
 
 MODEL_FILES = ("model.bin", "config.json", "tokenizer.json", "vocabulary.txt")
 # The registry packages that carry Whisper base (converted to CTranslate2 by the faster-whisper project),
@@ -98,7 +98,10 @@ class WhisperRecognizer:
         from faster_whisper.tokenizer import Tokenizer
 
         self._storage, self._pad = ctranslate2.StorageView, pad_or_trim
-        self.model = ctranslate2.models.Whisper(str(model), device="cpu", compute_type="int8", intra_threads=threads)
+        try:
+            self.model = ctranslate2.models.Whisper(str(model), device="cpu", compute_type="int8", intra_threads=threads)
+        except (RuntimeError, ValueError) as exc:  # a damaged or foreign model.bin
+            raise SpeechModelError(f"{model}: cannot load the Whisper model ({exc})") from exc
         self.tokenizer = Tokenizer(tokenizers.Tokenizer.from_file(str(Path(model) / "tokenizer.json")),
                                    self.model.is_multilingual, task="transcribe", language="en")
         self.features = FeatureExtractor(feature_size=self.model.n_mels)
@@ -114,22 +117,22 @@ class WhisperRecognizer:
 
     def transcribe(self, samples: np.ndarray) -> Transcript:
         """Decode one utterance (int16, 16 kHz); longer than 30 s, window by window."""
-        level = level_dbfs(samples)
-        if level < SILENCE_DBFS:
-            return Transcript("", reason=f"no speech: the audio is silent ({level:.0f} dBFS)")
+        silent = silence(samples)
+        if silent is not None:
+            return silent
         step = WINDOW_S * RATE
         windows = [self._hypotheses(samples[i:i + step]) for i in range(0, len(samples), step)]
         if len(windows) > 1:  # a long recording: the best text of each window, no alternatives
             text = " ".join(w[0][0] for w in windows if w and w[0][0])
-            return Transcript(text) if text else Transcript("", reason=f"no words recognised ({level:.0f} dBFS)")
+            return Transcript(text) if text else no_words(samples)
         hyps = windows[0]
         if not hyps or not hyps[0][0]:
-            return Transcript("", reason=f"no words recognised ({level:.0f} dBFS)")
+            return no_words(samples)
         logp = np.array([lp for _, lp in hyps])
-        posterior = np.exp(logp - logp.max()) / np.exp(logp - logp.max()).sum()
+        weights = np.exp(logp - logp[0])  # relative to the best (hypotheses come best first)
         best = hyps[0][0]
         close = [text for text, lp in hyps[1:] if logp[0] - lp <= CLOSE_LOG_PROB]
-        return Transcript(best, [text for text, _ in hyps[1:]], float(posterior[0]),
+        return Transcript(best, [text for text, _ in hyps[1:]], float(1.0 / weights.sum()),
                           doubts=doubts(best, close, self.key_words))
 
     def _hypotheses(self, samples: np.ndarray) -> list[tuple[str, float]]:
