@@ -12,7 +12,7 @@ from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
-from lmcr.lm.score import CONTEXT_TOP, LMScorer
+from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer
 from lmcr.lm.train import TrainConfig, pick_precision, train_lm
 from lmcr.lm.vocab import Vocab
 
@@ -144,6 +144,20 @@ def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, t
     dropped = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}, articles=False))
     assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == ["pour", "milk", "into", "cup"]
     assert LMScorer(dropped).score_frames([frame]) == kept.score(["pour water into cup"])
+
+
+def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, tmp_path):
+    model, vocab, _ = overfit
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    scorer.vocab = Vocab(vocab.words, unk_types=50)  # "kettle" is unknown: its <unk> share is charged too
+    # A frame whose text is inside another's ("pour water into the cup" / "... cup lid"), one that shares
+    # no more than the predicate, and a context with an unknown word.
+    frames = [("pour", {"Theme": "water", "Destination": "cup"}), ("pour", {"Theme": "water", "Destination": "cup lid"}),
+              ("pour", {"Theme": "milk", "Destination": "glass"})]
+    texts = ["pour water into the cup", "pour water into the cup lid", "pour milk into the glass"]
+    for norm in NORMS:
+        whole = scorer.score([f"{t} for the kettle" for t in texts], norm)
+        assert scorer.score_frames(frames, context="for the kettle", norm=norm) == pytest.approx(whole, abs=1e-4)
 
 
 def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monkeypatch):

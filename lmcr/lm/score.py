@@ -3,8 +3,8 @@
 Candidate frames share most of their text ("pour water into the cup", "... the mug", ...). The texts
 are put in a token trie. The prefix they all share goes through the LSTM as one sequence; below it
 the trie is evaluated level by level: one batched LSTM step per depth for every node that has
-children, one softmax per such node, and each text's score is the sum of its edges' log-
-probabilities. Cost grows with the number of distinct prefixes, not with the number of texts.
+children, then one decoder pass whose softmax rows are those nodes; each text's score is the sum of its
+edges' log-probabilities. Cost grows with the number of distinct prefixes, not with the number of texts.
 
 Normalisation (`norm`): "sum" is the total log-probability (the default), "mean" divides by the number
 of scored tokens. Chosen by measurement on the dev ratings (`bench/bench_lm.py --ratings`): with the
@@ -32,6 +32,7 @@ NORMS = ("sum", "mean")
 # Frames whose score reads the instruction's context (`LMScorer.score_frames`). A dev scene holds 5-7
 # objects, so there every frame reads it; the cap bounds the cost in large scenes (40 objects: the bench).
 CONTEXT_TOP = 10
+DECODER_BLOCK = 4096  # rows per decoder call: 4096 x 14k-word vocabulary = 235 MB of logits at most
 
 
 @contextmanager
@@ -99,7 +100,7 @@ class LMScorer:
     def score(self, texts: list[str], norm: str = "sum") -> list[float]:
         if norm not in NORMS:
             raise ValueError(f"norm must be one of {NORMS}")
-        return [total / max(n, 1) if norm == "mean" else total for total, n in self.logprobs(texts)]
+        return [_normed(total, n, norm) for total, n in self.logprobs(texts)]
 
     def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum") -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
@@ -107,15 +108,24 @@ class LMScorer:
         adds log P(context | frame), how well the frame serves what was said around it.
 
         The context is read after the CONTEXT_TOP frames this model scores best, the others get the
-        lowest context term of those: past the shared frame prefix every candidate's context costs a
-        softmax over the vocabulary per word, and a frame this far down is not what was meant."""
+        lowest context term of those: every candidate's context costs a softmax over the vocabulary
+        per word, and a frame this far down is not what was meant. The context continues the LSTM from
+        where each frame's text ended (`_Walk`), so the frames are not read twice."""
+        if norm not in NORMS:
+            raise ValueError(f"norm must be one of {NORMS}")
         texts = [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
-        scores = self.score(texts, norm)
-        if not context.strip() or not frames:
+        seqs = [self.encode(t) for t in texts]
+        read = context.strip() and frames
+        with _native_lstm():
+            walk = self._walk(seqs, keep_states=bool(read))
+        totals = [(walk.totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
+        scores = [_normed(total, n, norm) for total, n in totals]
+        ctx = self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1] if read else []
+        if not ctx:
             return scores
         top = sorted(range(len(texts)), key=lambda i: -scores[i])[:CONTEXT_TOP]
-        with_context = self.score([f"{texts[i]} {context}" for i in top], norm)
-        gains = {i: after - scores[i] for i, after in zip(top, with_context)}
+        extra = self._continue(walk, [walk.trie.leaf_of[i] for i in top], ctx)  # oneDNN: one call, many rows
+        gains = {i: _normed(totals[i][0] + x, totals[i][1] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)}
         floor = min(gains.values())
         return [s + gains.get(i, floor) for i, s in enumerate(scores)]
 
@@ -126,42 +136,95 @@ class LMScorer:
         # oneDNN's LSTM builds a primitive per call: ~0.3 ms for these one-step, few-row calls against
         # ~0.1 ms for the native kernel (same numbers to 1e-5), and scoring is nothing but such calls.
         with _native_lstm():
-            edge, trie = self._edges(seqs)
-        # An unknown word gets its share of <unk>'s pooled probability, not all of it.
-        unk, share = self.vocab.words.index(UNK), math.log(self.vocab.unk_types)
-        edge[torch.tensor(trie.token) == unk] -= share
-        total = edge.tolist()
-        for node in range(1, len(total)):  # parents precede children: cumulative sums in one pass
-            total[node] += total[trie.parent[node]]
-        return [total[leaf] for leaf in trie.leaf_of]
+            return self._walk(seqs).totals
 
-    def _edges(self, seqs: list[list[int]]) -> tuple[torch.Tensor, _Trie]:
-        """Log-probability of each trie edge (indexed by its child node), and the trie."""
+    def _edge_logprobs(self, rows: torch.Tensor, picks: torch.Tensor, tokens_: torch.Tensor) -> torch.Tensor:
+        """log P(tokens_[j] | rows[picks[j]]) for each j, an unknown word charged its share of <unk>. The
+        decoder's softmax runs once over all rows, a block at a time (one read of its weights per block,
+        bounded memory), instead of once per trie level."""
+        edge = torch.empty(len(picks))
+        for start in range(0, len(rows), DECODER_BLOCK):
+            logp = F.log_softmax(self.model.decoder(rows[start:start + DECODER_BLOCK]), dim=-1)
+            mine = (picks >= start) & (picks < start + DECODER_BLOCK)
+            edge[mine] = logp[picks[mine] - start, tokens_[mine]]
+        unk = self.vocab.words.index(UNK)
+        return edge - (tokens_ == unk) * math.log(self.vocab.unk_types)
+
+    @torch.no_grad()
+    def _walk(self, seqs: list[list[int]], keep_states: bool = False) -> _Walk:
+        """Every text's total log-probability, through the trie of the texts.
+
+        The prefix all texts share ("<s> pour water into the") goes through the LSTM as one sequence;
+        below it one batched LSTM step per depth for the nodes that have children. Each node with
+        children contributes its output as a row of the decoder's input; `keep_states` keeps the LSTM
+        state of each (for `_continue`)."""
         trie = _Trie.build(seqs)
         model = self.model
-        edge = torch.zeros(len(trie.parent))
         levels: dict[int, list[int]] = {}
         for node, depth in enumerate(trie.depth):
             levels.setdefault(depth, []).append(node)
-        # The prefix all texts share ("<s> pour water into the") is nodes 0..L-1 (the first text made
-        # them in order): one LSTM call and one decoder call over it, not one of each per token.
-        shared = min(len(s) for s in seqs)
-        shared = next((i for i in range(1, shared) if any(s[i] != seqs[0][i] for s in seqs)), shared)
+        # The shared prefix is nodes 0..L-1 (the first text made them in order); it stops a token short
+        # of the shortest text, so that every text's last node has a parent with a kept state.
+        shortest = min(len(s) for s in seqs)
+        shared = next((i for i in range(1, shortest) if any(s[i] != seqs[0][i] for s in seqs)), shortest)
+        shared = max(1, min(shared, shortest - 1))
         out, state = model.rnn(model.embed(torch.tensor([seqs[0][:shared]])))  # (1, L, E)
-        if shared > 1:
-            logp = F.log_softmax(model.decoder(out[0, :-1]), dim=-1)  # (L-1, V)
-            edge[1:shared] = logp[torch.arange(shared - 1), torch.tensor(seqs[0][1:shared])]
-        frontier_out, frontier_pos = out[:, -1], {shared - 1: 0}
+        rows, row_of = [out[0]], {n: n for n in range(shared)}
+        walk = _Walk(trie, [], {}, [])
+        if keep_states:
+            walk.states.append(state)
+            walk.state_of[shared - 1] = (0, 0)
+        frontier, frontier_pos = state, {shared - 1: 0}
         for depth in range(shared, max(levels) + 1):
-            nodes = levels[depth]
-            parents = [frontier_pos[trie.parent[n]] for n in nodes]
-            logp = F.log_softmax(model.decoder(frontier_out), dim=-1)  # (P, V) for the frontier nodes
-            edge[nodes] = logp[parents, [trie.token[n] for n in nodes]]
-            grow = [n for n in nodes if trie.has_children[n]]
+            grow = [n for n in levels[depth] if trie.has_children[n]]
             if not grow:
                 break
             pick = torch.tensor([frontier_pos[trie.parent[n]] for n in grow])
             x = model.embed(torch.tensor([trie.token[n] for n in grow])).unsqueeze(1)  # (G, 1, E)
-            out, state = model.rnn(x, (state[0][:, pick], state[1][:, pick]))
-            frontier_out, frontier_pos = out[:, 0], {n: i for i, n in enumerate(grow)}
-        return edge, trie
+            out, frontier = model.rnn(x, (frontier[0][:, pick], frontier[1][:, pick]))
+            frontier_pos = {n: i for i, n in enumerate(grow)}
+            offset = sum(len(r) for r in rows)
+            rows.append(out[:, 0])
+            row_of.update((n, offset + i) for i, n in enumerate(grow))
+            if keep_states:
+                walk.states.append(frontier)
+                walk.state_of.update((n, (len(walk.states) - 1, i)) for i, n in enumerate(grow))
+        children = list(range(1, len(trie.parent)))
+        edge = torch.zeros(len(trie.parent))
+        if children:
+            edge[1:] = self._edge_logprobs(torch.cat(rows), torch.tensor([row_of[trie.parent[n]] for n in children]),
+                                           torch.tensor([trie.token[n] for n in children]))
+        total = edge.tolist()
+        for node in range(1, len(total)):  # parents precede children: cumulative sums in one pass
+            total[node] += total[trie.parent[node]]
+        walk.totals = [total[leaf] for leaf in trie.leaf_of]
+        return walk
+
+    @torch.no_grad()
+    def _continue(self, walk: _Walk, leaves: list[int], ctx: list[int]) -> list[float]:
+        """log P(ctx | the text ending at each leaf): each leaf's token and the context read on from its
+        parent's kept state, all leaves in one LSTM call and one decoder pass."""
+        model, trie = self.model, walk.trie
+        places = [walk.state_of[trie.parent[leaf]] for leaf in leaves]
+        h = torch.cat([walk.states[level][0][:, [pos]] for level, pos in places], dim=1)
+        c = torch.cat([walk.states[level][1][:, [pos]] for level, pos in places], dim=1)
+        x = model.embed(torch.tensor([[trie.token[leaf], *ctx[:-1]] for leaf in leaves]))  # (N, k, E)
+        out, _ = model.rnn(x, (h, c))
+        k = len(ctx)
+        rows = out.reshape(len(leaves) * k, -1)
+        edge = self._edge_logprobs(rows, torch.arange(len(rows)), torch.tensor(ctx * len(leaves)))
+        return edge.reshape(len(leaves), k).sum(-1).tolist()
+
+
+def _normed(total: float, n: int, norm: str) -> float:
+    return total / max(n, 1) if norm == "mean" else total
+
+
+@dataclass
+class _Walk:
+    """A pass over a trie of texts: each text's total, and the LSTM states kept for continuing it."""
+
+    trie: _Trie
+    totals: list[float]
+    state_of: dict[int, tuple[int, int]]  # node -> (index into states, position in that batch)
+    states: list[tuple[torch.Tensor, torch.Tensor]]

@@ -157,11 +157,19 @@ class FrameParser:
         if batch:
             yield from self._batch(batch)
 
-    def _batch(self, texts: list[str]) -> list[list[FrameMention]]:
+    def parse_with_doc(self, text: str) -> tuple[list[FrameMention], Doc]:
+        """The frames of one text and its Doc as the frames were read from it (mended, lemmas filled):
+        for what else the text says, without a second spaCy pass where the parse had one of the text."""
+        docs: dict[int, Doc] = {}
+        frames = self._batch([text], docs)[0]
+        return frames, docs[0] if 0 in docs else next(self._parse([text]))
+
+    def _batch(self, texts: list[str], docs: dict[int, Doc] | None = None) -> list[list[FrameMention]]:
+        """Frames of each text; `docs` (when given) receives each text's own Doc where one was parsed."""
         frames: list[list[FrameMention]] = [[] for _ in texts]
         segments = [_Segment(i, 0, text) for i, text in enumerate(texts)]
         while segments:
-            segments = self._round(segments, frames)
+            segments = self._round(segments, frames, docs)
         for i, found in enumerate(frames):
             found.sort(key=lambda f: f.start)
             if self.priors is not None:
@@ -182,12 +190,13 @@ class FrameParser:
             r, v, n = self.first_words.get(first.lower_, (0, 0, 0))
             self.first_words[first.lower_] = (r + repaired, v + (repaired or first.tag_.startswith("VB")), n + 1)
 
-    def _round(self, segments: list[_Segment], frames: list[list[FrameMention]]) -> list[_Segment]:
+    def _round(self, segments: list[_Segment], frames: list[list[FrameMention]],
+               docs: dict[int, Doc] | None = None) -> list[_Segment]:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
         direct = [seg for seg in segments if self._direct(seg)]
         plain = [seg for seg in segments if not self._direct(seg)]
         parses, requests = self._parse_direct(direct, plain)  # appends the misjudged ones to `plain`
-        more_parses, more_requests = self._parse_plain(plain)
+        more_parses, more_requests = self._parse_plain(plain, docs)
         self._count_texts(segments)
         self.stats.reparsed += len(requests) + len(more_requests)
         parses += more_parses + self._reparse_requests(requests + more_requests)
@@ -212,10 +221,12 @@ class FrameParser:
                     (requests if needs_reparse(sent) else parses).append(_Piece(seg, sent, base))
         return parses, requests
 
-    def _parse_plain(self, plain: list[_Segment]) -> tuple[list[_Piece], list[_Piece]]:
+    def _parse_plain(self, plain: list[_Segment], docs: dict[int, Doc] | None = None) -> tuple[list[_Piece], list[_Piece]]:
         """Segments parsed as they are: (parses, sentences that look like misread commands)."""
         parses, requests = [], []
         for seg, doc in zip(plain, self._parse(s.text for s in plain)):
+            if docs is not None and seg.depth == 0:
+                docs[seg.text_id] = doc
             for k, sent in enumerate(doc.sents):
                 if self.repair and needs_reparse(sent):
                     requests.append(_Piece(seg, sent, seg.offset))
@@ -290,7 +301,17 @@ def load_parser(model: str | None = None, resources: Path | None = None) -> Fram
 def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
     """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
     parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
-    known = [f for f in parser.parse(check_text(text, "instruction")) if f.known]
+    return _first_known(parser, text, parser.parse(check_text(text, "instruction")))
+
+
+def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]:
+    """`parse_instruction`'s frame and the instruction's Doc (for the rest of what it says)."""
+    frames, doc = parser.parse_with_doc(check_text(text, "instruction"))
+    return _first_known(parser, text, frames), doc
+
+
+def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
+    known = [f for f in frames if f.known]
     if not known:
         verbs = ", ".join(sorted(parser.lex.predicates))
         raise NoPredicateError(f"no known predicate in {text!r}: the robot can {verbs}")
