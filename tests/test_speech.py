@@ -256,6 +256,17 @@ def test_whisper_hears_the_robot_words(whisper_model):
     assert silent.text == "" and "silent" in silent.reason
 
 
+def test_a_recording_longer_than_a_window_is_heard_window_by_window(whisper_model):
+    from lmcr.lexicon import load_lexicon
+    from lmcr.speech.audio import RATE
+    from lmcr.speech.whisper import WINDOW_S, WhisperRecognizer
+
+    pour, fry = read_wav(FIXTURES / "pour_me_some_water.wav"), read_wav(FIXTURES / "fry_the_egg.wav")
+    gap = np.zeros(WINDOW_S * RATE - len(pour), dtype=np.int16)  # the fry command starts the second window
+    heard = WhisperRecognizer(whisper_model, load_lexicon()).transcribe(np.concatenate([pour, gap, fry]))
+    assert heard.text.startswith("pour me some water") and heard.text.endswith("egg") and not heard.alternatives
+
+
 def test_whisper_text_is_written_as_spoken_words():
     from lmcr.speech.whisper import spoken_words
 
