@@ -158,6 +158,7 @@ def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, 
     for norm in NORMS:
         whole = scorer.score([f"{t} for the kettle" for t in texts], norm)
         assert scorer.score_frames(frames, context="for the kettle", norm=norm) == pytest.approx(whole, abs=1e-4)
+    assert scorer.score_frames([], context="for the kettle") == []
 
 
 def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monkeypatch):

@@ -113,16 +113,17 @@ class LMScorer:
         where each frame's text ended (`_Walk`), so the frames are not read twice."""
         if norm not in NORMS:
             raise ValueError(f"norm must be one of {NORMS}")
+        if not frames:
+            return []
         texts = [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
+        ctx = self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1]
+        if not ctx:
+            return self.score(texts, norm)  # in chunks: a whole evaluation's frames may come at once
         seqs = [self.encode(t) for t in texts]
-        read = context.strip() and frames
         with _native_lstm():
-            walk = self._walk(seqs, keep_states=bool(read))
+            walk = self._walk(seqs, keep_states=True)
         totals = [(walk.totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
         scores = [_normed(total, n, norm) for total, n in totals]
-        ctx = self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1] if read else []
-        if not ctx:
-            return scores
         top = sorted(range(len(texts)), key=lambda i: -scores[i])[:CONTEXT_TOP]
         extra = self._continue(walk, [walk.trie.leaf_of[i] for i in top], ctx)  # oneDNN: one call, many rows
         gains = {i: _normed(totals[i][0] + x, totals[i][1] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)}
