@@ -21,7 +21,7 @@ from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.context import utterance_context
-from lmcr.srl.parser import FrameParser, read_instruction
+from lmcr.srl.parser import FrameParser, parse_instruction, read_instruction
 
 
 class CompletionError(LMCRError, ValueError):
@@ -97,8 +97,11 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
              config: CompletionConfig = CompletionConfig()) -> dict:
     """The completion of one instruction in the CLI contract's output format (without the id); the
     scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so."""
-    frame, doc = read_instruction(parser, instruction)
-    context = utterance_context(doc, frame) if config.context else ""
+    if config.context:  # the Doc only when it is read: the parser may have to make one
+        frame, doc = read_instruction(parser, instruction)
+        context = utterance_context(doc, frame)
+    else:
+        frame, context = parse_instruction(parser, instruction), ""
     pool = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
     # A detection the robot has no vocabulary for is never chosen: nothing learned says what it is.
     ignored = [o for o in pool if parser.lex.objects and o not in parser.lex.objects]

@@ -184,7 +184,7 @@ class LMScorer:
             x = model.embed(torch.tensor([trie.token[n] for n in grow])).unsqueeze(1)  # (G, 1, E)
             out, frontier = model.rnn(x, (frontier[0][:, pick], frontier[1][:, pick]))
             frontier_pos = {n: i for i, n in enumerate(grow)}
-            offset = sum(len(r) for r in rows)
+            offset = len(row_of)  # one row per node mapped so far
             rows.append(out[:, 0])
             row_of.update((n, offset + i) for i, n in enumerate(grow))
             if keep_states:

@@ -49,7 +49,6 @@ WINDOW_S = 20
 # An alternative whose total log probability is within this (natural log) of the best one counts as
 # close: at least e^-1 = 0.37 times as likely. Set a priori, not tuned on the bench.
 CLOSE_LOG_PROB = 1.0
-FRAMES_PER_S = 100  # mel frames a second (10 ms hops)
 SPOKEN_WORD = re.compile(r"[a-z0-9]+(?:'[a-z]+)?")
 
 
@@ -111,6 +110,7 @@ class WhisperRecognizer:
         self.tokenizer = Tokenizer(tokenizers.Tokenizer.from_file(str(Path(model) / "tokenizer.json")),
                                    self.model.is_multilingual, task="transcribe", language="en")
         self.features = FeatureExtractor(feature_size=self.model.n_mels)
+        self.window_frames = WINDOW_S * RATE // self.features.hop_length  # mel frames the encoder reads
         tok = self.tokenizer
         previous: list[int] = []
         for part in prompt_parts(lexicon):  # the word lists first; requests while they fit
@@ -143,7 +143,7 @@ class WhisperRecognizer:
 
     def _hypotheses(self, samples: np.ndarray) -> list[tuple[str, float]]:
         """The beam's distinct texts with their total log probabilities, best first."""
-        mel = self._pad(self.features(samples.astype(np.float32) / 32768.0)[:, :-1], WINDOW_S * FRAMES_PER_S)
+        mel = self._pad(self.features(samples.astype(np.float32) / 32768.0)[:, :-1], self.window_frames)
         result = self.model.generate(self._storage.from_array(np.ascontiguousarray(mel[None])), [self.prompt],
                                      beam_size=BEAM, num_hypotheses=BEAM, return_scores=True)[0]
         eot = self.tokenizer.eot
