@@ -70,12 +70,15 @@ class Planner:
                 if holding:
                     _put_in_hand(arm, held)
                 g = Geometry.measure(held, target)
+                start = _save(held)
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
                 for variant in _variants(held, task, holding, arm.opening):
                     grasp = (variant.yaw, variant.pitch, variant.side)
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
+                    # the last attempt's checks left the held object in its hand: it stands where it started
+                    _restore(held, start)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
                     steps = task.program(g, variant, holding)
                     result = self._plan_variant(arm, clearance, steps, held, target, carried)

@@ -96,7 +96,7 @@ def solid_shape(label: str) -> tuple:
 
 
 def footprint(label: str) -> float:
-    """Radius of the circle an object covers on the table."""
+    """Half the object's widest side on the table (its radius when it is round)."""
     if label in CONTAINERS:
         w, d, _ = CONTAINERS[label]
         return max(w, d) / 2
@@ -112,9 +112,34 @@ def height(label: str) -> float:
     return 2 * shape[1] if shape[0] == "sphere" else shape[-1]  # cylinder height, box z size
 
 
+def outline(label: str) -> tuple[float, float, bool]:
+    """The object's outline on the table: half extents along x and y, and whether it is round (then
+    both are its radius); boxes and containers stand square to the table's edges."""
+    if label in CONTAINERS:
+        w, d, _ = CONTAINERS[label]
+        return w / 2, d / 2, False
+    shape = solid_shape(label)
+    if shape[0] in ("sphere", "cyl"):
+        return shape[1], shape[1], True
+    return shape[1] / 2, shape[2] / 2, False
+
+
+def gap_between(a: str, axy, b: str, bxy) -> float:
+    """The shortest distance between two objects' outlines on the table (0 when they overlap)."""
+    (ax, ay, a_round), (bx, by, b_round) = outline(a), outline(b)
+    dx, dy = abs(axy[0] - bxy[0]), abs(axy[1] - bxy[1])
+    if a_round and b_round:
+        return max(0.0, math.hypot(dx, dy) - ax - bx)
+    # a round one is its centre grown by its radius: measure from the box (grown by the other box's
+    # half extents) and take the radius off
+    radius = ax if a_round else bx if b_round else 0.0
+    hx = (0 if a_round else ax) + (0 if b_round else bx)
+    hy = (0 if a_round else ay) + (0 if b_round else by)
+    return max(0.0, math.hypot(max(0.0, dx - hx), max(0.0, dy - hy)) - radius)
+
+
 def _overlap(a: str, axy, b: str, bxy) -> bool:
-    gap = ((axy[0] - bxy[0]) ** 2 + (axy[1] - bxy[1]) ** 2) ** 0.5
-    return gap < footprint(a) + footprint(b) + 0.02
+    return gap_between(a, axy, b, bxy) < 0.02
 
 
 def load_scene(path: Path) -> Scene:

@@ -38,7 +38,9 @@ class Step:
     name: str = ""
     positions: tuple = ()
     orientation: tuple = DOWN
-    touches: str = ""  # "held" | "target": what this motion may come close to (the rest is kept clear)
+    # what this motion may come close to (the rest is kept clear): "held" | "target" (may touch it), or
+    # "neighbours" (a lift from among the objects it stood between: nothing touched, but no room to spare)
+    touches: str = ""
     probe: str = ""  # a name to record the held object's pose under once the pose is reached
     particles: int = 0
 
@@ -165,8 +167,9 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
     return side + top
 
 
-def above(xy, name: str, orientation=DOWN) -> Step:
-    return Step("move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation)
+def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:
+    return Step("move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation,
+                touches)
 
 
 def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "") -> Step:
@@ -183,9 +186,9 @@ def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     if v.side:
         back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
         return [move(f"next to {label}", pos - back, orn), move(f"grip {label}", pos, orn, touches="held"),
-                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn)]
+                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn, touches="neighbours")]
     return [above(pos, f"above {label}", orn), move(f"grip {label}", pos, orn, touches="held"),
-            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn)]
+            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn, touches="neighbours")]
 
 
 def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
