@@ -38,3 +38,12 @@ def test_an_impossible_motion_stops_at_its_budget_of_checks():
     assert joint_path(closed, q0, q1, LIMITS, budget=800) is None
     straight = int(np.ceil(2.0 / RESOLUTION))  # the straight segment is tried first
     assert len(checks) <= straight + 800 + 200  # the planner notices the budget between its iterations
+
+
+def test_without_a_budget_only_the_straight_motion_is_taken():
+    """What a motion that may touch its object gets: the straight segment when clear, else nothing
+    (a detour planned with that object ignored could sweep through it)."""
+    q0, q1 = np.zeros(7) + [-1, 0, 0, 0, 0, 0, 0], np.zeros(7) + [1, 0, 0, 0, 0, 0, 0]
+    assert joint_path(_wall, q0, q1, LIMITS, budget=0) is None
+    over = np.zeros(7) + [0, 1.5, 0, 0, 0, 0, 0]
+    assert [list(q) for q in joint_path(_wall, q0 + over, q1 + over, LIMITS, budget=0)] == [list(q0 + over), list(q1 + over)]

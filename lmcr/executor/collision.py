@@ -10,8 +10,8 @@ import pybullet as p
 
 from lmcr.executor.arm import Arm
 
-CLEARANCE = 0.01  # metres kept from obstacles while moving freely
-CONTACT_CLEARANCE = 0.003  # ... and on the last centimetres to a grasp or into the target
+CLEARANCE = 0.01  # metres kept from obstacles (the joints track a path only to a few millimetres)
+CONTACT_CLEARANCE = 0.003  # ... but from the table while grasping, lifting or lowering into the target
 
 
 @dataclass(frozen=True)
@@ -53,9 +53,10 @@ class Clearance:
         return pairs
 
     def clash(self, q, carried: Carried | None = None, ignore: frozenset[int] = frozenset(),
-              margin: float = CLEARANCE) -> str | None:
+              margin: float = CLEARANCE, tight: frozenset[int] = frozenset()) -> str | None:
         """What the arm at `q` is within `margin` of (None: clear). `ignore`: bodies allowed to touch
-        (the object about to be grasped, the target the motion goes into)."""
+        (the object about to be grasped, the target the motion goes into); `tight`: bodies it may come
+        within CONTACT_CLEARANCE of (the table under a grasp)."""
         arm = self.arm
         arm.set_config(q)
         if carried is not None:
@@ -63,9 +64,10 @@ class Clearance:
         for body, name in self.obstacles.items():
             if body in ignore or (carried is not None and body == carried.body):
                 continue
-            if p.getClosestPoints(arm.robot, body, margin):
+            gap = CONTACT_CLEARANCE if body in tight else margin
+            if p.getClosestPoints(arm.robot, body, gap):
                 return name
-            if carried is not None and p.getClosestPoints(carried.body, body, margin):
+            if carried is not None and p.getClosestPoints(carried.body, body, gap):
                 return name
         for a, b in self.self_pairs:
             if p.getClosestPoints(arm.robot, arm.robot, 0.0, linkIndexA=a, linkIndexB=b):

@@ -12,8 +12,8 @@ import numpy as np
 import pybullet as p
 
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
-from lmcr.executor.collision import CLEARANCE, CONTACT_CLEARANCE, Carried, Clearance
-from lmcr.executor.planner import joint_path, segment_clash
+from lmcr.executor.collision import CLEARANCE, Carried, Clearance
+from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.executor.scene import Scene, SceneObject
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, variants
 
@@ -74,7 +74,7 @@ class Planner:
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
                 for variant in _variants(held, task, holding, arm.opening):
-                    grasp = (variant.yaw, variant.pitch, variant.side)
+                    grasp = (variant.yaw, variant.pitch, variant.side, variant.shift)
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
                     # the last attempt's checks left the held object in its hand: it stands where it started
@@ -108,12 +108,14 @@ class Planner:
             if step.kind != "move":
                 segments.append(Segment(step))
                 continue
+            # a motion that touches the held object or the target may pass close over the table; the
+            # other objects it keeps CLEARANCE from, as every motion does
             ignore = {"held": {held.body}, "target": {target.body}}.get(step.touches, set())
             ignore = frozenset(ignore | ({held.body} if released else set()))
-            margin = CONTACT_CLEARANCE if step.touches else CLEARANCE
+            tight = frozenset({self.table} if step.touches else ())
 
-            def clash(x, carried=carried, ignore=ignore, margin=margin):
-                return clearance.clash(x, carried, ignore, margin)
+            def clash(x, carried=carried, ignore=ignore, tight=tight):
+                return clearance.clash(x, carried, ignore, CLEARANCE, tight)
 
             found, why = None, ""
             for position in step.positions:
@@ -125,7 +127,10 @@ class Planner:
                 if hit:
                     why = f"'{step.name}' would put the {arm.side} arm against {hit}"
                     continue
-                path = joint_path(clash, q, goal, arm.limits)
+                # a motion that may touch what it reaches for goes there straight: a detour found with the
+                # object ignored could sweep through it
+                straight = step.touches in ("held", "target")
+                path = joint_path(clash, q, goal, arm.limits, budget=0 if straight else PLAN_CHECKS)
                 if path is None:
                     why = f"no clear way for the {arm.side} arm to '{step.name}' ({segment_clash(clash, q, goal)} is in the way)"
                     continue
@@ -146,9 +151,9 @@ def _pick_steps(steps: list[Step]) -> int:
 
 def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> list[Variant]:
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
-    over in (tilting either way)."""
+    over in, by its middle (tilting either way)."""
     if holding:
-        return [v for v in variants(held) if v.yaw == 0.0 and not v.side]
+        return [v for v in variants(held) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
     return variants(held, task.pours, opening)
 
 

@@ -26,10 +26,13 @@ PLAN_CHECKS = 6000
 def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
                budget: int = PLAN_CHECKS) -> list[np.ndarray] | None:
     """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none within
-    `budget` clearance checks. `clash(q)` names what the configuration hits, None when it is clear."""
+    `budget` clearance checks (0: only the straight segment). `clash(q)` names what the configuration hits,
+    None when it is clear."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if segment_clash(clash, q0, q1) is None:
         return [q0, q1]
+    if budget <= 0:  # the straight motion or none
+        return None
     space = ob.RealVectorStateSpace(len(q0))
     bounds = ob.RealVectorBounds(len(q0))
     for k, (lo, hi) in enumerate(limits):

@@ -25,6 +25,7 @@ TABLE_TOP = 0.75  # height above the floor
 TABLE_SIZE = (0.7, 1.2)
 X_LIMIT, Y_LIMIT = 0.3, 0.5
 HAND_OFF = (-1.6, 0.0)  # where a held object waits (behind the robot, on the floor) until it is put in the hand
+LAYOUT_ATTEMPTS = 20  # seeded random layouts tried before a scene's objects are said not to fit
 
 # label -> (kind, size): container (width, depth, height, wall), bottle (radius, height),
 # food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
@@ -191,11 +192,24 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
                 if other.xy is not None and _overlap(label, xy, other.label, other.xy):
                     raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
-    rng = random.Random(seed)
-    for obj in sorted(placed, key=lambda o: -footprint(o.label)):  # big ones first: they need the room
+    free = [o for o in placed if o.xy is None]
+    for attempt in range(LAYOUT_ATTEMPTS):  # an unlucky early spot can leave no room for a later object
+        try:
+            _place_at_random(placed, random.Random(seed if attempt == 0 else f"{seed}:{attempt}"), where)
+            break
+        except InputError:
+            if attempt == LAYOUT_ATTEMPTS - 1:
+                raise
+            for obj in free:
+                obj.xy = None
+    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
+
+
+def _place_at_random(placed: list[SceneObject], rng: random.Random, where: str) -> None:
+    """Give the objects without a position one, big ones first (they need the room)."""
+    for obj in sorted(placed, key=lambda o: -footprint(o.label)):
         if obj.xy is None:
             obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
-    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
 
 
 def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:

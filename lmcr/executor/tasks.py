@@ -28,6 +28,7 @@ SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's ax
 PITCHES = (0.0, 0.5)
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
+GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
 
 
 @dataclass(frozen=True)
@@ -38,8 +39,8 @@ class Step:
     name: str = ""
     positions: tuple = ()
     orientation: tuple = DOWN
-    # what this motion may come close to (the rest is kept clear): "held" | "target" (may touch it), or
-    # "neighbours" (a lift from among the objects it stood between: nothing touched, but no room to spare)
+    # what this motion may touch, "held" | "target", or "table" (a lift from it); it may also pass close
+    # over the table, the rest is kept clear
     touches: str = ""
     probe: str = ""  # a name to record the held object's pose under once the pose is reached
     particles: int = 0
@@ -55,6 +56,7 @@ class Variant:
     tilt_sign: int = 1  # which way it turns to pour
     side: bool = False  # grasped from the side (bottles and shakers, to pour), not by the top
     turn: float = 0.0  # how far the hand turns about the vertical between the grasp and the target
+    shift: tuple = (0.0, 0.0)  # a top grasp this far (x, y metres) from the top's middle, along a long object
 
     def at_target(self) -> tuple:
         """The gripper orientation over the target: the grasp's, turned about the vertical (the held
@@ -97,7 +99,7 @@ class Geometry:
         if variant.side:
             h = height(self.held.label)
             return self.held_top - [0, 0, h - max(SIDE_GRIP * h, SIDE_GRIP_MIN)], variant.upright()
-        return self.held_top + [0, 0, GRIP_GAP], variant.upright()
+        return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
         """The held object's pose relative to the gripper after the grasp."""
@@ -153,11 +155,16 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
     fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
     shape = solid_shape(held.label) if held.label not in CONTAINERS else ("box", *CONTAINERS[held.label])
-    yaws = [0.0, math.pi / 2, -math.pi / 2]
+    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if shape[0] == "box" and abs(shape[1] - shape[2]) > 0.02:
-        yaws = [0.0, math.pi] if shape[1] > shape[2] else [math.pi / 2, -math.pi / 2]
+        long_x = shape[1] > shape[2]
+        yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
+        # a long object may also be held nearer either end, the hand then further from a neighbour
+        reach = (max(shape[1], shape[2]) / 2 - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
+        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
     signs = (1, -1) if pours else (1,)
-    top = [Variant(yaw, pitch, sign, turn=turn) for pitch in PITCHES for yaw in yaws for turn in TURNS for sign in signs]
+    top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
+           for turn in TURNS for sign in signs]
     if not pours or 2 * footprint(held.label) > opening - 0.01:
         return top
     x, y = world_xy(held.xy)
@@ -186,9 +193,9 @@ def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     if v.side:
         back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
         return [move(f"next to {label}", pos - back, orn), move(f"grip {label}", pos, orn, touches="held"),
-                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn, touches="neighbours")]
+                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn, touches="table")]
     return [above(pos, f"above {label}", orn), move(f"grip {label}", pos, orn, touches="held"),
-            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn, touches="neighbours")]
+            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn, touches="table")]
 
 
 def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
@@ -246,7 +253,7 @@ def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
     return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip"),
-            move("lift out", out, orn, probe="lifted")]
+            move("lift out", out, orn, touches="target", probe="lifted")]
 
 
 def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
