@@ -54,6 +54,8 @@ def failure_reason(out: dict, held: str, target: str) -> str:
     if checks.get("knocked"):
         step = next(iter(out.get("knocked_during", {}).values()), "?")
         return f"knocked an object ({step.replace(held, '<held>').replace(target, '<target>')})"
+    if not checks.get("verb_check", True) and out.get("target_moved_m", 0) > 0.02:
+        return f"pushed the target {100 * out['target_moved_m']:.0f} cm"
     far = [w["name"] for w in out["waypoints"] if w["error_m"] > 0.02]
     if far:
         return f"waypoint off by > 2 cm ({far[0].split(' ')[0]})"

@@ -160,6 +160,7 @@ def test_each_predicate_executes_from_the_completion(sim, completer, predicate):
     assert out["frame"]["predicate"] == predicate and out["chosen_object"] == other
     assert out["success"], out
     assert all(w["error_m"] <= 0.02 for w in out["waypoints"]) and out["checks"]["verb_check"]
+    assert 0.0 <= out["target_moved_m"] < 0.02  # the target stays where it stood
 
 
 def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):

@@ -20,6 +20,7 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
     not in the task, stayed where they were) and `success` whether all passed."""
     arm, other = plan.arm, plan.other
     before = {o.label: p.getBasePositionAndOrientation(o.body)[0] for o in others}
+    target_at = p.getBasePositionAndOrientation(target.body)[0]
     for a, q in ((other, other.parked), (arm, arm.home)):
         a.set_config(q)
         a.hold(q)
@@ -51,7 +52,11 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
     checks = task.check(held, target, out) if grasped else {"ok": False}
     within = all(w["error_m"] <= TOLERANCE for w in arm.log)
     moved = _moved(others, before)
+    # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
+    # but the reason to name when they do
+    pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
     return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": arm.log,
+            "target_moved_m": round(pushed, 3),
             "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
                        "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
             **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
