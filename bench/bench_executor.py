@@ -117,7 +117,7 @@ def main() -> None:
             scene = random_scene(f"{args.seed}:{predicate}:{k}", stated, expected, objects, args.distractors,
                                  stated if args.holding and predicate in HELD_IS_STATED else None)
             started = time.perf_counter()
-            out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected})
+            out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf)
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])
             lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
             row["other_choice"] += lm_choice != expected
