@@ -12,7 +12,7 @@ import numpy as np
 import pybullet as p
 
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
-from lmcr.executor.collision import CLEARANCE, Carried, Clearance
+from lmcr.executor.collision import Carried, Clearance
 from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.executor.scene import Scene, SceneObject
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, variants
@@ -108,14 +108,14 @@ class Planner:
             if step.kind != "move":
                 segments.append(Segment(step))
                 continue
-            # a motion that touches the held object or the target may pass close over the table; the
-            # other objects it keeps CLEARANCE from, as every motion does
-            ignore = {"held": {held.body}, "target": {target.body}}.get(step.touches, set())
-            ignore = frozenset(ignore | ({held.body} if released else set()))
+            # a motion that touches something (the held object, the target, the table it lifts from) may
+            # pass close over the table; the other objects it keeps CLEARANCE from, as every motion does
+            touched = {"held": {held.body}, "target": {target.body}}.get(step.touches, set())
+            ignore = frozenset(touched | ({held.body} if released else set()))
             tight = frozenset({self.table} if step.touches else ())
 
             def clash(x, carried=carried, ignore=ignore, tight=tight):
-                return clearance.clash(x, carried, ignore, CLEARANCE, tight)
+                return clearance.clash(x, carried, ignore, tight=tight)
 
             found, why = None, ""
             for position in step.positions:
@@ -129,8 +129,7 @@ class Planner:
                     continue
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
                 # object ignored could sweep through it
-                straight = step.touches in ("held", "target")
-                path = joint_path(clash, q, goal, arm.limits, budget=0 if straight else PLAN_CHECKS)
+                path = joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
                 if path is None:
                     why = f"no clear way for the {arm.side} arm to '{step.name}' ({segment_clash(clash, q, goal)} is in the way)"
                     continue

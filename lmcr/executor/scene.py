@@ -98,11 +98,8 @@ def solid_shape(label: str) -> tuple:
 
 def footprint(label: str) -> float:
     """Half the object's widest side on the table (its radius when it is round)."""
-    if label in CONTAINERS:
-        w, d, _ = CONTAINERS[label]
-        return max(w, d) / 2
-    shape = solid_shape(label)
-    return shape[1] if shape[0] in ("sphere", "cyl") else max(shape[1], shape[2]) / 2
+    half_x, half_y, _ = outline(label)
+    return max(half_x, half_y)
 
 
 def height(label: str) -> float:

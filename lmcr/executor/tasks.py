@@ -17,7 +17,7 @@ import numpy as np
 import pybullet as p
 
 from lmcr.executor.arm import DOWN, relative_pose
-from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, solid_shape, world_xy
+from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, outline, world_xy
 
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
 TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
@@ -154,13 +154,13 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
     forward, each tilting either way; for pouring, side grasps first where the object fits between the
     fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
-    shape = solid_shape(held.label) if held.label not in CONTAINERS else ("box", *CONTAINERS[held.label])
+    half_x, half_y, round_ = outline(held.label)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
-    if shape[0] == "box" and abs(shape[1] - shape[2]) > 0.02:
-        long_x = shape[1] > shape[2]
+    if not round_ and abs(2 * half_x - 2 * half_y) > 0.02:
+        long_x = half_x > half_y
         yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
         # a long object may also be held nearer either end, the hand then further from a neighbour
-        reach = (max(shape[1], shape[2]) / 2 - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
+        reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
         shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
     signs = (1, -1) if pours else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
