@@ -5,7 +5,7 @@ Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--see
 For each of the 11 predicates, an incomplete instruction on `--placements` random layouts: the two
 objects the frame needs plus `--distractors` random other objects (obstacles, and other candidates for
 the completion), placed at random with a seed. With `--holding` the stated object starts in the robot's
-hand instead of on the table. The task's own object is given as the answer, so the run measures
+hand instead of on the table (for fill and season it is the target: the robot puts it down first). The task's own object is given as the answer, so the run measures
 execution; how often the language model (the published checkpoint of $LMCR_DATA_DIR) would have chosen
 another object is counted beside it. Prints per predicate: executed successfully / executed, refused
 before moving (infeasible), then a histogram of failure and refusal reasons, and the time to plan and
@@ -100,7 +100,8 @@ def main() -> None:
     parser_.add_argument("--seed", type=int, default=0)
     parser_.add_argument("--predicates", default=",".join(TASKS), help="comma-separated subset")
     parser_.add_argument("--urdf", help="a Baxter URDF to use instead of the built-in one (LMCR_BAXTER_URDF)")
-    parser_.add_argument("--holding", action="store_true", help="the stated object starts in the hand")
+    parser_.add_argument("--holding", action="store_true",
+                         help="the stated object starts in the hand (fill, season: put down first)")
     args = parser_.parse_args()
     if args.urdf:
         os.environ["LMCR_BAXTER_URDF"] = args.urdf
@@ -115,7 +116,7 @@ def main() -> None:
         row = collections.Counter()
         for k in range(args.placements):
             scene = random_scene(f"{args.seed}:{predicate}:{k}", stated, expected, objects, args.distractors,
-                                 stated if args.holding and predicate in HELD_IS_STATED else None)
+                                 stated if args.holding else None)
             started = time.perf_counter()
             out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf)
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])

