@@ -58,12 +58,20 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
     planner = og.RRTConnect(si)
     planner.setProblemDefinition(problem)
     planner.setup()
-    solved = planner.solve(ob.PlannerTerminationCondition(lambda: checks >= budget)) and problem.hasExactSolution()
     path = None
-    if solved:
+    while path is None and checks < budget:
+        if not (planner.solve(ob.PlannerTerminationCondition(lambda: checks >= budget)) and problem.hasExactSolution()):
+            break
         geometric = problem.getSolutionPath()
         og.PathSimplifier(si).simplifyMax(geometric)
         path = [np.array([s[k] for k in range(len(q0))]) for s in geometric.getStates()]
+        # OMPL checks a motion at points spaced along its length, ours every RESOLUTION of the largest
+        # joint step: a thin obstacle one misses the other may catch. A path is kept only when clear by
+        # the check the rest of the planner uses; else planning goes on within the budget.
+        if any(segment_clash(clash, a, b) for a, b in zip(path, path[1:])):
+            path = None
+            planner.clear()
+            problem.clearSolutionPaths()
     del planner, problem, si  # released here: nanobind reports objects still alive at exit as leaks
     return path
 
