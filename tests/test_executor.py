@@ -420,7 +420,7 @@ def test_a_plan_found_after_failed_grasps_carries_the_object_where_it_was_graspe
     for segment in plan.segments:
         if segment.step.kind == "grasp":
             carried = Carried(water.body, *_grasped(plan.arm, q, water))
-        if segment.step.kind != "move":
+        if not segment.step.moves:
             continue
         for a, b in zip(segment.path, segment.path[1:]):
             for t in np.linspace(0, 1, 1 + int(np.ceil(np.max(np.abs(b - a)) / 0.005))):

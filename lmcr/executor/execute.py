@@ -65,7 +65,7 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
         roles = frame["roles"]
         if recorder is not None:
             recorder.target, recorder.held = roles[task.target_role], roles[task.held_role]
-            for arm in {result.arm.side: result.arm, **({result.first.arm.side: result.first.arm} if result.first else {})}.values():
+            for arm in result.moving_arms:
                 arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
             recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
         held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
@@ -108,7 +108,7 @@ def _plan(planner: Planner, scene: Scene, frame: dict) -> Plan | Infeasible:
     # set down elsewhere first: the held object when no arm reaches all the task as it stands (from the
     # table it may be picked up by either arm, in any grasp), else, with the hand free, the object on
     # the table a pose would put the arm against
-    blocking = None if holding else {f"the {o.label}": o for o in scene.objects}.get(direct.blocker)
+    blocking = None if holding else planner.on_table(direct.blocker)
     moved = held if direct.out_of_reach else blocking
     if moved is None:
         return direct

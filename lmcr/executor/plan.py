@@ -39,13 +39,19 @@ class Plan:
     geometry: Geometry
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
 
+    @property
+    def moving_arms(self) -> list[Arm]:
+        """The arms that move, in order: the first part's, then the task's (once when they are one)."""
+        lead = self.first.arm if self.first else self.arm
+        return [lead] + ([self.arm] if self.arm is not lead else [])
+
 
 @dataclass
 class Infeasible:
     reason: str
     progress: int = 0  # steps planned before the one that failed (the best attempt's reason is reported)
     out_of_reach: bool = False  # it failed for want of an IK solution (not an obstacle in the way)
-    blocker: str = ""  # else what a waypoint's pose would put the arm against ("the pot")
+    blocker: str = ""  # else what was in the way, as a clash names it ("the pot")
 
 
 @dataclass
@@ -131,9 +137,13 @@ class Planner:
                 best = rest if rest.progress >= best.progress else best
         return best
 
+    def on_table(self, name: str) -> SceneObject | None:
+        """The object on the table a clash names ("the pot"; None for the table or the robot)."""
+        return next((o for o in self.scene.objects if _named(o) == name), None)
+
     def _obstacles(self, held: SceneObject) -> dict[int, str]:
-        things = {o.body: f"the {o.label}" for o in self.scene.objects if o.body != held.body}
-        return {self.table: "the table", **things, held.body: f"the {held.label}"}
+        things = {o.body: _named(o) for o in self.scene.objects if o.body != held.body}
+        return {self.table: "the table", **things, held.body: _named(held)}
 
     def _plan_variant(self, arm: Arm, clearance: Clearance, steps: list[Step], held: SceneObject,
                       target: SceneObject, carried: Carried | None, start: np.ndarray) -> list[Segment] | Infeasible:
@@ -143,7 +153,7 @@ class Planner:
                 carried = Carried(held.body, *_grasped(arm, q, held))
             elif step.kind == "release":
                 carried, released = None, True
-            if step.kind not in ("move", "home", "park"):
+            if not step.moves:
                 segments.append(Segment(step))
                 continue
             # a motion that touches something (the held object, the target, the table it lifts from) may
@@ -207,6 +217,11 @@ def _grasped(arm: Arm, q, held: SceneObject) -> tuple:
     """The held object's pose in the hand when grasped at joints `q`, as it stands now."""
     arm.set_config(q)
     return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+
+
+def _named(obj: SceneObject) -> str:
+    """How a clash names an object."""
+    return f"the {obj.label}"
 
 
 def _gripper_at(arm: Arm, q) -> np.ndarray:

@@ -21,7 +21,6 @@ GRAIN_RADIUS = 0.003
 def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, others: list[SceneObject]) -> dict:
     """Execute `plan`; the result's `checks` hold the task's checks (and whether the `others`, the objects
     not in the task, stayed where they were) and `success` whether all passed."""
-    arm = plan.arm
     lead = plan.first or plan  # the arm that moves first starts at home, the other parked
     for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
         a.set_config(q)
@@ -36,7 +35,7 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
     checks = task.check(held, target, out) if grasped else {"ok": False}
-    log = lead.arm.log + (arm.log if arm is not lead.arm else [])  # both parts' waypoints, in order
+    log = [w for a in plan.moving_arms for w in a.log]  # both parts' waypoints, in order
     within = all(w["error_m"] <= TOLERANCE for w in log)
     moved = _moved(others, before)
     # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
@@ -62,7 +61,7 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
     knocked_during: dict[str, str] = {}
     for segment in plan.segments:
         step = segment.step
-        if step.kind in ("move", "home", "park"):
+        if step.moves:
             arm.follow(segment.path)
             arm.record(step.name, segment.goal)
             if step.probe:

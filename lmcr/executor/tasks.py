@@ -46,6 +46,11 @@ class Step:
     probe: str = ""  # a name to record the held object's pose under once the pose is reached
     particles: int = 0
 
+    @property
+    def moves(self) -> bool:
+        """Whether the arm moves in this step (to a gripper pose, or to its start or parked configuration)."""
+        return self.kind in ("move", "home", "park")
+
 
 @dataclass(frozen=True)
 class Variant:
