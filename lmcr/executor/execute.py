@@ -69,7 +69,8 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
                 arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
             recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
         held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
-        out.update(run_plan(result, task, held, target, [o for o in scene.present if o not in (held, target)]))
+        out.update(run_plan(result, task, held, target, [o for o in scene.present if o not in (held, target)],
+                            planner))
         out["set_down_first"] = result.first.geometry.held.label if result.first else None
         if recorder is not None:  # what was poured or put down, once it has come to rest
             recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
@@ -158,7 +159,8 @@ def execute_batch(path: Path, run: Callable[[str, Scene], dict]) -> Iterator[dic
                 raise error
             scene = _batch_scene(record, Path(path).parent, f"{path}:{line_no}")
             yield {"id": ident, **run(check_text(record["instruction"], f"{path}:{line_no}"), scene)}
-        except (ValueError, KeyError, RuntimeError) as exc:  # every LMCR error is a ValueError/RuntimeError
+        # every LMCR error is a ValueError/RuntimeError; the simulator raises its own type
+        except (ValueError, KeyError, RuntimeError, p.error) as exc:
             yield {"id": ident, "line": line_no, "error": one_line(exc)}
 
 

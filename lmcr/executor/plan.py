@@ -37,6 +37,7 @@ class Plan:
     segments: list[Segment]
     carried: Carried | None  # what the hand holds at the start
     geometry: Geometry
+    task: Task
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
 
     @property
@@ -97,8 +98,8 @@ class Planner:
                              *task.program(g, variant, holding)]
                     result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
                     if isinstance(result, list):
-                        return Plan(arm, other, variant, result, carried, g)
-                    if result.progress < _pick_steps(steps):
+                        return Plan(arm, other, variant, result, carried, g, task)
+                    if result.progress < pick_steps(steps):
                         failed_grasps.add(grasp)
                     if result.progress > best.progress:
                         best = result
@@ -136,6 +137,24 @@ class Planner:
                     return replace(rest, first=first)
                 best = rest if rest.progress >= best.progress else best
         return best
+
+    def replan_in_hand(self, plan: Plan, held: SceneObject, target: SceneObject) -> Plan | None:
+        """The rest of `plan` (after the pick-up) planned afresh from where its arm is, for the object as
+        it sits in the hand now: a grasp can push the object before the fingers hold it, and the planned
+        motions then carry it somewhere else (into the target's rim). None when no plan is found; the
+        simulation is left as it was."""
+        arm, state = plan.arm, p.saveState()
+        try:
+            in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+            g = replace(plan.geometry, grasped=in_hand)
+            carried = Carried(held.body, *in_hand)
+            steps = plan.task.program(g, plan.variant, True)
+            result = self._plan_variant(arm, Clearance(arm, self._obstacles(held)), steps, held, target, carried,
+                                        arm.config())
+        finally:
+            p.restoreState(state)
+            p.removeState(state)
+        return replace(plan, segments=result, carried=carried, geometry=g) if isinstance(result, list) else None
 
     def on_table(self, name: str) -> SceneObject | None:
         """The object on the table a clash names ("the pot"; None for the table or the robot)."""
@@ -199,7 +218,7 @@ class Planner:
         return segments
 
 
-def _pick_steps(steps: list[Step]) -> int:
+def pick_steps(steps: list[Step]) -> int:
     """How many of a program's steps pick the object up (up to and including the lift after the grasp)."""
     kinds = [s.kind for s in steps]
     return kinds.index("grasp") + 2 if "grasp" in kinds else 0

@@ -12,10 +12,10 @@ from ompl import geometric as og
 from ompl import util as ou
 
 ou.setLogLevel(ou.LogLevel.LOG_NONE)  # OMPL's console chatter is no use to a CLI user
-# One seed before any planner exists: a process then plans the same paths for the same scenes in the
-# same order (a run, the bench) instead of new random ones each time.
+# Every search starts from this seed (OMPL's seed generator is re-seeded, so the samplers a search makes
+# draw the same numbers): the same motion request gets the same path whatever was planned before it in
+# the process, so a scene's plan does not depend on which scenes a run or the bench did first.
 SEED = 1
-ou.RNG.setSeed(SEED)
 
 RESOLUTION = 0.04  # radians between checked states along a motion
 # RRT-Connect's budget for one segment, in clearance checks (about 1.5 s on one core) rather than in
@@ -24,15 +24,16 @@ PLAN_CHECKS = 6000
 
 
 def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
-               budget: int = PLAN_CHECKS) -> list[np.ndarray] | None:
+               budget: int = PLAN_CHECKS, seed: int = SEED) -> list[np.ndarray] | None:
     """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none within
     `budget` clearance checks (0: only the straight segment). `clash(q)` names what the configuration hits,
-    None when it is clear."""
+    None when it is clear. The search is seeded with `seed`."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if segment_clash(clash, q0, q1) is None:
         return [q0, q1]
     if budget <= 0:  # the straight motion or none
         return None
+    ou.RNG.setSeed(seed)  # before the search makes its samplers (OMPL logs, unseen, that seeds were drawn before)
     space = ob.RealVectorStateSpace(len(q0))
     bounds = ob.RealVectorBounds(len(q0))
     for k, (lo, hi) in enumerate(limits):
@@ -63,17 +64,26 @@ def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.nda
         if not (planner.solve(ob.PlannerTerminationCondition(lambda: checks >= budget)) and problem.hasExactSolution()):
             break
         geometric = problem.getSolutionPath()
+        raw = _states(geometric, len(q0))
         og.PathSimplifier(si).simplifyMax(geometric)
-        path = [np.array([s[k] for k in range(len(q0))]) for s in geometric.getStates()]
         # OMPL checks a motion at points spaced along its length, ours every RESOLUTION of the largest
-        # joint step: a thin obstacle one misses the other may catch. A path is kept only when clear by
-        # the check the rest of the planner uses; else planning goes on within the budget.
-        if any(segment_clash(clash, a, b) for a, b in zip(path, path[1:])):
-            path = None
+        # joint step: a thin obstacle one misses the other may catch (seen most after shortcutting). The
+        # simplified path is kept when clear by the check the rest of the planner uses, else the path as
+        # found; else planning goes on within the budget.
+        path = next((c for c in (_states(geometric, len(q0)), raw) if _clear(clash, c)), None)
+        if path is None:
             planner.clear()
             problem.clearSolutionPaths()
     del planner, problem, si  # released here: nanobind reports objects still alive at exit as leaks
     return path
+
+
+def _states(geometric, n: int) -> list[np.ndarray]:
+    return [np.array([s[k] for k in range(n)]) for s in geometric.getStates()]
+
+
+def _clear(clash, path: list[np.ndarray]) -> bool:
+    return not any(segment_clash(clash, a, b) for a, b in zip(path, path[1:]))
 
 
 def segment_clash(clash, q0, q1) -> str | None:

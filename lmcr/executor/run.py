@@ -6,32 +6,36 @@ from __future__ import annotations
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.arm import settle
-from lmcr.executor.plan import Plan
+from lmcr.executor.arm import relative_pose, rotation_error, settle
+from lmcr.executor.plan import Plan, Planner, pick_steps
 from lmcr.executor.scene import SceneObject, footprint
 from lmcr.executor.tasks import Outcome, Task
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
+# an object the grasp pushed further than this (or turned more) is not where the plan has it in the hand
+SHIFTED, TURNED = 0.005, 0.05
 # a poured drop or grain, 6 mm across: twice that, they piled up like marbles and rolled off round food
 # (cinnamon shaken over an apple: 0.21-0.38 stayed on it, 0.75-0.96 at this size)
 GRAIN_RADIUS = 0.003
 
 
-def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, others: list[SceneObject]) -> dict:
+def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, others: list[SceneObject],
+             planner: Planner | None = None) -> dict:
     """Execute `plan`; the result's `checks` hold the task's checks (and whether the `others`, the objects
-    not in the task, stayed where they were) and `success` whether all passed."""
+    not in the task, stayed where they were) and `success` whether all passed. With the `planner`, a
+    grasp that left the object in the hand otherwise than planned has the rest planned afresh."""
     lead = plan.first or plan  # the arm that moves first starts at home, the other parked
     for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
         a.set_config(q)
         a.hold(q)
     if plan.first is not None:  # an object set down out of the way or within reach; the checks start from there
-        _act(plan.first, plan.first.geometry.held, Outcome())
+        _act(plan.first, plan.first.geometry.held, Outcome(), planner=planner)
         settle(120)
     before = {o.label: p.getBasePositionAndOrientation(o.body)[0] for o in others}
     target_at = p.getBasePositionAndOrientation(target.body)[0]
     out = Outcome()
-    grasped, released, knocked_during = _act(plan, held, out, others, before)
+    grasped, released, knocked_during = _act(plan, held, out, others, before, planner)
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
     checks = task.check(held, target, out) if grasped else {"ok": False}
@@ -42,28 +46,31 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
     # but the reason to name when they do
     pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
     return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": log,
-            "target_moved_m": round(pushed, 3),
+            "target_moved_m": round(pushed, 3), "replanned_after_grasp": out.replanned,
             "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
                        "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
             **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
 
 
 def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] = (),
-         before: dict[str, tuple] | None = None) -> tuple[bool, bool, dict[str, str]]:
+         before: dict[str, tuple] | None = None, planner: Planner | None = None) -> tuple[bool, bool, dict[str, str]]:
     """Follow the plan's segments: move, grasp, let go and pour where it says. Returns whether the grasp
     held, whether the object was let go, and for each of the `others` found moved (from `before`) the
-    step during which it was first seen moved."""
+    step during which it was first seen moved. Once the object is picked up, when it sits in the hand
+    otherwise than planned, the rest is planned afresh (kept as planned when no new plan is found)."""
     arm = plan.arm
     if plan.carried is not None:
         plan.carried.place(arm)
         arm.attach(held.body)
     grasped, released = True, False
     knocked_during: dict[str, str] = {}
-    for segment in plan.segments:
-        step = segment.step
+    segments, picked = list(plan.segments), pick_steps([s.step for s in plan.segments])
+    k = 0
+    while k < len(segments):
+        step = segments[k].step
         if step.moves:
-            arm.follow(segment.path)
-            arm.record(step.name, segment.goal)
+            arm.follow(segments[k].path)
+            arm.record(step.name, segments[k].goal)
             if step.probe:
                 out.probes[step.probe] = (p.getBasePositionAndOrientation(held.body)[0], p.getAABB(held.body))
         elif step.kind == "grasp":
@@ -77,7 +84,21 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
             out.particles += spill(held, plan.geometry.opening, step.particles)
         for label in _moved(others, before or {}):
             knocked_during.setdefault(label, step.name)
+        k += 1
+        if k == picked and planner is not None and _shifted_in_hand(plan, held):
+            again = planner.replan_in_hand(plan, held, plan.geometry.target)
+            if again is not None:
+                plan, segments[k:], out.replanned = again, again.segments, True
     return grasped, released, knocked_during
+
+
+def _shifted_in_hand(plan: Plan, held: SceneObject) -> bool:
+    """Whether the held object sits in the hand further than SHIFTED (or turned more than TURNED) from
+    where the plan has it."""
+    planned_pos, planned_orn = plan.geometry.in_hand(plan.variant)
+    pos, orn = relative_pose(*plan.arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+    turned = float(np.linalg.norm(rotation_error(orn, planned_orn)))
+    return float(np.linalg.norm(np.subtract(pos, planned_pos))) > SHIFTED or turned > TURNED
 
 
 def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:

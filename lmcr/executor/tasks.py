@@ -90,6 +90,7 @@ class Geometry:
     held_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
     target_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
     target_box: tuple = ()
+    grasped: tuple | None = None  # the held object's pose in the hand as found after the grasp, if not as planned
 
     @classmethod
     def measure(cls, held: SceneObject, target: SceneObject) -> Geometry:
@@ -108,7 +109,9 @@ class Geometry:
         return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
-        """The held object's pose relative to the gripper after the grasp."""
+        """The held object's pose relative to the gripper after the grasp (as found, once it is known)."""
+        if self.grasped is not None:
+            return self.grasped
         return relative_pose(*self.grip_pose(variant), self.held_pos, self.held_orn)
 
     def point_in_hand(self, variant: Variant, local) -> np.ndarray:
@@ -161,7 +164,7 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
     fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
     half_x, half_y, round_ = outline(held.label)
-    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
+    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2, math.pi / 4, -math.pi / 4], [(0.0, 0.0)]
     if not round_ and abs(2 * half_x - 2 * half_y) > 0.02:
         long_x = half_x > half_y
         yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
@@ -289,10 +292,12 @@ def put_down(xy: tuple[float, float]) -> Task:
 
 @dataclass
 class Outcome:
-    """What happened while the program ran: particles poured, the held object's poses at probes."""
+    """What happened while the program ran: particles poured, the held object's poses at probes, whether
+    the rest was planned afresh after the pick-up."""
 
     particles: list[int] = field(default_factory=list)
     probes: dict[str, tuple] = field(default_factory=dict)  # name -> (position, AABB)
+    replanned: bool = False
 
 
 def inside(target: SceneObject, point, above: float = 0.05) -> bool:
