@@ -109,7 +109,7 @@ def main() -> None:
     scorer, config = ws.completion_scorer(args.method)
     nlp = ws.parser()
     objects = load_lexicon().objects
-    times, reasons, refusals = [], collections.Counter(), collections.Counter()
+    times, slowest, reasons, refusals = [], [], collections.Counter(), collections.Counter()
     totals = collections.Counter()
     for predicate in args.predicates.split(","):
         instruction, stated, expected, role = TASKS[predicate]
@@ -120,6 +120,7 @@ def main() -> None:
             started = time.perf_counter()
             out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf)
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])
+            slowest.append((times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
             lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
             row["other_choice"] += lm_choice != expected
             if not out["feasible"]:
@@ -128,6 +129,7 @@ def main() -> None:
                 continue
             row["executed"] += 1
             row["ok"] += out["success"]
+            row["replanned"] += out["replanned_after_grasp"]
             if not out["success"]:
                 held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
                 reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
@@ -138,11 +140,12 @@ def main() -> None:
     n = totals["executed"] + totals["refused"]
     print(f"overall: succeeded {totals['ok']}/{n} = {totals['ok'] / n:.3f}; of executed plans "
           f"{totals['ok']}/{totals['executed']} = {totals['ok'] / max(totals['executed'], 1):.3f}; "
-          f"refused {totals['refused']}")
+          f"refused {totals['refused']}; planned afresh after a grasp that shifted the object {totals['replanned']}")
     print("failures of executed plans:", dict(reasons.most_common()) or "none")
     print("refusals:", dict(refusals.most_common()) or "none")
     print(f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
-          f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT)")
+          f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); slowest: "
+          + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(slowest)[::-1][:3]))
 
 
 if __name__ == "__main__":

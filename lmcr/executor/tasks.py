@@ -159,12 +159,15 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
 
 
 def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> list[Variant]:
-    """The grasps that suit the held object's shape (fingers across a long object), upright or leaning
+    """The grasps that suit the held object's shape (fingers across a long object; a round one also from
+    the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
     forward, each tilting either way; for pouring, side grasps first where the object fits between the
     fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
     half_x, half_y, round_ = outline(held.label)
-    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2, math.pi / 4, -math.pi / 4], [(0.0, 0.0)]
+    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
+    if round_:  # a square box held across its corners would not fit between fingers set for its sides
+        yaws += [math.pi / 4, -math.pi / 4]
     if not round_ and abs(2 * half_x - 2 * half_y) > 0.02:
         long_x = half_x > half_y
         yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
