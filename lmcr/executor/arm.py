@@ -23,6 +23,7 @@ IK_POSITION = 0.003  # metres: a pose counts as reachable when IK gets this clos
 IK_ROTATION = 0.03  # ... and this close in orientation (radians)
 JOINT_STEP = 0.012  # radians per control tick pair while following a path (about 1.4 rad/s)
 SETTLED = 0.002  # radians: the joints have arrived
+IK_RESTARTS, IK_RESTART_SEED = 4, 0  # other starts for a pose whose first IK solution clashes
 FINGER_THICKNESS = 0.01  # metres, both grippers' finger pads
 GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside the object's box to hold it
 
@@ -79,6 +80,10 @@ class Arm:
         # out of the other arm's way: the shoulder turned outwards, the hand raised above the tallest
         # object (a blender near the robot's edge: 0.22 m; the fingers 5 cm above it, off the table's side)
         self.parked = np.array([0.9 * sign, -0.9, -1.19 * sign, 1.94, 0.67 * sign, 1.03, -0.5 * sign])
+        # where IK starts again when a pose's solution clashes: seeded random configurations within the
+        # limits (the same ones every run)
+        rng = np.random.default_rng(IK_RESTART_SEED)
+        self.ik_restarts = [rng.uniform(*self.limits.T) for _ in range(IK_RESTARTS)]
         self.finger_open, self.finger_shut, self.gaps = self._finger_range()
         self.opening = self.gaps[0] - FINGER_THICKNESS  # the widest object that fits between the open fingers
 

@@ -200,6 +200,8 @@ class Planner:
                     continue
                 hit = clash(goal)
                 if hit:
+                    goal = _other_solution(arm, position, step.orientation, clash)
+                if goal is None:
                     why, reach, blocker = f"'{step.name}' would put the {arm.side} arm against {hit}", False, hit
                     continue
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
@@ -216,6 +218,16 @@ class Planner:
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
+
+
+def _other_solution(arm: Arm, position, orientation, clash) -> np.ndarray | None:
+    """A clear IK solution for a pose whose first solution clashes, from other starting configurations
+    (the arm has seven joints: the elbow can often swing away from what it hit), or None."""
+    for seed in arm.ik_restarts:
+        goal, err_pos, err_rot = arm.solve(position, orientation, [seed])
+        if err_pos <= IK_POSITION and err_rot <= IK_ROTATION and not clash(goal):
+            return goal
+    return None
 
 
 def pick_steps(steps: list[Step]) -> int:
