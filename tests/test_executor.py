@@ -389,6 +389,27 @@ def test_the_official_baxter_loads_and_pours(sim, tmp_path):
     assert out["success"], out
 
 
+@pytest.mark.skipif(not SHARED_URDF.exists(), reason="needs ../shared (the official Baxter description)")
+def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere(sim, tmp_path):
+    """Official Baxter, bench seed 0, dump 0: over the pot near the robot's edge the first IK solution
+    puts the elbow into the head's collision spheres; starting IK again from other configurations finds
+    the elbow a clear place, and the dump is planned."""
+    from lmcr.executor.plan import Plan, Planner
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    layout = {"pasta": (-0.203, 0.354), "pot": (-0.077, 0.177), "scissors": (0.154, 0.186), "pizza": (0.084, -0.116),
+              "plate": (-0.17, -0.289), "fish": (0.123, 0.361)}
+    scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
+    planner = Planner(build_world(scene, tmp_path, SHARED_URDF), scene, scene.table)
+    pasta, pot = scene.find("pasta"), scene.find("pot")
+    assert isinstance(planner.plan(PROGRAMS["dump"], pasta, pot, holding=False), Plan)
+    for arm in planner.arms.values():
+        arm.ik_restarts = []
+    refused = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
+    assert not isinstance(refused, Plan) and "robot's own body" in refused.reason
+
+
 def test_renders_show_each_waypoint_with_labels_and_the_target(sim, tmp_path):
     """A 3/4 view at 640x480 per waypoint (plus start and end), the cup outlined, saved as an animated
     GIF and as a contact sheet with the waypoint captions."""
