@@ -161,7 +161,9 @@ class Planner:
         return next((o for o in self.scene.objects if _named(o) == name), None)
 
     def _obstacles(self, held: SceneObject) -> dict[int, str]:
-        things = {o.body: _named(o) for o in self.scene.objects if o.body != held.body}
+        # what the robot was handed counts too: once set down it stands on the table (planning again
+        # after a later grasp must keep clear of it)
+        things = {o.body: _named(o) for o in self.scene.present if o.body != held.body}
         return {self.table: "the table", **things, held.body: _named(held)}
 
     def _plan_variant(self, arm: Arm, clearance: Clearance, steps: list[Step], held: SceneObject,
