@@ -385,7 +385,7 @@ def test_the_official_baxter_loads_and_pours(sim, tmp_path):
     assert 0.05 < Arm(robot, "left").opening < 0.07  # the electric gripper's extended narrow fingers, slot 2
     plan = Planner(robot, scene, scene.table).plan(PROGRAMS["pour"], *scene.objects, holding=False)
     assert isinstance(plan, Plan), plan
-    out = run_plan(plan, PROGRAMS["pour"], *scene.objects, others=[])
+    out = run_plan(plan, *scene.objects, others=[])
     assert out["success"], out
 
 
@@ -487,7 +487,7 @@ def test_a_grasp_that_shifts_the_object_has_the_rest_planned_afresh(sim, tmp_pat
     planner = Planner(robot, scene, scene.table)
     plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
     assert isinstance(plan, Plan) and plan.variant.pitch > 0  # the leaning grasp
-    out = run_plan(plan, PROGRAMS["dump"], pasta, pot, [o for o in scene.objects if o not in (pasta, pot)],
+    out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)],
                    planner if replan else None)
     assert out["replanned_after_grasp"] is replan
     assert out["success"] is replan and (out["target_moved_m"] < 0.02) is replan, out
@@ -508,5 +508,5 @@ def test_a_long_object_next_to_a_neighbour_is_grasped_nearer_its_end(sim, tmp_pa
     banana, blender = scene.find("banana"), scene.find("blender")
     plan = Planner(robot, scene, scene.table).plan(PROGRAMS["blend"], banana, blender, holding=False)
     assert isinstance(plan, Plan) and plan.variant.shift != (0.0, 0.0)
-    out = run_plan(plan, PROGRAMS["blend"], banana, blender, [o for o in scene.objects if o not in (banana, blender)])
+    out = run_plan(plan, banana, blender, [o for o in scene.objects if o not in (banana, blender)])
     assert out["success"], out["checks"]

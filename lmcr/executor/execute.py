@@ -69,7 +69,7 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
                 arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
             recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
         held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
-        out.update(run_plan(result, task, held, target, [o for o in scene.present if o not in (held, target)],
+        out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)],
                             planner))
         out["set_down_first"] = result.first.geometry.held.label if result.first else None
         if recorder is not None:  # what was poured or put down, once it has come to rest

@@ -9,7 +9,7 @@ import pybullet as p
 from lmcr.executor.arm import relative_pose, rotation_error, settle
 from lmcr.executor.plan import Plan, Planner, pick_steps
 from lmcr.executor.scene import SceneObject, footprint
-from lmcr.executor.tasks import Outcome, Task
+from lmcr.executor.tasks import Outcome
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
@@ -20,9 +20,9 @@ SHIFTED, TURNED = 0.005, 0.05
 GRAIN_RADIUS = 0.003
 
 
-def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, others: list[SceneObject],
+def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject],
              planner: Planner | None = None) -> dict:
-    """Execute `plan`; the result's `checks` hold the task's checks (and whether the `others`, the objects
+    """Execute `plan` (its task); the result's `checks` hold the task's checks (and whether the `others`, the objects
     not in the task, stayed where they were) and `success` whether all passed. With the `planner`, a
     grasp that left the object in the hand otherwise than planned has the rest planned afresh."""
     lead = plan.first or plan  # the arm that moves first starts at home, the other parked
@@ -38,7 +38,7 @@ def run_plan(plan: Plan, task: Task, held: SceneObject, target: SceneObject, oth
     grasped, released, knocked_during = _act(plan, held, out, others, before, planner)
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
-    checks = task.check(held, target, out) if grasped else {"ok": False}
+    checks = plan.task.check(held, target, out) if grasped else {"ok": False}
     log = [w for a in plan.moving_arms for w in a.log]  # both parts' waypoints, in order
     within = all(w["error_m"] <= TOLERANCE for w in log)
     moved = _moved(others, before)
