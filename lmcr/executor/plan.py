@@ -138,19 +138,17 @@ class Planner:
                 best = rest if rest.progress >= best.progress else best
         return best
 
-    def replan_in_hand(self, plan: Plan, held: SceneObject, target: SceneObject) -> Plan | None:
-        """The rest of `plan` (after the pick-up) planned afresh from where its arm is, for the object as
-        it sits in the hand now: a grasp can push the object before the fingers hold it, and the planned
-        motions then carry it somewhere else (into the target's rim). None when no plan is found; the
-        simulation is left as it was."""
-        arm, state = plan.arm, p.saveState()
+    def replan_in_hand(self, plan: Plan, in_hand: tuple) -> Plan | None:
+        """The rest of `plan` (after the pick-up) planned afresh from where its arm is, for the held object
+        at pose `in_hand` relative to the gripper (as found): a grasp can push the object before the
+        fingers hold it, and the planned motions then carry it somewhere else (into the target's rim).
+        None when no plan is found; the simulation is left as it was."""
+        arm, held, state = plan.arm, plan.geometry.held, p.saveState()
+        g = replace(plan.geometry, grasped=in_hand)
+        carried = Carried(held.body, *in_hand)
         try:
-            in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
-            g = replace(plan.geometry, grasped=in_hand)
-            carried = Carried(held.body, *in_hand)
-            steps = plan.task.program(g, plan.variant, True)
-            result = self._plan_variant(arm, Clearance(arm, self._obstacles(held)), steps, held, target, carried,
-                                        arm.config())
+            result = self._plan_variant(arm, Clearance(arm, self._obstacles(held)), plan.task.program(g, plan.variant, True),
+                                        held, g.target, carried, arm.config())
         finally:
             p.restoreState(state)
             p.removeState(state)

@@ -85,18 +85,19 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
         for label in _moved(others, before or {}):
             knocked_during.setdefault(label, step.name)
         k += 1
-        if k == picked and planner is not None and _shifted_in_hand(plan, held):
-            again = planner.replan_in_hand(plan, held, plan.geometry.target)
+        if k == picked and planner is not None:
+            in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+            again = planner.replan_in_hand(plan, in_hand) if _shifted(plan, in_hand) else None
             if again is not None:
                 plan, segments[k:], out.replanned = again, again.segments, True
     return grasped, released, knocked_during
 
 
-def _shifted_in_hand(plan: Plan, held: SceneObject) -> bool:
-    """Whether the held object sits in the hand further than SHIFTED (or turned more than TURNED) from
-    where the plan has it."""
+def _shifted(plan: Plan, in_hand: tuple) -> bool:
+    """Whether the held object, at pose `in_hand` relative to the gripper, is further than SHIFTED (or
+    turned more than TURNED) from where the plan has it."""
     planned_pos, planned_orn = plan.geometry.in_hand(plan.variant)
-    pos, orn = relative_pose(*plan.arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+    pos, orn = in_hand
     turned = float(np.linalg.norm(rotation_error(orn, planned_orn)))
     return float(np.linalg.norm(np.subtract(pos, planned_pos))) > SHIFTED or turned > TURNED
 
