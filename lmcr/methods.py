@@ -23,9 +23,10 @@ from lmcr.workspace import SPACY_MODEL
 # The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
 # command line and light commands start fast (`bench/bench_cli.py`).
 
-# What completes instructions by default: the sentence LM times the frame counts, the most accurate
-# on the dev ratings (Table I) and the dev instructions (README, Completion).
-COMPLETION_METHOD = "sentence_lm+frame_counts"
+# What completes instructions by default: the sentence LM times the frame counts, less how common the
+# fillers are anyway (lmcr/rarity.py); the most accurate on the dev ratings (Table I) and the dev
+# instructions (README, Completion).
+COMPLETION_METHOD = "sentence_lm+frame_counts+rarity"
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
 
@@ -152,14 +153,35 @@ def _frame_counts(res: MethodResources) -> Scorer:
     return FrameCountScorer.from_store(res.db, res.sql_dir, res.corpus, mixture=res.mixture).score_frames
 
 
-def _frame_corpus_hash(res: MethodResources) -> str:
+def store_corpus_hash(db: Path, linearization: str) -> str:
+    """The content hash of the store's sentences ('sentence') or frames ('frame')."""
     from lmcr.lm.corpus import corpus_hash
 
-    con = read_connection(res.db)
+    con = read_connection(db)
     try:
-        return corpus_hash(con, "frame")
+        return corpus_hash(con, linearization)
     finally:
         con.close()
+
+
+def _frame_corpus_hash(res: MethodResources) -> str:
+    return store_corpus_hash(res.db, "frame")
+
+
+def _rarity(res: MethodResources) -> Scorer:
+    from lmcr.rarity import PhraseCounts
+
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"rarity needs the store's sentences: no store at {res.db}")
+    counts = PhraseCounts(res.db, res.sql_dir, res.corpus, res.mixture)
+    counts.count(load_lexicon().objects)  # the detector's objects up front: completion then never scans
+    return counts.rarity
+
+
+def _rarity_fingerprint(res: MethodResources) -> str:
+    from lmcr.rarity import WEIGHT
+
+    return f"{store_corpus_hash(res.db, 'sentence')}*{WEIGHT:g}"
 
 
 def _cooccur(res: MethodResources) -> Scorer:
@@ -226,11 +248,15 @@ SCORERS: dict[str, ScorerSpec] = {
     "conceptnet": ScorerSpec(_conceptnet),
     "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
+    "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
 }
 
 
 METHODS = tuple(SCORERS)
-EVALUATED = (*METHODS[:3], COMPLETION_METHOD, *METHODS[3:])  # what `lmcr evaluate` compares by default
+TERMS = ("rarity",)  # added to methods ('a+rarity'), not compared as a method of its own
+# what `lmcr evaluate` compares by default: the methods, and the default with and without the rarity term
+EVALUATED = (*METHODS[:3], "sentence_lm+frame_counts", COMPLETION_METHOD,
+             *(m for m in METHODS[3:] if m not in TERMS))
 
 
 def make_scorer(method: str, res: MethodResources) -> Scorer:
@@ -295,13 +321,8 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
 def corpus_word2vec(res: MethodResources) -> Path:
     """word2vec vectors trained on the setting's sentences, cached by the corpus content hash."""
     from lmcr.baselines.vectors import train_word2vec
-    from lmcr.lm.corpus import corpus_hash
 
-    con = read_connection(res.db)
-    try:
-        digest = corpus_hash(con, "sentence")[:12]
-    finally:
-        con.close()
+    digest = store_corpus_hash(res.db, "sentence")[:12]
     path = Path(res.cache_dir or Path(res.db).parent / "baselines") / f"word2vec-{res.corpus}-{digest}.bin"
     if not path.exists():
         train_word2vec(corpus_sentences(res), path, seed=res.seed + 1)

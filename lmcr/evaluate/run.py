@@ -16,8 +16,9 @@ from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import MethodResources, lm_experts, lm_version_dir, make_scorer
+from lmcr.methods import COMPLETION_METHOD, MethodResources, lm_experts, lm_version_dir, make_scorer
 from lmcr.mixture import Mixture
+from lmcr.rarity import WEIGHT
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
 
 SETTINGS = tuple(s.label for s in ALL_SETTINGS)
@@ -43,7 +44,9 @@ DEVIATIONS = [
     "not a like-for-like comparison.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
     "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). 'a+b' sums two methods' log-probabilities "
-    "(a product of experts); sentence_lm+frame_counts is what `lmcr complete` uses by default.",
+    f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
+    "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); "
+    f"{COMPLETION_METHOD} is what `lmcr complete` uses by default.",
 ]
 
 

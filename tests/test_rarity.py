@@ -1,0 +1,80 @@
+"""The rarity term: phrase counts from a tiny store's sentences, by hand, and what it does to a ranking."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from lmcr.frame import Frame
+from lmcr.methods import MethodResources, make_scorer, scorer_fingerprint
+from lmcr.mixture import Mixture
+from lmcr.rarity import WEIGHT, PhraseCounts, phrase_pattern
+from lmcr.store import connect
+from lmcr.workspace import Workspace
+
+SENTENCES = [  # (corpus, text)
+    ("recipes", "Dump the pan into the bowl."),
+    ("recipes", "Wash the pans and the pan lids."),
+    ("recipes", "Dump the cheese into a bowl; use a cutting board."),
+    ("household", "put pan on cutting boards"),
+    ("household", "rinse panini pan"),  # 'panini' is not 'pan'
+]
+
+
+@pytest.fixture
+def store(tmp_path):
+    db = tmp_path / "lmcr.duckdb"
+    sql_dir = Workspace.from_env().sql_dir
+    con = connect(db, sql_dir)
+    con.executemany("insert into sentences values (?, 's', ?, ?, 'instruction', ?, ?, 'f', 0, null, null)",
+                    [(corpus, f"d{i}", i, text, len(text.split())) for i, (corpus, text) in enumerate(SENTENCES)])
+    con.close()
+    return db, sql_dir
+
+
+def test_phrases_are_counted_whole_with_plurals_and_smoothed(store):
+    counts = PhraseCounts(*store)
+    counts.count(["pan", "cutting board", "cheese", "board", "scissors"])
+    # 'pans' counts as pan, 'panini' does not; 'cutting boards' is the phrase, so not a bare 'board'
+    assert counts.counts == {"pan": 5, "cutting board": 2, "cheese": 1, "board": 0, "scissors": 0}
+    words = sum(len(text.split()) for _, text in SENTENCES)
+    assert counts.words == words
+    assert counts.log_p("pan") == pytest.approx(math.log(6 / (words + 1)))
+    assert counts.log_p("Scissors") == pytest.approx(math.log(1 / (words + 1)))  # unseen: as rare as one in N + 1
+
+
+def test_longest_phrase_first():
+    assert phrase_pattern(["ab", "pepper", "black pepper", "a.b"]) == r"black\ pepper|pepper|a\.b|ab"
+
+
+def test_a_corpus_and_a_mixture_weigh_the_counts(store):
+    assert PhraseCounts(*store, corpus="household").counts == {}
+    household = PhraseCounts(*store, corpus="household")
+    household.count(["pan"])
+    assert household.counts == {"pan": 2} and household.words == 8
+    mixed = PhraseCounts(*store, mixture=Mixture.of({"household": 3}))
+    mixed.count(["pan", "cheese"])
+    assert mixed.counts == {"pan": 3 + 3 * 2, "cheese": 1}
+    assert mixed.words == sum(len(t.split()) * (3 if c == "household" else 1) for c, t in SENTENCES)
+
+
+def test_rarity_lifts_the_rarer_filler_by_its_log_frequency(store):
+    counts = PhraseCounts(*store)
+    frames = [Frame.of("dump", {"Theme": theme, "Destination": "bowl"}) for theme in ("pan", "cheese")]
+    pan, cheese = counts.rarity(frames)
+    assert cheese > pan
+    assert cheese - pan == pytest.approx(WEIGHT * (counts.log_p("pan") - counts.log_p("cheese")))
+    assert cheese == pytest.approx(-WEIGHT * (counts.log_p("cheese") + counts.log_p("bowl")))
+
+
+def test_rarity_is_a_term_of_sums_with_a_fingerprint(store):
+    db, sql_dir = store
+    res = MethodResources(checkpoints=db.parent, db=db, sql_dir=sql_dir)
+    frames = [Frame.of("dump", {"Theme": theme, "Destination": "bowl"}) for theme in ("pan", "cheese")]
+    alone = make_scorer("rarity", res)(frames)
+    assert make_scorer("random+rarity", res)(frames) == pytest.approx(
+        [a + b for a, b in zip(make_scorer("random", res)(frames), alone)])
+    assert scorer_fingerprint("rarity", res).endswith(f"*{WEIGHT:g}")
+    with pytest.raises(ValueError, match="rarity needs the store's sentences"):
+        make_scorer("rarity", MethodResources(checkpoints=db.parent, db=db.parent / "none.duckdb", sql_dir=sql_dir))
