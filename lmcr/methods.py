@@ -174,7 +174,9 @@ def _rarity(res: MethodResources) -> Scorer:
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"rarity needs the store's sentences: no store at {res.db}")
     counts = PhraseCounts(res.db, res.sql_dir, res.corpus, res.mixture)
-    counts.count(load_lexicon().objects)  # the detector's objects up front: completion then never scans
+    digest = store_corpus_hash(res.db, "sentence")[:12]
+    # the detector's objects up front (completion then never scans), cached by the corpus content
+    counts.count_cached(load_lexicon().objects, _cache_dir(res) / f"phrases-{res.corpus}-{res.mixture.label}-{digest}.json")
     return counts.rarity
 
 
@@ -318,12 +320,17 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
     return stream
 
 
+def _cache_dir(res: MethodResources) -> Path:
+    """Where scorers keep what they derive from the store (word2vec, phrase counts)."""
+    return Path(res.cache_dir or Path(res.db).parent / "baselines")
+
+
 def corpus_word2vec(res: MethodResources) -> Path:
     """word2vec vectors trained on the setting's sentences, cached by the corpus content hash."""
     from lmcr.baselines.vectors import train_word2vec
 
     digest = store_corpus_hash(res.db, "sentence")[:12]
-    path = Path(res.cache_dir or Path(res.db).parent / "baselines") / f"word2vec-{res.corpus}-{digest}.bin"
+    path = _cache_dir(res) / f"word2vec-{res.corpus}-{digest}.bin"
     if not path.exists():
         train_word2vec(corpus_sentences(res), path, seed=res.seed + 1)
     return path

@@ -17,11 +17,13 @@ frequencies are the corpus's, nothing is written by hand.
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from collections.abc import Iterable
 from pathlib import Path
 
+from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.mixture import Mixture
 from lmcr.setting import SOURCE_CORPORA
@@ -75,6 +77,22 @@ class PhraseCounts:
         finally:
             con.close()
         self.counts.update(found)
+
+    def count_cached(self, phrases: Iterable[str], cache: Path) -> None:
+        """Count the phrases, read from `cache` when it holds them for this corpus (the caller names the
+        file by the corpus content), else counted and saved there: a scan of the full store takes about a
+        second, every `lmcr complete` would pay it."""
+        phrases = sorted({p.lower() for p in phrases})
+        try:
+            saved = json.loads(Path(cache).read_text(encoding="utf-8"))
+            if saved["words"] == self.words and set(phrases) <= set(saved["counts"]):
+                self.counts.update({p: float(n) for p, n in saved["counts"].items()})
+                return
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            pass  # no cache yet, or not one of ours: count afresh and write it
+        self.count(phrases)
+        with atomic_path(cache) as tmp:
+            tmp.write_text(json.dumps({"words": self.words, "counts": self.counts}), encoding="utf-8")
 
     def log_p(self, phrase: str) -> float:
         """log P(phrase), add-one smoothed (a phrase never seen is as rare as one occurrence in N + 1)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
@@ -78,3 +79,22 @@ def test_rarity_is_a_term_of_sums_with_a_fingerprint(store):
     assert scorer_fingerprint("rarity", res).endswith(f"*{WEIGHT:g}")
     with pytest.raises(ValueError, match="rarity needs the store's sentences"):
         make_scorer("rarity", MethodResources(checkpoints=db.parent, db=db.parent / "none.duckdb", sql_dir=sql_dir))
+
+
+def test_counts_are_cached_by_the_caller_named_file_and_a_bad_cache_is_recounted(store, tmp_path):
+    cache = tmp_path / "cache" / "phrases.json"
+    first = PhraseCounts(*store)
+    first.count_cached(["pan", "cheese"], cache)
+    assert json.loads(cache.read_text())["counts"] == {"cheese": 1, "pan": 5}
+    # a second build reads the file instead of scanning: a count put there by hand shows it
+    cache.write_text(json.dumps({"words": first.words, "counts": {"pan": 7, "cheese": 1}}))
+    again = PhraseCounts(*store)
+    again.count_cached(["pan"], cache)
+    assert again.counts["pan"] == 7
+    for bad in ("{not json", json.dumps({"words": first.words + 1, "counts": {"pan": 7}}), "[1, 2]",
+                json.dumps({"words": first.words, "counts": {"pan": 7}})):  # the last lacks cheese
+        cache.write_text(bad)
+        fresh = PhraseCounts(*store)
+        fresh.count_cached(["pan", "cheese"], cache)
+        assert fresh.counts == {"pan": 5, "cheese": 1}
+        assert json.loads(cache.read_text())["counts"] == {"pan": 5, "cheese": 1}
