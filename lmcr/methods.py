@@ -173,7 +173,7 @@ def _rarity(res: MethodResources) -> Scorer:
 
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"rarity needs the store's sentences: no store at {res.db}")
-    counts = PhraseCounts(res.db, res.sql_dir, res.corpus, res.mixture)
+    counts = PhraseCounts(res.db, res.sql_dir, corpus_words(res), res.corpus, res.mixture)
     digest = store_corpus_hash(res.db, "sentence")[:12]
     # the detector's objects up front (completion then never scans), cached by the corpus content
     counts.count_cached(load_lexicon().objects, _cache_dir(res) / f"phrases-{res.corpus}-{res.mixture.label}-{digest}.json")
@@ -292,7 +292,8 @@ def robot_terms() -> set[str]:
 
 
 def corpus_words(res: MethodResources) -> dict[str, int]:
-    """Words per source corpus in the store: the sizes a mixture's shares are taken of."""
+    """Words per source corpus in the store: what a mixture's shares and the rarity term's frequencies are
+    taken of."""
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"a corpus mixture needs the store's corpus sizes: no store at {res.db}")
     con = read_connection(res.db)

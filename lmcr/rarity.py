@@ -26,7 +26,6 @@ from pathlib import Path
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.mixture import Mixture
-from lmcr.setting import SOURCE_CORPORA
 from lmcr.store import named_query, read_connection
 
 WEIGHT = 0.6
@@ -38,42 +37,30 @@ def phrase_pattern(phrases: Iterable[str]) -> str:
 
 
 class PhraseCounts:
-    """Occurrences of filler phrases in the corpus sentences of a setting (weighted per corpus under a
-    mixture), counted in one pass for every phrase not seen before and kept."""
+    """Occurrences of filler phrases in the corpus sentences of a setting (in `all`, each corpus weighted
+    as a mixture weighs it), counted in one pass for every phrase not seen before and kept. `words` is
+    the store's words per source corpus (`methods.corpus_words`)."""
 
-    def __init__(self, db: Path, sql_dir: Path, corpus: str = "all", mixture: Mixture = Mixture()):
-        self.db, self.sql_dir, self.corpus, self.mixture = Path(db), sql_dir, corpus, mixture
+    def __init__(self, db: Path, sql_dir: Path, words: dict[str, int], corpus: str = "all",
+                 mixture: Mixture = Mixture()):
+        self.db, self.sql_dir = Path(db), sql_dir
+        self.weights = {c: mixture.weight(c) for c in words} if corpus == "all" else {corpus: 1.0}
+        self.words = float(sum(w * words.get(c, 0) for c, w in self.weights.items()))
         self.counts: dict[str, float] = {}
-        self.words = self._words()
-
-    def _parts(self) -> list[str]:
-        return [self.corpus] if self.corpus != "all" or self.mixture.plain else list(SOURCE_CORPORA)
-
-    def _words(self) -> float:
-        con = read_connection(self.db)
-        try:
-            rows = con.execute("select corpus, sum(n_words) from sentences group by corpus").fetchall()
-        finally:
-            con.close()
-        by_corpus = {c: float(n or 0) for c, n in rows}
-        parts = self._parts()
-        if parts == ["all"]:
-            return sum(by_corpus.values())
-        return sum(self.mixture.weight(c) * by_corpus.get(c, 0.0) for c in parts)
 
     def count(self, phrases: Iterable[str]) -> None:
-        """Count the phrases not counted yet (one scan of the sentences for all of them)."""
+        """Count the phrases not counted yet (one query per corpus for all of them)."""
         todo = sorted({p.lower() for p in phrases} - set(self.counts))
         if not todo:
             return
         found: dict[str, float] = dict.fromkeys(todo, 0.0)
         con = read_connection(self.db)
         try:
-            for part in self._parts():
+            for part, weight in self.weights.items():
                 rows = con.execute(named_query(self.sql_dir, "phrase_counts"),
                                    {"phrases": phrase_pattern(todo), "corpus": part}).fetchall()
                 for phrase, n in rows:
-                    found[phrase] = found.get(phrase, 0.0) + self.mixture.weight(part) * n
+                    found[phrase] = found.get(phrase, 0.0) + weight * n
         finally:
             con.close()
         self.counts.update(found)

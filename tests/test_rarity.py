@@ -8,7 +8,7 @@ import math
 import pytest
 
 from lmcr.frame import Frame
-from lmcr.methods import MethodResources, make_scorer, scorer_fingerprint
+from lmcr.methods import MethodResources, corpus_words, make_scorer, scorer_fingerprint
 from lmcr.mixture import Mixture
 from lmcr.rarity import WEIGHT, PhraseCounts, phrase_pattern
 from lmcr.store import connect
@@ -31,7 +31,7 @@ def store(tmp_path):
     con.executemany("insert into sentences values (?, 's', ?, ?, 'instruction', ?, ?, 'f', 0, null, null)",
                     [(corpus, f"d{i}", i, text, len(text.split())) for i, (corpus, text) in enumerate(SENTENCES)])
     con.close()
-    return db, sql_dir
+    return db, sql_dir, corpus_words(MethodResources(checkpoints=tmp_path, db=db))
 
 
 def test_phrases_are_counted_whole_with_plurals_and_smoothed(store):
@@ -70,7 +70,7 @@ def test_rarity_lifts_the_rarer_filler_by_its_log_frequency(store):
 
 
 def test_rarity_is_a_term_of_sums_with_a_fingerprint(store):
-    db, sql_dir = store
+    db, sql_dir, _ = store
     res = MethodResources(checkpoints=db.parent, db=db, sql_dir=sql_dir)
     frames = [Frame.of("dump", {"Theme": theme, "Destination": "bowl"}) for theme in ("pan", "cheese")]
     alone = make_scorer("rarity", res)(frames)
