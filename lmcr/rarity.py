@@ -50,7 +50,7 @@ class PhraseCounts:
 
     def count(self, phrases: Iterable[str]) -> None:
         """Count the phrases not counted yet (one query per corpus for all of them)."""
-        todo = sorted({p.lower() for p in phrases} - set(self.counts))
+        todo = sorted({p.lower() for p in phrases if p.lower() not in self.counts})
         if not todo:
             return
         found: dict[str, float] = dict.fromkeys(todo, 0.0)
@@ -83,8 +83,10 @@ class PhraseCounts:
 
     def log_p(self, phrase: str) -> float:
         """log P(phrase), add-one smoothed (a phrase never seen is as rare as one occurrence in N + 1)."""
-        self.count([phrase])
-        return math.log((self.counts[phrase.lower()] + 1.0) / (self.words + 1.0))
+        key = phrase.lower()
+        if key not in self.counts:
+            self.count([key])
+        return math.log((self.counts[key] + 1.0) / (self.words + 1.0))
 
     def rarity(self, frames: list[Frame]) -> list[float]:
         """-WEIGHT * sum of log P(filler) for each frame."""
