@@ -1,12 +1,14 @@
 """Benchmark: instructions end to end through batch `lmcr execute`: completed right and executed.
 
 Usage: python bench/bench_end_to_end.py --instructions instructions_dev.jsonl [--seed 0] [--work DIR]
-       [--method M] [--urdf PATH]
+       [--method M] [--urdf PATH] [--distractors N]
 Each instruction (`{id, instruction, objects, expected, missing}`) gets a seeded random scene of its
-objects; a stated object that is not among them is the one in the robot's hand (`"holding"`). One
+objects (with `--distractors`, N more objects drawn at random from the lexicon: a crowded table, and
+candidates the instruction's author did not weigh); a stated object that is not among them is the one in
+the robot's hand (`"holding"`). One
 `lmcr execute --input IN.jsonl --output OUT.jsonl` process (the published checkpoint and store of
 $LMCR_DATA_DIR) runs them all. Prints: completed right (the frame is the expected one), executed
-successfully, both, refused before moving, errors; per predicate; then every instruction that is not
+successfully, both, executed plans that failed, refused before moving, errors; per predicate; then every instruction that is not
 both right and successful, with why.
 """
 
@@ -15,22 +17,26 @@ from __future__ import annotations
 import argparse
 import collections
 import json
+import random
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 from lmcr.jsonl import read_jsonl
+from lmcr.lexicon import load_lexicon
 
 FIELDS = {"id": str, "instruction": str, "objects": list, "expected": dict}
 
 
-def batch_line(record: dict, seed: int) -> dict:
-    """The batch input line: the instruction and a scene of its objects placed at random (seeded per
-    instruction), with a stated object that is not among them in the hand."""
+def batch_line(record: dict, seed: int, distractors: int = 0) -> dict:
+    """The batch input line: the instruction and a scene of its objects (and `distractors` random other
+    ones) placed at random (seeded per instruction), with a stated object that is not among them in the hand."""
     stated = [v for role, v in record["expected"]["roles"].items() if role != record.get("missing")]
     held = [label for label in stated if label not in record["objects"]]
-    scene = {"objects": [{"label": label} for label in record["objects"]], "seed": seed}
+    others = sorted(set(load_lexicon().objects) - set(record["objects"]) - set(stated))
+    labels = record["objects"] + random.Random(f"{seed}:distractors").sample(others, distractors)
+    scene = {"objects": [{"label": label} for label in labels], "seed": seed}
     if held:
         scene["holding"] = held[0]
     return {"id": record["id"], "instruction": record["instruction"], "scene": scene}
@@ -57,12 +63,13 @@ def main() -> None:
     args_.add_argument("--work", type=Path, help="folder for IN.jsonl / OUT.jsonl (default: a temporary one)")
     args_.add_argument("--method", help="completion method (default: lmcr execute's)")
     args_.add_argument("--urdf", help="the official Baxter URDF instead of the built-in one")
+    args_.add_argument("--distractors", type=int, default=0, help="random other objects in each scene")
     args = args_.parse_args()
     records = [r for _, r in read_jsonl(args.instructions, FIELDS)]
     work = args.work or Path(tempfile.mkdtemp(prefix="lmcr-e2e-"))
     work.mkdir(parents=True, exist_ok=True)
     inp, outp = work / "in.jsonl", work / "out.jsonl"
-    inp.write_text("".join(json.dumps(batch_line(r, args.seed * 1000 + k)) + "\n" for k, r in enumerate(records)))
+    inp.write_text("".join(json.dumps(batch_line(r, args.seed * 1000 + k, args.distractors)) + "\n" for k, r in enumerate(records)))
     outp.unlink(missing_ok=True)
     command = [sys.executable, "-m", "lmcr.cli", "execute", "--input", str(inp), "--output", str(outp)]
     command += ["--method", args.method] if args.method else []
@@ -77,15 +84,17 @@ def main() -> None:
         right = "error" not in out and out["frame"] == r["expected"]
         done = "error" not in out and out.get("success", False)
         for key, hit in (("n", True), ("right", right), ("success", done), ("both", why == "ok"),
+                         ("failed", "error" not in out and out["feasible"] and not done),
                          ("refused", "error" not in out and not out["feasible"]), ("error", "error" in out)):
             rows[key] += hit
             per[pred][key] += hit
         if why != "ok":
             misses.append(f"  {r['id']} {r['instruction']!r}: {why}")
     n = rows["n"]
-    print(f"{n} instructions, seed {args.seed}: completed right {rows['right']}/{n} = {rows['right'] / n:.3f}; "
-          f"executed successfully {rows['success']}/{n} = {rows['success'] / n:.3f}; **both {rows['both']}/{n} = "
-          f"{rows['both'] / n:.3f}**; refused before moving {rows['refused']}; errors {rows['error']}")
+    print(f"{n} instructions, seed {args.seed}, {args.distractors} distractors: completed right {rows['right']}/{n} = "
+          f"{rows['right'] / n:.3f}; executed successfully {rows['success']}/{n} = {rows['success'] / n:.3f}; "
+          f"**both {rows['both']}/{n} = {rows['both'] / n:.3f}**; executed plans that failed {rows['failed']}; "
+          f"refused before moving {rows['refused']}; errors {rows['error']}")
     for pred, c in sorted(per.items()):
         print(f"  {pred:9s} both {c['both']}/{c['n']} (right {c['right']}, succeeded {c['success']}, refused {c['refused']})")
     print("not both right and successful:" if misses else "every instruction right and successful")

@@ -305,8 +305,10 @@ def score(
     conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
 ) -> None:
     """Score complete frames with each method (higher = more plausible)."""
+    from lmcr.files import check_output_file
     from lmcr.methods import read_frames_csv, write_scores_csv
 
+    check_output_file(out, reads=frames_csv)
     ws = Workspace.from_env()
     res = ws.resources(checkpoint, corpus, vectors, conceptnet)
     columns, rows = read_frames_csv(frames_csv)
@@ -407,7 +409,7 @@ def complete(
     from lmcr.jsonl import InputError, read_jsonl, write_jsonl_atomic
     from lmcr.srl.parser import NoPredicateError
 
-    check_output_file(output)
+    check_output_file(output, reads=input)
     records = list(read_jsonl(input, required={"id": (str, int), "instruction": str, "objects": list}))
     for line, rec in records:
         if not all(isinstance(o, str) for o in rec["objects"]):
@@ -573,7 +575,7 @@ def execute(
         if path.suffix.lower() not in (".png", ".gif"):
             raise OutputError(f"{path}: --render takes a .png or .gif file name")
     if batch:
-        check_output_file(output)
+        check_output_file(output, reads=input)
         read_bytes(input)  # an unreadable input fails before the models load
     else:
         layout = load_scene(scene)
@@ -670,7 +672,7 @@ def listen(
             console.print(escape(result["question"]), highlight=False)
         print(json.dumps(result))
         return
-    check_output_file(output)
+    check_output_file(output, reads=input)
     records = read_listen_input(input)  # bad input fails before the models load
     results = listen_batch(records, input.parent, ws.recognizer(speech_model, asr), ws.parser(model))
     write_jsonl_atomic(output, results)
@@ -785,7 +787,7 @@ def srl(
             verbs = ", ".join(sorted(parser.lex.predicates))
             fail(f"no known predicate in {text!r}: the robot can {verbs}")
         return
-    check_output_file(output)
+    check_output_file(output, reads=input)
     records = [check_record_text(line, r, "text", input) for line, r in read_jsonl(input, {"id": (str, int), "text": str})]
     frames = Workspace.from_env().parser(model, resources).pipe(r["text"] for r in records)
     rows = ({"id": r["id"], "text": r["text"],

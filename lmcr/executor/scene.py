@@ -24,8 +24,11 @@ TABLE_CENTRE = (0.60, 0.0)  # in the robot's base frame (x forward), metres: as 
 TABLE_TOP = 0.75  # height above the floor
 TABLE_SIZE = (0.7, 1.2)
 X_LIMIT, Y_LIMIT = 0.3, 0.5
+ROLLING_RESISTANCE = 0.01  # of round food (spheres) on the table, metres: the lever of its contact patch
 HAND_OFF = (-1.6, 0.0)  # where a held object waits (behind the robot, on the floor) until it is put in the hand
-LAYOUT_ATTEMPTS = 20  # seeded random layouts tried before a scene's objects are said not to fit
+LAYOUT_ATTEMPTS = 20  # seeded random layouts tried before the objects are packed tight
+PACKING_ATTEMPTS = 200  # seeded tight packings tried before a scene's objects are said not to fit
+PACKING_GAP = 0.022  # between packed neighbours: the 2 cm that counts as clear, and the 3-decimal rounding
 
 # label -> (kind, size): container (width, depth, height, wall), bottle (radius, height),
 # food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
@@ -190,12 +193,14 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
                     raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
     free = [o for o in placed if o.xy is None]
-    for attempt in range(LAYOUT_ATTEMPTS):  # an unlucky early spot can leave no room for a later object
+    layouts = [(_place_at_random, attempt) for attempt in range(LAYOUT_ATTEMPTS)]
+    layouts += [(_pack_tight, attempt) for attempt in range(PACKING_ATTEMPTS)]
+    for k, (place, attempt) in enumerate(layouts):  # an unlucky early spot can leave no room for a later object
         try:
-            _place_at_random(placed, random.Random(seed if attempt == 0 else f"{seed}:{attempt}"), where)
+            place(placed, random.Random(seed if k == 0 else f"{seed}:{place.__name__}:{attempt}"), where)
             break
         except InputError:
-            if attempt == LAYOUT_ATTEMPTS - 1:
+            if k == len(layouts) - 1:
                 raise
             for obj in free:
                 obj.xy = None
@@ -207,6 +212,33 @@ def _place_at_random(placed: list[SceneObject], rng: random.Random, where: str) 
     for obj in sorted(placed, key=lambda o: -footprint(o.label)):
         if obj.xy is None:
             obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
+
+
+def _pack_tight(placed: list[SceneObject], rng: random.Random, where: str) -> None:
+    """Give the objects without a position one where it touches the table's edges or its neighbours
+    (a corner-point packing, the spot drawn at random among the free ones, big objects first): scenes
+    crowded with big things (an oven, a sink, a cutting board, ...) that uniform draws do not fit."""
+    for obj in sorted(placed, key=lambda o: -footprint(o.label)):
+        if obj.xy is None:
+            others = [o for o in placed if o.xy is not None and o is not obj]
+            spots = [xy for xy in _touching_spots(obj.label, others)
+                     if not any(_overlap(obj.label, xy, o.label, o.xy) for o in others)]
+            if not spots:
+                raise InputError(f"{where}: no free spot for the {obj.label} on the table")
+            obj.xy = rng.choice(spots)
+
+
+def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, float]]:
+    """On-table spots where `label` touches a table edge or stands PACKING_GAP from a placed object's
+    side, along x and along y (a round object packed as the square around it)."""
+    half_x, half_y, _ = outline(label)
+    xs, ys = {-X_LIMIT + half_x, X_LIMIT - half_x}, {-Y_LIMIT + half_y, Y_LIMIT - half_y}
+    for other in placed:
+        other_x, other_y, _ = outline(other.label)
+        xs |= {other.xy[0] + s * (other_x + PACKING_GAP + half_x) for s in (-1, 1)}
+        ys |= {other.xy[1] + s * (other_y + PACKING_GAP + half_y) for s in (-1, 1)}
+    on_table = [(round(x, 3), round(y, 3)) for x in sorted(xs) for y in sorted(ys)]
+    return [xy for xy in on_table if abs(xy[0]) <= X_LIMIT - half_x + 1e-9 and abs(xy[1]) <= Y_LIMIT - half_y + 1e-9]
 
 
 def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
@@ -266,8 +298,12 @@ def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
         col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half)
         vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_color(label))
     body = p.createMultiBody(0.15, col, vis, [x, y, z + height(label) / 2 + 0.001])
-    # real fruit and eggs do not roll on for ever: without rolling resistance a grazed sphere leaves the table
-    p.changeDynamics(body, -1, rollingFriction=0.002, spinningFriction=0.002)
+    # real fruit and eggs do not roll on for ever: without rolling resistance a grazed sphere leaves the
+    # table. They rest on a patch about a centimetre across, not a point: salt shaken onto an apple's top
+    # off its middle rolled a 0.002-resisted sphere off under the grains (half of them then missed it).
+    # Flat-bottomed things keep 0.002: a shaker that resists more is not nudged aside by a fish dipped in it
+    resistance = ROLLING_RESISTANCE if shape[0] == "sphere" else 0.002
+    p.changeDynamics(body, -1, rollingFriction=resistance, spinningFriction=resistance)
     return body
 
 

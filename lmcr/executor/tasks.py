@@ -104,8 +104,7 @@ class Geometry:
         """The gripper pose that grasps the held object by its top, or from the side around its body
         (high enough for the hand to clear the table)."""
         if variant.side:
-            h = height(self.held.label)
-            return self.held_top - [0, 0, h - max(SIDE_GRIP * h, SIDE_GRIP_MIN)], variant.upright()
+            return self.held_top - [0, 0, height(self.held.label) - side_grip_height(self.held.label)], variant.upright()
         return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
@@ -135,6 +134,11 @@ class Geometry:
     def centre(self, variant: Variant) -> np.ndarray:
         """The held object's middle in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
+
+
+def side_grip_height(label: str) -> float:
+    """How far above the table a side grasp holds the object: SIDE_GRIP of its height, at least SIDE_GRIP_MIN."""
+    return max(SIDE_GRIP * height(label), SIDE_GRIP_MIN)
 
 
 def _turned(orientation, yaw: float) -> tuple:
@@ -177,8 +181,8 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
     signs = (1, -1) if pours else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
            for turn in TURNS for sign in signs]
-    if not pours or 2 * footprint(held.label) > opening - 0.01:
-        return top
+    if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
+        return top  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
     x, y = world_xy(held.xy)
     heading = math.atan2(y, x)
     side = [Variant(heading + a, 0.0, sign, side=True, turn=turn) for a in (0.0, 0.5, -0.5) for turn in TURNS
