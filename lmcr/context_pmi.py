@@ -14,18 +14,17 @@ without context scores 0 for every candidate, as without the term, and so does e
 Table I. The sentence LM reads the context too, but word by word after the frame: this term sees the
 whole document a purpose and an object share, and nothing in it is written by hand.
 
-WEIGHT = 1.0
-instructions (README, Completion).
+WEIGHT = 1 (log-probability units, as the experts it is added to) of 0.5, 1 and 2 tried on the dev
+instructions, which complete the same with each (README, Completion).
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Iterable
 from pathlib import Path
 
-from lmcr.files import atomic_path
+from lmcr.files import cached_json
 from lmcr.frame import Frame
 from lmcr.lm.linearize import tokens
 from lmcr.rarity import phrase_pattern
@@ -70,21 +69,23 @@ class ContextCooccurrence:
         """The counts from `cache` when it holds them for these objects (the caller names the file by the
         corpus content and mixture), else counted (about 10 s on the full store) and saved there."""
         objects = sorted({o.lower() for o in objects})
-        try:
-            saved = json.loads(Path(cache).read_text(encoding="utf-8"))
-            if saved["objects"] == objects:
-                return cls(float(saved["docs"]), saved["words"], saved["object_docs"], saved["pairs"])
-        except (OSError, ValueError, KeyError, TypeError):
-            pass  # no cache yet, or not one of ours: count afresh and write it
-        found = cls.count(db, sql_dir, objects, corpora)
-        with atomic_path(cache) as tmp:
-            tmp.write_text(json.dumps({"objects": objects, "docs": found.docs, "words": found.word_docs,
-                                       "object_docs": found.object_docs, "pairs": found.pair_docs}), encoding="utf-8")
-        return found
+
+        def counted() -> dict:
+            found = cls.count(db, sql_dir, objects, corpora)
+            return {"objects": objects, "docs": found.docs, "words": found.word_docs,
+                    "object_docs": found.object_docs, "pairs": found.pair_docs}
+
+        def usable(saved) -> bool:
+            return saved["objects"] == objects and isinstance(saved["docs"], (int, float))
+
+        saved = cached_json(cache, usable, counted)
+        return cls(float(saved["docs"]), saved["words"], saved["object_docs"], saved["pairs"])
 
     def context_words(self, context: str) -> list[str]:
         """The context's counted words of three letters or more that are not stop words, each once, in order."""
-        from spacy.lang.en.stop_words import STOP_WORDS
+        from spacy.lang.en.stop_words import (
+            STOP_WORDS,  # imported here: building the term (`lmcr evaluate` does) needs no spaCy
+        )
 
         seen = dict.fromkeys(w for w in tokens(context) if len(w) > 2 and w.isalpha() and w not in STOP_WORDS and w in self.word_docs)
         return list(seen)

@@ -23,7 +23,6 @@ from pathlib import Path
 
 from lmcr.frame import Frame
 from lmcr.mixture import Mixture
-from lmcr.setting import SOURCE_CORPORA
 from lmcr.store import named_query, read_connection
 
 
@@ -59,13 +58,12 @@ class FrameCountScorer:
                    mixture: Mixture = Mixture()) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
         corpus's frames count as often as the mixture weighs it."""
-        parts = [corpus] if corpus != "all" or mixture.plain else list(SOURCE_CORPORA)
         fillers, pairs = [], []
         con = read_connection(db)
         try:
-            for part in parts:  # 'all' is never weighted: its weight is 1
-                fillers += _weighted_counts(con, sql_dir, "frame_fillers", part, mixture.weight(part))
-                pairs += _weighted_counts(con, sql_dir, "frame_filler_pairs", part, mixture.weight(part))
+            for part, weight in mixture.parts(corpus).items():
+                fillers += _weighted_counts(con, sql_dir, "frame_fillers", part, weight)
+                pairs += _weighted_counts(con, sql_dir, "frame_filler_pairs", part, weight)
         finally:
             con.close()
         if not fillers:

@@ -6,7 +6,7 @@ import hashlib
 import json
 import os
 import shutil
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -34,6 +34,22 @@ def atomic_path(path: Path) -> Iterator[Path]:
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def cached_json(path: Path, usable: Callable[[object], bool], make: Callable[[], object]) -> object:
+    """What `make()` returns, kept as JSON at `path`: the saved value when `usable` accepts it, else made
+    afresh and saved there (atomically). A file that is missing, not JSON, or not shaped as `usable`
+    expects (it may index into the value freely) is made again."""
+    try:
+        saved = json.loads(Path(path).read_text(encoding="utf-8"))
+        if usable(saved):
+            return saved
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        pass  # no cache yet, or not one of ours
+    made = make()
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(made), encoding="utf-8")
+    return made
 
 
 def check_output_file(path: Path, reads: Path | None = None) -> None:

@@ -193,7 +193,7 @@ def _context_pmi(res: MethodResources) -> Scorer:
 
     if res.db is None or not Path(res.db).exists():
         raise ValueError(f"context_pmi needs the store's sentences: no store at {res.db}")
-    corpora = {c: res.mixture.weight(c) for c in corpus_words(res)} if res.mixed else {res.corpus: 1.0}
+    corpora = res.mixture.parts(res.corpus)
     digest = store_corpus_hash(res.db, "sentence")[:12]
     cache = _cache_dir(res) / f"context-{res.corpus}-{res.mixture.label}-{digest}.json"
 
@@ -281,7 +281,7 @@ SCORERS: dict[str, ScorerSpec] = {
 
 METHODS = tuple(SCORERS)
 TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
-# what `lmcr evaluate` compares by default: the methods, and the default with and without the rarity term
+# what `lmcr evaluate` compares by default: the methods, and the default with and without its terms
 EVALUATED = (*METHODS[:3], "sentence_lm+frame_counts", COMPLETION_METHOD,
              *(m for m in METHODS[3:] if m not in TERMS))
 

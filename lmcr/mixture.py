@@ -73,6 +73,13 @@ class Mixture:
         """'household=30', or 'plain': how method names, fingerprints and reports name it (`parse` reads it)."""
         return ",".join(f"{c}={w:g}" for c, w in self.weights) or "plain"
 
+    def parts(self, corpus: str) -> dict[str, float]:
+        """What a count over the setting `corpus` adds up, each part with its weight: the setting itself
+        (weight 1), unless it pools corpora under weights (`all` with a mixture): then each source corpus."""
+        if corpus != "all" or self.plain:
+            return {corpus: 1.0}
+        return {c: self.weight(c) for c in SOURCE_CORPORA}
+
     def shares(self, words: dict[str, int]) -> dict[str, float]:
         """Each weighted corpus's share of the weighted words: its LM's interpolation weight."""
         total = sum(self.weight(c) * n for c, n in words.items())

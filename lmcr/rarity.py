@@ -17,13 +17,12 @@ frequencies are the corpus's, nothing is written by hand.
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from collections.abc import Iterable
 from pathlib import Path
 
-from lmcr.files import atomic_path
+from lmcr.files import cached_json
 from lmcr.frame import Frame
 from lmcr.mixture import Mixture
 from lmcr.store import named_query, read_connection
@@ -44,8 +43,8 @@ class PhraseCounts:
     def __init__(self, db: Path, sql_dir: Path, words: dict[str, int], corpus: str = "all",
                  mixture: Mixture = Mixture()):
         self.db, self.sql_dir = Path(db), sql_dir
-        self.weights = {c: mixture.weight(c) for c in words} if corpus == "all" else {corpus: 1.0}
-        self.words = float(sum(w * words.get(c, 0) for c, w in self.weights.items()))
+        self.weights = mixture.parts(corpus)
+        self.words = float(sum(mixture.weight(c) * n for c, n in words.items()) if corpus == "all" else words.get(corpus, 0))
         self.counts: dict[str, float] = {}
 
     def count(self, phrases: Iterable[str]) -> None:
@@ -70,16 +69,17 @@ class PhraseCounts:
         file by the corpus content), else counted and saved there: a scan of the full store takes about a
         second, every `lmcr complete` would pay it."""
         phrases = sorted({p.lower() for p in phrases})
-        try:
-            saved = json.loads(Path(cache).read_text(encoding="utf-8"))
-            if saved["words"] == self.words and set(phrases) <= set(saved["counts"]):
-                self.counts.update({p: float(n) for p, n in saved["counts"].items()})
-                return
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            pass  # no cache yet, or not one of ours: count afresh and write it
-        self.count(phrases)
-        with atomic_path(cache) as tmp:
-            tmp.write_text(json.dumps({"words": self.words, "counts": self.counts}), encoding="utf-8")
+
+        def counted() -> dict:
+            self.count(phrases)
+            return {"words": self.words, "counts": self.counts}
+
+        def usable(saved) -> bool:
+            counts = saved["counts"]
+            return (saved["words"] == self.words and set(phrases) <= set(counts)
+                    and all(isinstance(n, (int, float)) for n in counts.values()))
+
+        self.counts.update({p: float(n) for p, n in cached_json(cache, usable, counted)["counts"].items()})
 
     def log_p(self, phrase: str) -> float:
         """log P(phrase), add-one smoothed (a phrase never seen is as rare as one occurrence in N + 1)."""

@@ -45,7 +45,9 @@ DEVIATIONS = [
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
     "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). 'a+b' sums two methods' log-probabilities "
     f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
-    "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); "
+    "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); context_pmi is the term "
+    "that weighs what an instruction's purpose says of each filler (lmcr/context_pmi.py), 0 on the rated "
+    "frames, which have no context; "
     f"{COMPLETION_METHOD} is what `lmcr complete` uses by default.",
 ]
 

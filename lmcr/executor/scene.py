@@ -193,13 +193,13 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
                     raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
     free = [o for o in placed if o.xy is None]
-    layouts = [(_place_at_random, attempt) for attempt in range(LAYOUT_ATTEMPTS)]
-    layouts += [(_pack_tight, attempt) for attempt in range(PACKING_ATTEMPTS)]
-    for k, (place, attempt) in enumerate(layouts):  # an unlucky early spot can leave no room for a later object
+    # uniform draws first (seeded "7", "7:1", ...: a scene that fits one is laid out as it always was),
+    # then tight packings; an unlucky early spot can leave no room for a later object
+    layouts = [(_random_spot, seed if k == 0 else f"{seed}:{k}") for k in range(LAYOUT_ATTEMPTS)]
+    layouts += [(_packed_spot, f"{seed}:packed:{k}") for k in range(PACKING_ATTEMPTS)]
+    for k, (spot, layout_seed) in enumerate(layouts):
         try:
-            # the uniform draws keep their seeds ("7", "7:1", ...): a scene that fits one is laid out as ever
-            label = f"{seed}:{attempt}" if place is _place_at_random else f"{seed}:packed:{attempt}"
-            place(placed, random.Random(seed if k == 0 else label), where)
+            _place(placed, spot, random.Random(layout_seed), where)
             break
         except InputError:
             if k == len(layouts) - 1:
@@ -209,25 +209,22 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
     return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
 
 
-def _place_at_random(placed: list[SceneObject], rng: random.Random, where: str) -> None:
-    """Give the objects without a position one, big ones first (they need the room)."""
+def _place(placed: list[SceneObject], spot, rng: random.Random, where: str) -> None:
+    """Give the objects without a position one, big ones first (they need the room): `spot(label, others,
+    rng, where)` picks it clear of the objects placed so far."""
     for obj in sorted(placed, key=lambda o: -footprint(o.label)):
         if obj.xy is None:
-            obj.xy = _random_spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
+            obj.xy = spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
 
 
-def _pack_tight(placed: list[SceneObject], rng: random.Random, where: str) -> None:
-    """Give the objects without a position one where it touches the table's edges or its neighbours
-    (a corner-point packing, the spot drawn at random among the free ones, big objects first): scenes
-    crowded with big things (an oven, a sink, a cutting board, ...) that uniform draws do not fit."""
-    for obj in sorted(placed, key=lambda o: -footprint(o.label)):
-        if obj.xy is None:
-            others = [o for o in placed if o.xy is not None and o is not obj]
-            spots = [xy for xy in _touching_spots(obj.label, others)
-                     if not any(_overlap(obj.label, xy, o.label, o.xy) for o in others)]
-            if not spots:
-                raise InputError(f"{where}: no free spot for the {obj.label} on the table")
-            obj.xy = rng.choice(spots)
+def _packed_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
+    """A free spot where `label` touches the table's edges or its neighbours, drawn at random among them (a
+    corner-point packing): scenes crowded with big things (an oven, a sink, a cutting board, ...) that
+    uniform draws do not fit."""
+    spots = [xy for xy in _touching_spots(label, placed) if not any(_overlap(label, xy, o.label, o.xy) for o in placed)]
+    if not spots:
+        raise InputError(f"{where}: no free spot for the {label} on the table")
+    return rng.choice(spots)
 
 
 def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, float]]:
