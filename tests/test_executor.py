@@ -545,3 +545,28 @@ def test_a_long_object_next_to_a_neighbour_is_grasped_nearer_its_end(sim, tmp_pa
     assert isinstance(plan, Plan) and plan.variant.shift != (0.0, 0.0)
     out = run_plan(plan, banana, blender, [o for o in scene.objects if o not in (banana, blender)])
     assert out["success"], out["checks"]
+
+
+def test_a_grasp_that_would_push_the_object_away_is_not_planned(sim, tmp_path, monkeypatch):
+    """Bench seed 3, dump 13: from the left arm only leaning grasps reach the pasta, and the one closing
+    along the lean came down 2 mm beside the rim; the joints lag a few millimetres behind the path, so
+    the finger pushed the pasta out of the hand. The pick-up is simulated before the plan is taken: that
+    grasp is refused, another holds, and the dump succeeds."""
+    from lmcr.executor import plan as planning
+    from lmcr.executor.plan import Plan, Planner
+    from lmcr.executor.run import run_plan
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    layout = {"pasta": (0.205, -0.169), "pot": (0.178, 0.337), "plate": (0.12, -0.375), "oven": (-0.129, 0.23),
+              "skillet": (-0.067, -0.077), "towel": (-0.159, -0.38)}
+    scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
+    robot = build_world(scene, tmp_path)
+    pasta, pot = scene.find("pasta"), scene.find("pot")
+    holds, trials = planning._pick_up_holds, []
+    monkeypatch.setattr(planning, "_pick_up_holds", lambda *args: trials.append(holds(*args)) or trials[-1])
+    planner = Planner(robot, scene, scene.table)
+    plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
+    assert isinstance(plan, Plan) and trials == [False, True]  # the first grasp found would have pushed it away
+    out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)], planner)
+    assert out["success"] and not out["replanned_after_grasp"], out["checks"]

@@ -195,6 +195,13 @@ class Arm:
     def grasp(self, body: int, half_width: float) -> bool:
         """Close the fingers on an object `half_width` wide and attach it where it is; False when the
         object is not under the fingertips (knocked away or never reached)."""
+        if not self.close_on(body, half_width):
+            return False
+        self.attach(body)
+        return True
+
+    def close_on(self, body: int, half_width: float) -> bool:
+        """Close the fingers on an object `half_width` wide; whether it is under the fingertips then."""
         # the fingers stop 2 mm short of the object's sides
         wide, narrow = self.gaps
         shut = float(np.clip((wide - FINGER_THICKNESS - 2 * half_width - 0.004) / (wide - narrow), 0.0, 1.0))
@@ -204,10 +211,11 @@ class Arm:
             p.stepSimulation()
         ee_pos, _ = self.ee_pose()
         lo, hi = p.getAABB(body)
-        if not all(lo[k] - GRASP_SLACK <= ee_pos[k] <= hi[k] + GRASP_SLACK for k in range(3)):
-            return False
-        self.attach(body)
-        return True
+        return all(lo[k] - GRASP_SLACK <= ee_pos[k] <= hi[k] + GRASP_SLACK for k in range(3))
+
+    def open_fingers(self) -> None:
+        """Drive the fingers open (no stepping)."""
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=self.finger_open)
 
     def attach(self, body: int) -> None:
         """Hold `body` rigidly where it is relative to the gripper."""
@@ -223,7 +231,7 @@ class Arm:
         away (turned back on while it still overlaps the fingers, contact would throw it off the table)."""
         if self.constraint is not None:
             p.removeConstraint(self.constraint)
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=self.finger_open)
+        self.open_fingers()
         settle(240)
         if self.held is not None:
             robot_collisions(self.robot, self.held, True)

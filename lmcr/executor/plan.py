@@ -16,7 +16,7 @@ import pybullet as p
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
 from lmcr.executor.collision import Carried, Clearance
 from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
-from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, world_xy
+from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, footprint, world_xy
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, put_down, variants
 
 SIDES = ("left", "right")
@@ -97,6 +97,11 @@ class Planner:
                     steps = [*([Step("home", "to its start")] if start != "home" else []),
                              *task.program(g, variant, holding)]
                     result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
+                    _restore(held, standing)  # the checks of carried motions left it in the hand
+                    if isinstance(result, list) and not holding and not _pick_up_holds(arm, other, getattr(arm, start),
+                                                                                      result, held):
+                        result = Infeasible(f"the {held.label} would slip from the {arm.side} hand's grasp",
+                                            pick_steps(steps) - 2)
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, g, task)
                     if result.progress < pick_steps(steps):
@@ -218,6 +223,31 @@ class Planner:
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
+
+
+def _pick_up_holds(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject) -> bool:
+    """Whether the planned pick-up, simulated as it will run (the arm from `start` along the planned paths,
+    the other one parked, the fingers closing), leaves the object under the fingertips. The paths keep
+    clear of everything, but the joints track them to a few millimetres: a leaning grasp whose finger came
+    down 2 mm beside a pasta box's rim pushed it out of the hand. The simulation is left as it was, the
+    fingers driven open (as `run_plan` starts them)."""
+    state = p.saveState()
+    try:
+        for a, q in ((other, other.parked), (arm, start)):
+            a.set_config(q)
+            a.hold(q)
+            a.open_fingers()
+        for segment in segments:
+            if segment.step.kind == "grasp":
+                return arm.close_on(held.body, footprint(held.label))
+            if segment.step.moves:
+                arm.follow(segment.path)
+        return True
+    finally:
+        p.restoreState(state)
+        p.removeState(state)
+        for a in (arm, other):
+            a.open_fingers()
 
 
 def _other_solution(arm: Arm, position, orientation, clash) -> np.ndarray | None:

@@ -25,10 +25,11 @@ def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[Sc
     """Execute `plan` (its task); the result's `checks` hold the task's checks (and whether the `others`, the objects
     not in the task, stayed where they were) and `success` whether all passed. With the `planner`, a
     grasp that left the object in the hand otherwise than planned has the rest planned afresh."""
-    lead = plan.first or plan  # the arm that moves first starts at home, the other parked
+    lead = plan.first or plan  # the arm that moves first starts at home, the other parked, both hands open
     for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
         a.set_config(q)
         a.hold(q)
+        a.open_fingers()
     if plan.first is not None:  # an object set down out of the way or within reach; the checks start from there
         _act(plan.first, plan.first.geometry.held, Outcome(), planner=planner)
         settle(120)
