@@ -224,10 +224,17 @@ def test_killed_publish_and_promote_always_leave_a_loadable_recorded_latest(tmp_
         return proc
 
     assert start(1).wait() == 0  # one version published and promoted
+    latest = root / "sentence-all" / "LATEST"
     versions = set()
     for _ in range(5):
+        before = latest.read_text()
         proc = start(1000)
-        time.sleep(rng.uniform(1.0, 3.5))  # the first publish of a process takes ~1 s (warm-up), later ones ~0.1 s
+        # the first publish of a process takes a second or more (warm-up; longer on a busy machine), later
+        # ones ~0.1 s: kill at a random moment after this process has published one
+        deadline = time.monotonic() + 120
+        while latest.read_text() == before and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(rng.uniform(0.0, 1.5))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         loaded = ckpt.load(root / "sentence-all")
