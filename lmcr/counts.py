@@ -26,10 +26,20 @@ from lmcr.mixture import Mixture
 from lmcr.store import named_query, read_connection
 
 
-def _weighted_counts(con, sql_dir: Path, query: str, corpus: str, weight: float) -> list[tuple]:
-    """A count query's rows for one corpus, the count (last column) times the corpus's weight."""
-    rows = con.execute(named_query(sql_dir, query), {"corpus": corpus}).fetchall()
-    return [(*row[:-1], weight * row[-1]) for row in rows]
+def weighted_counts(db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: str = "all",
+                    mixture: Mixture = Mixture()) -> list[list[tuple]]:
+    """Each named count query's rows over the setting `corpus` (`all`: every corpus), the count (last
+    column) of each corpus's rows times the weight the mixture gives it."""
+    found: list[list[tuple]] = [[] for _ in queries]
+    con = read_connection(db)
+    try:
+        for part, weight in mixture.parts(corpus).items():
+            for rows, query in zip(found, queries):
+                rows += [(*row[:-1], weight * row[-1])
+                         for row in con.execute(named_query(sql_dir, query), {"corpus": part}).fetchall()]
+    finally:
+        con.close()
+    return found
 
 
 class FrameCountScorer:
@@ -58,14 +68,7 @@ class FrameCountScorer:
                    mixture: Mixture = Mixture()) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
         corpus's frames count as often as the mixture weighs it."""
-        fillers, pairs = [], []
-        con = read_connection(db)
-        try:
-            for part, weight in mixture.parts(corpus).items():
-                fillers += _weighted_counts(con, sql_dir, "frame_fillers", part, weight)
-                pairs += _weighted_counts(con, sql_dir, "frame_filler_pairs", part, weight)
-        finally:
-            con.close()
+        fillers, pairs = weighted_counts(db, sql_dir, ("frame_fillers", "frame_filler_pairs"), corpus, mixture)
         if not fillers:
             raise ValueError(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
         return cls(fillers, pairs, alpha)

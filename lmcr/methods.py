@@ -24,11 +24,12 @@ from lmcr.workspace import SPACY_MODEL
 # The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
 # command line and light commands start fast (`bench/bench_cli.py`).
 
-# What completes instructions by default: the sentence LM times the frame counts, less how common the
-# fillers are anyway (lmcr/rarity.py), plus what the instruction's purpose says of each filler
+# What completes instructions by default: the sentence LM times the frame counts times what the verbs
+# most like the predicate do with the same fillers (lmcr/similar_verbs.py), less how common the fillers
+# are anyway (lmcr/rarity.py), plus what the instruction's purpose says of each filler
 # (lmcr/context_pmi.py; 0 without one, so on the rated frames); the most accurate on the dev ratings
 # (Table I) and the dev instructions (README, Completion).
-COMPLETION_METHOD = "sentence_lm+frame_counts+rarity+context_pmi"
+COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi"
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
 
@@ -147,12 +148,32 @@ def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     return fingerprint
 
 
+def _store(res: MethodResources, method: str, what: str = "frames") -> Path:
+    """The store a count-based scorer reads, or why there is none."""
+    if res.db is None or not Path(res.db).exists():
+        raise ValueError(f"{method} needs the store's {what}: no store at {res.db}")
+    return Path(res.db)
+
+
 def _frame_counts(res: MethodResources) -> Scorer:
     from lmcr.counts import FrameCountScorer
 
-    if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"frame_counts needs the store's frames: no store at {res.db}")
-    return FrameCountScorer.from_store(res.db, res.sql_dir, res.corpus, mixture=res.mixture).score_frames
+    return FrameCountScorer.from_store(_store(res, "frame_counts"), res.sql_dir, res.corpus, mixture=res.mixture).score_frames
+
+
+def _similar_verbs(res: MethodResources) -> Scorer:
+    from lmcr.similar_verbs import MIN_PAIRS, NEIGHBOURS, SimilarVerbs
+
+    db = _store(res, "similar_verbs")
+    digest = store_corpus_hash(db, "frame")[:12]
+    cache = _cache_dir(res) / f"similar-verbs-{res.corpus}-{res.mixture.label}-{digest}-{NEIGHBOURS}-{MIN_PAIRS}.json"
+    return SimilarVerbs.cached(db, res.sql_dir, load_lexicon(), res.corpus, res.mixture, cache).score_frames
+
+
+def _similar_verbs_fingerprint(res: MethodResources) -> str:
+    from lmcr.similar_verbs import MIN_PAIRS, NEIGHBOURS, WEIGHT
+
+    return f"{store_corpus_hash(res.db, 'frame')}*{WEIGHT:g}/{NEIGHBOURS}/{MIN_PAIRS}"
 
 
 def store_corpus_hash(db: Path, linearization: str) -> str:
@@ -173,9 +194,7 @@ def _frame_corpus_hash(res: MethodResources) -> str:
 def _rarity(res: MethodResources) -> Scorer:
     from lmcr.rarity import PhraseCounts
 
-    if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"rarity needs the store's sentences: no store at {res.db}")
-    counts = PhraseCounts(res.db, res.sql_dir, corpus_words(res), res.corpus, res.mixture)
+    counts = PhraseCounts(_store(res, "rarity", "sentences"), res.sql_dir, corpus_words(res), res.corpus, res.mixture)
     digest = store_corpus_hash(res.db, "sentence")[:12]
     # the detector's objects up front (completion then never scans), cached by the corpus content
     counts.count_cached(load_lexicon().objects, _cache_dir(res) / f"phrases-{res.corpus}-{res.mixture.label}-{digest}.json")
@@ -191,8 +210,7 @@ def _rarity_fingerprint(res: MethodResources) -> str:
 def _context_pmi(res: MethodResources) -> Scorer:
     from lmcr.context_pmi import ContextCooccurrence
 
-    if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"context_pmi needs the store's sentences: no store at {res.db}")
+    _store(res, "context_pmi", "sentences")
     corpora = res.mixture.parts(res.corpus)
     digest = store_corpus_hash(res.db, "sentence")[:12]
     cache = _cache_dir(res) / f"context-{res.corpus}-{res.mixture.label}-{digest}.json"
@@ -269,6 +287,7 @@ SCORERS: dict[str, ScorerSpec] = {
     **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
        for method, lin in LM_METHODS.items()},
     "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
+    "similar_verbs": ScorerSpec(_similar_verbs, _similar_verbs_fingerprint),
     "cooccur": ScorerSpec(_cooccur),
     "word2vec": ScorerSpec(_word2vec),
     "conceptnet": ScorerSpec(_conceptnet),
@@ -281,9 +300,10 @@ SCORERS: dict[str, ScorerSpec] = {
 
 METHODS = tuple(SCORERS)
 TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
-# what `lmcr evaluate` compares by default: the methods, and the default with and without its terms
-EVALUATED = (*METHODS[:3], "sentence_lm+frame_counts", COMPLETION_METHOD,
-             *(m for m in METHODS[3:] if m not in TERMS))
+# what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
+# its third expert
+EVALUATED = (*METHODS[:4], "sentence_lm+frame_counts", COMPLETION_METHOD.replace("+similar_verbs", ""),
+             COMPLETION_METHOD, *(m for m in METHODS[4:] if m not in TERMS))
 
 
 def make_scorer(method: str, res: MethodResources) -> Scorer:
@@ -319,9 +339,7 @@ def robot_terms() -> set[str]:
 def corpus_words(res: MethodResources) -> dict[str, int]:
     """Words per source corpus in the store: what a mixture's shares and the rarity term's frequencies are
     taken of."""
-    if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"a corpus mixture needs the store's corpus sizes: no store at {res.db}")
-    con = read_connection(res.db)
+    con = read_connection(_store(res, "a corpus mixture", "corpus sizes"))
     try:
         return dict(con.execute("select corpus, sum(n_words)::bigint from sentences group by corpus").fetchall())
     finally:
@@ -330,8 +348,7 @@ def corpus_words(res: MethodResources) -> dict[str, int]:
 
 def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
     """A re-iterable source of the setting's corpus sentences (all kinds), streamed from the store."""
-    if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"this method needs the ingested corpus: no store at {res.db}")
+    _store(res, "this method", "ingested sentences")
     where = "" if res.corpus == "all" else "where corpus = ?"
 
     def stream() -> Iterator[str]:

@@ -264,7 +264,8 @@ def test_a_recording_longer_than_a_window_is_heard_window_by_window(whisper_mode
     pour, fry = read_wav(FIXTURES / "pour_me_some_water.wav"), read_wav(FIXTURES / "fry_the_egg.wav")
     gap = np.zeros(WINDOW_S * RATE - len(pour), dtype=np.int16)  # the fry command starts the second window
     heard = WhisperRecognizer(whisper_model, load_lexicon()).transcribe(np.concatenate([pour, gap, fry]))
-    assert heard.text.startswith("pour me some water") and heard.text.endswith("egg") and not heard.alternatives
+    # both windows heard, in order ("egg" or "eggs": the model's beam differs between CPUs' kernels)
+    assert heard.text.startswith("pour me some water") and "fry the egg" in heard.text and not heard.alternatives
 
 
 def test_whisper_text_is_written_as_spoken_words():

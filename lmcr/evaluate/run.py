@@ -20,6 +20,7 @@ from lmcr.methods import COMPLETION_METHOD, MethodResources, lm_experts, lm_vers
 from lmcr.mixture import Mixture
 from lmcr.rarity import WEIGHT
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
+from lmcr.similar_verbs import NEIGHBOURS
 
 SETTINGS = tuple(s.label for s in ALL_SETTINGS)
 DEVIATIONS = [
@@ -43,7 +44,9 @@ DEVIATIONS = [
     "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
     "not a like-for-like comparison.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
-    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). 'a+b' sums two methods' log-probabilities "
+    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). similar_verbs is not in the paper either: the same "
+    f"two conditionals from the pair counts of the {NEIGHBOURS} verbs whose fillers are most like the predicate's "
+    "(similarity-based smoothing, lmcr/similar_verbs.py). 'a+b' sums two methods' log-probabilities "
     f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
     "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); context_pmi is the term "
     "that weighs what an instruction's purpose says of each filler (lmcr/context_pmi.py), 0 on the rated "
