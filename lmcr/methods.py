@@ -28,7 +28,7 @@ from lmcr.workspace import SPACY_MODEL
 # most like the predicate do with the same fillers (lmcr/similar_verbs.py), less how common the fillers
 # are anyway (lmcr/rarity.py), plus what the instruction's purpose says of each filler
 # (lmcr/context_pmi.py; 0 without one, so on the rated frames); the most accurate on the dev ratings
-# (Table I) and the dev instructions (README, Completion).
+# (Table I); on the dev instructions one fewer right than without similar_verbs (README, Results).
 COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi"
 REQUIRED_COLUMNS = ("verb", "role1", "arg1", "role2", "arg2")
 
@@ -165,15 +165,14 @@ def _similar_verbs(res: MethodResources) -> Scorer:
     from lmcr.similar_verbs import MIN_PAIRS, NEIGHBOURS, SimilarVerbs
 
     db = _store(res, "similar_verbs")
-    digest = store_corpus_hash(db, "frame")[:12]
-    cache = _cache_dir(res) / f"similar-verbs-{res.corpus}-{res.mixture.label}-{digest}-{NEIGHBOURS}-{MIN_PAIRS}.json"
+    cache = _count_cache(res, "similar-verbs", "frame", f"-{NEIGHBOURS}-{MIN_PAIRS}")
     return SimilarVerbs.cached(db, res.sql_dir, load_lexicon(), res.corpus, res.mixture, cache).score_frames
 
 
 def _similar_verbs_fingerprint(res: MethodResources) -> str:
     from lmcr.similar_verbs import MIN_PAIRS, NEIGHBOURS, WEIGHT
 
-    return f"{store_corpus_hash(res.db, 'frame')}*{WEIGHT:g}/{NEIGHBOURS}/{MIN_PAIRS}"
+    return f"{_frame_corpus_hash(res)}*{WEIGHT:g}/{NEIGHBOURS}/{MIN_PAIRS}"
 
 
 def store_corpus_hash(db: Path, linearization: str) -> str:
@@ -195,9 +194,8 @@ def _rarity(res: MethodResources) -> Scorer:
     from lmcr.rarity import PhraseCounts
 
     counts = PhraseCounts(_store(res, "rarity", "sentences"), res.sql_dir, corpus_words(res), res.corpus, res.mixture)
-    digest = store_corpus_hash(res.db, "sentence")[:12]
     # the detector's objects up front (completion then never scans), cached by the corpus content
-    counts.count_cached(load_lexicon().objects, _cache_dir(res) / f"phrases-{res.corpus}-{res.mixture.label}-{digest}.json")
+    counts.count_cached(load_lexicon().objects, _count_cache(res, "phrases", "sentence"))
     return counts.rarity
 
 
@@ -212,8 +210,7 @@ def _context_pmi(res: MethodResources) -> Scorer:
 
     _store(res, "context_pmi", "sentences")
     corpora = res.mixture.parts(res.corpus)
-    digest = store_corpus_hash(res.db, "sentence")[:12]
-    cache = _cache_dir(res) / f"context-{res.corpus}-{res.mixture.label}-{digest}.json"
+    cache = _count_cache(res, "context", "sentence")
 
     @functools.cache
     def counts() -> ContextCooccurrence:  # counted (or read) at the first context: rated frames have none
@@ -366,6 +363,13 @@ def corpus_sentences(res: MethodResources) -> Callable[[], Iterator[str]]:
 def _cache_dir(res: MethodResources) -> Path:
     """Where scorers keep what they derive from the store (word2vec, phrase counts)."""
     return Path(res.cache_dir or Path(res.db).parent / "baselines")
+
+
+def _count_cache(res: MethodResources, kind: str, linearization: str, suffix: str = "") -> Path:
+    """The cache file of a count-based scorer's counts: named by the setting, the mixture and the content
+    hash of the store's sentences or frames (`linearization`), so that changed inputs are counted afresh."""
+    digest = store_corpus_hash(res.db, linearization)[:12]
+    return _cache_dir(res) / f"{kind}-{res.corpus}-{res.mixture.label}-{digest}{suffix}.json"
 
 
 def corpus_word2vec(res: MethodResources) -> Path:
