@@ -18,30 +18,11 @@ from dataclasses import replace
 from pathlib import Path
 
 from lmcr.complete import complete
-from lmcr.jsonl import read_jsonl
+from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
 from lmcr.lexicon import load_lexicon
 from lmcr.methods import COMPLETION_METHOD
 from lmcr.mixture import Mixture
 from lmcr.workspace import Workspace
-
-
-def accuracy(parser, scorer, config, path: Path) -> str:
-    rows = [r for _, r in read_jsonl(path, {"instruction": str, "objects": list, "expected": dict})]
-    answered = asked = asked_right = 0
-    wrong = []
-    for r in rows:
-        out = complete(parser, scorer, r["instruction"], r["objects"], config)
-        guessed = out["frame"] == r["expected"]
-        if out["question"]:
-            asked += 1
-            asked_right += guessed
-        else:
-            answered += guessed
-        if not guessed:
-            wrong.append(f"  {r['instruction']!r}: {out['frame']['roles']} (context {out['context']!r})")
-    right = answered + asked_right
-    return "\n".join([f"dev instructions: {right}/{len(rows)} = {right / len(rows):.3f} right "
-                      f"({answered} answered right, {asked} questions of which {asked_right} guess right)", *wrong])
 
 
 def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs: int = 200) -> str:
@@ -75,7 +56,7 @@ def main() -> None:
     parser = ws.parser()
     print(f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
           f"{'on' if config.context else 'off'}); {config.source}")
-    print(accuracy(parser, scorer, config, args.instructions))
+    print(instruction_accuracy(parser, scorer, config, load_instructions(args.instructions)).summary())
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
         print(latency(parser, scorer, config, instruction, runs=args.runs))
 

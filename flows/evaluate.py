@@ -59,12 +59,16 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 
 
 @task(name="choose-mixture")
-def mixture_task(ratings: str, res: MethodResources, ws: Workspace) -> str:
-    """Choose the household weight of the pooled setting on the ratings (`lmcr mixture`) and save it."""
-    from lmcr.evaluate.mixture import choose_and_save
+def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
+    """Choose the household weight of the pooled setting on the ratings (and the instructions: `lmcr
+    mixture`) and save it."""
+    from lmcr.evaluate.instructions import load_instructions
+    from lmcr.evaluate.mixture import DevInstructions, choose_and_save
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-    chosen, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info)
+    dev = DevInstructions(load_instructions(Path(instructions)), Path(instructions), ws.parser()) if instructions else None
+    chosen, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info,
+                                instructions=dev)
     return chosen.label
 
 
@@ -82,17 +86,19 @@ def evaluate_flow(
     data_dir: str | None = None,
     paper: str | None = None,
     mixture: bool = True,
+    instructions: str | None = None,
 ) -> dict:
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods. With `mixture`
-    and a household sentence LM published, the household weight is chosen on the same ratings first,
-    so the default completion is evaluated and calibrated under it."""
+    and a household sentence LM published, the household weight is chosen on the same ratings first
+    (and on `instructions`, a JSONL of instructions in scenes, when given), so the default completion is
+    evaluated and calibrated under it."""
     ws = Workspace.from_env(data_dir=data_dir)
     if paper:
         ws = replace(ws, paper=Path(paper))
     res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
     if mixture and corpus == "all" and (ws.checkpoints / Setting("sentence", "household").name / "LATEST").exists():
-        get_run_logger().info("household weight: %s", mixture_task(ratings or str(ws.db), res, ws))
+        get_run_logger().info("household weight: %s", mixture_task(ratings or str(ws.db), res, ws, instructions))
         res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
         if not res.mixture.plain:  # the report shows what the mixture changed
             methods = [*methods, f"{COMPLETION_METHOD}@plain"]

@@ -46,6 +46,8 @@ class PipelineParams(BaseModel):
         "nyc", "recipes_json/recipes_sample.jsonl", "recipes_json/folder", "feeding_america")])
     household: list[str] = Field(default_factory=lambda: [str(SAMPLE / "household")])
     ratings: list[str] = Field(default_factory=lambda: [str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")])
+    # instructions in scenes the household weight is chosen on besides the ratings (the repo's own set)
+    instructions: str | None = str(REPO_ROOT / "data" / "eval" / "instructions_own.jsonl")
     conceptnet: str | None = str(SAMPLE / "conceptnet" / "edges.txt")
     vectors: str | None = None
     paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
@@ -90,7 +92,7 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     lm_settings = [Setting.parse(s).label for s in params.settings]
     evaluation = evaluate_flow(methods=params.methods, settings=lm_settings, conceptnet=params.conceptnet,
                                vectors=params.vectors, per_verb=params.per_verb, seed=params.seed, data_dir=data_dir,
-                               paper=params.paper)
+                               paper=params.paper, instructions=params.instructions)
     check = executor_check_task(params.executor_instruction, params.executor_scene, data_dir)
     logger.info("executor check %r: %s", params.executor_instruction, "success" if check["success"] else "FAILED")
     create_table_artifact(key="executor-check", description=f"simulated Baxter: {params.executor_instruction!r}",

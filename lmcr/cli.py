@@ -366,10 +366,14 @@ def mixture(
     grid: str = typer.Option(",".join(f"{w:g}" for w in MIXTURE_GRID), help="Candidate weights."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
+    instructions: Path | None = typer.Option(None, help="Instructions JSONL ({instruction, objects, expected}) to "
+                                                        "choose on as well: the best mean of the two accuracies wins."),
 ) -> None:
-    """Choose how much a corpus counts in the pooled `all` setting, on rated frames; saves mixture.json
-    (read by every command that scores, and part of the completion calibration's fingerprint)."""
-    from lmcr.evaluate.mixture import choose_and_save
+    """Choose how much a corpus counts in the pooled `all` setting, on rated frames (and instructions);
+    saves mixture.json (read by every command that scores, and part of the completion calibration's
+    fingerprint)."""
+    from lmcr.evaluate.instructions import load_instructions
+    from lmcr.evaluate.mixture import DevInstructions, choose_and_save
     from lmcr.evaluate.ratings import load_ratings
     from lmcr.lexicon import load_lexicon
 
@@ -381,8 +385,12 @@ def mixture(
     rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
+    dev = DevInstructions(load_instructions(instructions), instructions, ws.parser()) if instructions else None
+    if dev is not None and not dev.records:
+        fail(f"{instructions}: no instructions")
     chosen, path = choose_and_save(rated, ratings, ws.resources(checkpoint), method, ws.data_dir, corpus, weights,
-                                   EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False))
+                                   EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False),
+                                   instructions=dev)
     console.print(f"{corpus} weight {chosen.weight(corpus):g} saved to {path}; run `lmcr evaluate` to calibrate "
                   "completion under it")
 

@@ -130,6 +130,9 @@ def _write_jsonl(path: Path, valid: list[str], at: int, bad: bytes) -> None:
 SRL_FIELDS = {"id": "a", "text": "pour the water into the cup"}
 COMPLETE_FIELDS = {"id": "a", "instruction": "pour me some water", "objects": ["cup", "plate"]}
 LISTEN_FIELDS = {"id": "a", "audio": "said.wav"}
+INSTRUCTION_FIELDS = {"instruction": "pour me some water", "objects": ["cup", "plate"],  # no id: it is not read
+                      "expected": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}}
+SAMPLE_RATINGS = Path(__file__).resolve().parents[1] / "data" / "sample" / "ratings" / "sample_ratings_mturk.csv"
 
 
 def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case) -> bool:
@@ -159,6 +162,23 @@ def test_srl_batch_rejects_malformed_jsonl(case):
 def test_complete_batch_rejects_malformed_jsonl(case):
     if _check_rejected("complete", COMPLETE_FIELDS, "instruction", "objects", case):
         _count("complete JSONL")
+
+
+@FUZZ
+@given(case=_jsonl_case(INSTRUCTION_FIELDS, "instruction", "objects"))
+def test_mixture_rejects_malformed_instructions(case):
+    """`lmcr mixture --instructions`: the dev instructions a corpus weight is chosen on; nothing is saved."""
+    valid, at, (kind, arg) = case
+    bad = _mutated_line(INSTRUCTION_FIELDS, "instruction", "objects", kind, arg)
+    if bad is None:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        _write_jsonl(tmp / "in.jsonl", valid, at, bad)
+        result = invoke(["mixture", "--ratings", str(SAMPLE_RATINGS), "--instructions", str(tmp / "in.jsonl")], tmp)
+        assert_one_line_error(result, tmp / "in.jsonl", at)
+        assert not (tmp / "data" / "mixture.json").exists()
+    _count("instructions JSONL")
 
 
 @FUZZ

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
@@ -112,3 +113,26 @@ def test_a_modifier_the_parser_kept_does_not_hide_a_detected_object(parser):
     out = complete(parser, scorer, "heat the leftover pizza", ["pizza", "microwave", "cup"])
     assert out["unresolved"] == {} and out["missing"] == "Instrument"
     assert out["frame"]["roles"]["Theme"] == "pizza" and "pizza" not in [c["object"] for c in out["candidates"]]
+
+
+def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_path):
+    from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
+    from lmcr.jsonl import InputError
+
+    def pour(destination):
+        return {"predicate": "pour", "roles": {"Theme": "water", "Destination": destination}}
+
+    lines = [{"instruction": "pour me some water", "objects": ["scissors", "cup", "bowl"], "expected": pour("cup")},
+             {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("cup")},  # asks, cup first
+             {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("glass")},  # asks, wrong guess
+             {"instruction": "pour me some water", "objects": ["bowl", "scissors"], "expected": pour("scissors")}]
+    path = tmp_path / "instructions.jsonl"
+    path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
+    done = instruction_accuracy(parser, scorer, CompletionConfig(set_threshold=0.3), load_instructions(path))
+    assert (done.total, done.answered_right, done.asked, done.asked_right, done.right) == (4, 1, 2, 1, 2)
+    assert done.accuracy == 0.5 and [roles["Destination"] for _, roles, _ in done.wrong] == ["cup", "bowl"]
+    assert done.summary().splitlines()[0] == ("dev instructions: 2/4 = 0.500 right (1 answered right, 2 questions "
+                                              "of which 1 guess right)")
+    path.write_text(json.dumps(lines[0]) + "\n" + '{"instruction": "pour it"}\n', encoding="utf-8")
+    with pytest.raises(InputError, match=r"instructions.jsonl:2"):
+        load_instructions(path)

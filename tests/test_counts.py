@@ -81,3 +81,14 @@ def test_mixture_file_round_trip_and_bad_file(tmp_path):
     (tmp_path / "mixture.json").write_text('{"weights": {"household": -1}}')
     with pytest.raises(MixtureError, match="mixture.json: not a mixture file"):
         load(tmp_path)
+
+
+def test_the_weight_with_the_best_mean_over_the_dev_sets_wins():
+    from lmcr.evaluate.mixture import best_weight
+
+    # dev ratings alone: the best Table I; with instructions: the best mean of the two (what the full store gives)
+    assert best_weight({1: {"table1": 0.924}, 3: {"table1": 0.922}}) == 1
+    both = {1: {"table1": 0.924, "instructions": 0.933}, 3: {"table1": 0.922, "instructions": 0.950},
+            10: {"table1": 0.912, "instructions": 0.950}}
+    assert best_weight(both) == 3
+    assert best_weight({1: {"table1": 0.9}, 3: {"table1": 0.9}, 10: {"table1": 0.9}}) == 1  # a tie: the plain pool

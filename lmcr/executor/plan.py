@@ -270,8 +270,8 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
     over in, by its middle (tilting either way)."""
     if holding:
-        return [v for v in variants(held) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
-    return variants(held, task.pours, opening)
+        return [v for v in variants(held, turns=task.turns) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
+    return variants(held, task.pours, opening, task.turns)
 
 
 def _grasped(arm: Arm, q, held: SceneObject) -> tuple:

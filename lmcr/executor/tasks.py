@@ -22,6 +22,7 @@ from lmcr.executor.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, h
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
 TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
 POUR_HEIGHT = 0.10  # the opening this far above the target's rim: low enough to aim, high enough for the hand
+DUMP_HEIGHTS = (0.03, 0.07, 0.11)  # the dumped object's middle this far above the target's rim, tried in turn
 SHAKE_HEIGHT = 0.18  # a shaker's opening above the target: flat targets (pizza, steak) leave the hand no room lower
 SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
 SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
@@ -162,10 +163,10 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
     return np.asarray(goal) - offset
 
 
-def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> list[Variant]:
+def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
-    forward, each tilting either way; for pouring, side grasps first where the object fits between the
+    forward, each tilting either way when the task `turns` it (pouring implies it); for pouring, side grasps first where the object fits between the
     fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
     half_x, half_y, round_ = outline(held.label)
@@ -178,7 +179,7 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0) -> li
         # a long object may also be held nearer either end, the hand then further from a neighbour
         reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
         shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
-    signs = (1, -1) if pours else (1,)
+    signs = (1, -1) if pours or turns else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
            for turn in TURNS for sign in signs]
     if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
@@ -258,8 +259,10 @@ def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -
 def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Carry the object over the target, turn the hand over and let go."""
     tilt = tilted(v)
-    turned = gripper_for(g.centre(v), tilt, g.target_top + [0, 0, 0.03 + height(g.held.label) / 2])
-    return [*pick(g, v, holding), over_target(g, v), move("turn over", turned, tilt), Step("release", "let go"),
+    # lowest first (what falls stays where it lands); higher ones when the hand, turned, would meet the rim
+    turned = tuple(gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.label) / 2])
+                   for h in DUMP_HEIGHTS)
+    return [*pick(g, v, holding), over_target(g, v), Step("move", "turn over", turned, tilt), Step("release", "let go"),
             over_target(g, v)]
 
 
@@ -356,17 +359,18 @@ class Task:
     program: Callable[[Geometry, Variant, bool], list[Step]]
     check: Callable[[SceneObject, SceneObject, Outcome], dict]
     pours: bool = False  # the held object's contents run out of its opening
+    turns: bool = False  # the held object is turned over (pouring or dumping): either way will do
 
 
 TASKS = {
-    "pour": Task("Theme", "Destination", program_pour, check_pour, pours=True),
-    "fill": Task("Theme", "Destination", program_pour, check_pour, pours=True),
-    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle, pours=True),
-    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle, pours=True),
+    "pour": Task("Theme", "Destination", program_pour, check_pour, pours=True, turns=True),
+    "fill": Task("Theme", "Destination", program_pour, check_pour, pours=True, turns=True),
+    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle, pours=True, turns=True),
+    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle, pours=True, turns=True),
     "heat": Task("Theme", "Instrument", program_place, check_in_target),
     "fry": Task("Theme", "Instrument", program_place, check_in_target),
     "blend": Task("Theme", "Destination", lambda g, v, h: program_place(g, v, h, press=True), check_in_target),
-    "dump": Task("Theme", "Destination", program_dump, check_in_target),
+    "dump": Task("Theme", "Destination", program_dump, check_in_target, turns=True),
     "dip": Task("Theme", "Destination", program_dip, check_dip),
     "brush": Task("Theme", "Destination", program_stroke, check_stroke),
     "rub": Task("Theme", "Destination", program_stroke, check_stroke),
