@@ -166,8 +166,8 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
 def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
-    forward, each tilting either way when the task `turns` it (pouring implies it); for pouring, side grasps first where the object fits between the
-    fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
+    forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
+    object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
     robot towards the object."""
     half_x, half_y, round_ = outline(held.label)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
@@ -179,7 +179,7 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
         # a long object may also be held nearer either end, the hand then further from a neighbour
         reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
         shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
-    signs = (1, -1) if pours or turns else (1,)
+    signs = (1, -1) if turns else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
            for turn in TURNS for sign in signs]
     if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
