@@ -62,11 +62,10 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
     """Choose the household weight of the pooled setting on the ratings (and the instructions: `lmcr
     mixture`) and save it."""
-    from lmcr.evaluate.instructions import load_instructions
     from lmcr.evaluate.mixture import DevInstructions, choose_and_save
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-    dev = DevInstructions(load_instructions(Path(instructions)), Path(instructions), ws.parser()) if instructions else None
+    dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None
     chosen, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info,
                                 instructions=dev)
     return chosen.label

@@ -372,7 +372,6 @@ def mixture(
     """Choose how much a corpus counts in the pooled `all` setting, on rated frames (and instructions);
     saves mixture.json (read by every command that scores, and part of the completion calibration's
     fingerprint)."""
-    from lmcr.evaluate.instructions import load_instructions
     from lmcr.evaluate.mixture import DevInstructions, choose_and_save
     from lmcr.evaluate.ratings import load_ratings
     from lmcr.lexicon import load_lexicon
@@ -385,9 +384,7 @@ def mixture(
     rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
-    dev = DevInstructions(load_instructions(instructions), instructions, ws.parser()) if instructions else None
-    if dev is not None and not dev.records:
-        fail(f"{instructions}: no instructions")
+    dev = DevInstructions.read(instructions, ws.parser) if instructions else None
     chosen, path = choose_and_save(rated, ratings, ws.resources(checkpoint), method, ws.data_dir, corpus, weights,
                                    EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False),
                                    instructions=dev)

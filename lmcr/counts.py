@@ -25,6 +25,18 @@ from lmcr.frame import Frame
 from lmcr.mixture import Mixture
 from lmcr.store import named_query, read_connection
 
+ALPHA = 5.0  # the smoothing mass (module docstring)
+
+
+def add_one(count: float, total: float, types: int) -> float:
+    """P(x) = (c(x) + 1) / (N + V + 1): a marginal that keeps some mass for a filler never seen."""
+    return (count + 1) / (total + types + 1)
+
+
+def dirichlet(count: float, total: float, prior: float, alpha: float = ALPHA) -> float:
+    """(c + alpha prior) / (total + alpha): a conditional interpolated with the distribution it backs off to."""
+    return (count + alpha * prior) / (total + alpha)
+
 
 def weighted_counts(db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: str = "all",
                     mixture: Mixture = Mixture()) -> list[list[tuple]]:
@@ -46,7 +58,7 @@ class FrameCountScorer:
     """Smoothed conditional filler probabilities from (predicate, role, value) and pair counts."""
 
     def __init__(self, fillers: Iterable[tuple[str, str, str, float]],
-                 pairs: Iterable[tuple[str, str, str, str, str, float]], alpha: float = 5.0):
+                 pairs: Iterable[tuple[str, str, str, str, str, float]], alpha: float = ALPHA):
         self.alpha = alpha
         # Counts may be weighted (a mixture), hence floats.
         self.filler: Counter[tuple[str, str, str]] = Counter()  # (v, role, value)
@@ -64,7 +76,7 @@ class FrameCountScorer:
         self.n, self.types = sum(self.value.values()), len(self.value)
 
     @classmethod
-    def from_store(cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = 5.0,
+    def from_store(cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = ALPHA,
                    mixture: Mixture = Mixture()) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
         corpus's frames count as often as the mixture weighs it."""
@@ -74,18 +86,16 @@ class FrameCountScorer:
         return cls(fillers, pairs, alpha)
 
     def p_value(self, value: str) -> float:
-        return (self.value[value] + 1) / (self.n + self.types + 1)
+        return add_one(self.value[value], self.n, self.types)
 
     def p_filler(self, v: str, role: str, value: str) -> float:
         """P(value | v, role)."""
-        prior = self.p_value(value)
-        return (self.filler[(v, role, value)] + self.alpha * prior) / (self.role_total[(v, role)] + self.alpha)
+        return dirichlet(self.filler[(v, role, value)], self.role_total[(v, role)], self.p_value(value), self.alpha)
 
     def p_given(self, v: str, given_role: str, given: str, role: str, value: str) -> float:
         """P(value | v, given_role = given, role)."""
-        backoff = self.p_filler(v, role, value)
-        seen = self.pair[(v, given_role, given, role, value)]
-        return (seen + self.alpha * backoff) / (self.given_total[(v, given_role, given, role)] + self.alpha)
+        return dirichlet(self.pair[(v, given_role, given, role, value)], self.given_total[(v, given_role, given, role)],
+                         self.p_filler(v, role, value), self.alpha)
 
     def score_frame(self, frame: Frame) -> float:
         v, roles = frame

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from lmcr.counts import weighted_counts
+from lmcr.counts import add_one, dirichlet, weighted_counts
 from lmcr.files import cached_json
 from lmcr.frame import Frame
 from lmcr.lexicon import Lexicon, PredicateSpec
@@ -48,7 +48,7 @@ from lmcr.mixture import Mixture
 WEIGHT = 0.25
 NEIGHBOURS = 20
 MIN_PAIRS = 20  # a verb seen with fewer pairs has too few fillers to compare
-ALPHA = 5.0  # Dirichlet smoothing mass, as the frame counts'
+# smoothing: lmcr/counts.py's add-one marginal and Dirichlet interpolation, with the frame counts' mass
 
 
 @dataclass(frozen=True)
@@ -99,9 +99,8 @@ class PairTable:
     def log_p(self, a: str, o: str) -> float:
         """log P(o | a) + log P(a | o), each smoothed towards the add-one marginal."""
         joint, c_a, c_o = self.pairs.get((a, o), 0.0), self.objects.get(a, 0.0), self.others.get(o, 0.0)
-        p_o = (c_o + 1) / (self.total + self.other_types + 1)
-        p_a = (c_a + 1) / (self.total + self.object_types + 1)
-        return math.log((joint + ALPHA * p_o) / (c_a + ALPHA)) + math.log((joint + ALPHA * p_a) / (c_o + ALPHA))
+        p_o, p_a = add_one(c_o, self.total, self.other_types), add_one(c_a, self.total, self.object_types)
+        return math.log(dirichlet(joint, c_a, p_o)) + math.log(dirichlet(joint, c_o, p_a))
 
     def restricted(self, words: set[str]) -> PairTable:
         """The same table holding only pairs and marginals of `words` (what a cache keeps; sizes unchanged)."""

@@ -13,6 +13,7 @@ import gzip
 import json
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import duckdb
@@ -135,8 +136,10 @@ INSTRUCTION_FIELDS = {"instruction": "pour me some water", "objects": ["cup", "p
 SAMPLE_RATINGS = Path(__file__).resolve().parents[1] / "data" / "sample" / "ratings" / "sample_ratings_mturk.csv"
 
 
-def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case) -> bool:
-    """Run `lmcr COMMAND --input --output` on one generated case; False when the mutation was valid."""
+def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case,
+                    argv: Callable[[Path, Path], list[str]] | None = None, made: str = "out.jsonl") -> bool:
+    """Run `lmcr COMMAND --input --output` (or `argv(input, folder)`) on one generated case; the file
+    `made` (in the folder) must not appear. False when the mutation was valid."""
     valid, at, (kind, arg) = case
     bad = _mutated_line(fields, text_field, list_field, kind, arg)
     if bad is None:
@@ -144,9 +147,11 @@ def _check_rejected(command: str, fields: dict, text_field: str, list_field: str
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         _write_jsonl(tmp / "in.jsonl", valid, at, bad)
-        result = invoke([command, "--input", str(tmp / "in.jsonl"), "--output", str(tmp / "out.jsonl")], tmp)
+        args = argv(tmp / "in.jsonl", tmp) if argv else [command, "--input", str(tmp / "in.jsonl"),
+                                                          "--output", str(tmp / made)]
+        result = invoke(args, tmp)
         assert_one_line_error(result, tmp / "in.jsonl", at)
-        assert not (tmp / "out.jsonl").exists()
+        assert not (tmp / made).exists()
     return True
 
 
@@ -168,17 +173,11 @@ def test_complete_batch_rejects_malformed_jsonl(case):
 @given(case=_jsonl_case(INSTRUCTION_FIELDS, "instruction", "objects"))
 def test_mixture_rejects_malformed_instructions(case):
     """`lmcr mixture --instructions`: the dev instructions a corpus weight is chosen on; nothing is saved."""
-    valid, at, (kind, arg) = case
-    bad = _mutated_line(INSTRUCTION_FIELDS, "instruction", "objects", kind, arg)
-    if bad is None:
-        return
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        _write_jsonl(tmp / "in.jsonl", valid, at, bad)
-        result = invoke(["mixture", "--ratings", str(SAMPLE_RATINGS), "--instructions", str(tmp / "in.jsonl")], tmp)
-        assert_one_line_error(result, tmp / "in.jsonl", at)
-        assert not (tmp / "data" / "mixture.json").exists()
-    _count("instructions JSONL")
+    def argv(instructions: Path, folder: Path) -> list[str]:
+        return ["mixture", "--ratings", str(SAMPLE_RATINGS), "--instructions", str(instructions)]
+
+    if _check_rejected("mixture", INSTRUCTION_FIELDS, "instruction", "objects", case, argv, "data/mixture.json"):
+        _count("instructions JSONL")
 
 
 @FUZZ

@@ -11,10 +11,11 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig
-from lmcr.evaluate.instructions import instruction_accuracy
+from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
 from lmcr.evaluate.protocol import EvalConfig, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.files import file_sha256
+from lmcr.jsonl import InputError
 from lmcr.methods import MethodResources, make_scorer
 from lmcr.mixture import GRID, Mixture, save
 
@@ -26,6 +27,15 @@ class DevInstructions:
     records: list[dict]
     path: Path
     parser: object
+
+    @classmethod
+    def read(cls, path: Path, make_parser: Callable[[], object]) -> DevInstructions:
+        """The instructions of a JSONL file (a bad line or an empty file raises InputError), and the
+        parser, made once the file is known to be good."""
+        records = load_instructions(Path(path))
+        if not records:
+            raise InputError(f"{path}: no instructions")
+        return cls(records, Path(path), make_parser())
 
 
 def choose_mixture(rated: list[RatedFrame], res: MethodResources, method: str, corpus: str = "household",
