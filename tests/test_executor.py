@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import xml.etree.ElementTree as ET
 from contextlib import nullcontext
+from dataclasses import replace
 
 import numpy as np
 import pybullet as p
@@ -532,24 +533,52 @@ def test_a_plan_found_after_failed_grasps_carries_the_object_where_it_was_graspe
         q = segment.path[-1]
 
 
-@pytest.mark.parametrize("replan", [False, True])
-def test_a_grasp_that_shifts_the_object_has_the_rest_planned_afresh(sim, tmp_path, replan):
-    """Bench seed 1, dump 7: the leaning grasp pushes the pasta 4 cm across the fingers before they hold
-    it; turned over as planned, it then sweeps into the pot's rim and pushes the pot 22 cm. Planned
-    afresh for the pasta as it sits in the hand, the dump succeeds."""
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
+def _shift_layout():
+    """Bench seed 1, dump 7: the leaning grasp pushes the pasta 4 cm across the fingers before they hold it."""
     from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
 
     layout = {"pasta": (0.118, -0.043), "pot": (0.079, 0.337), "fish": (-0.024, -0.399), "honey": (-0.251, -0.419),
               "cup": (-0.003, -0.029), "batter": (-0.222, -0.288)}
-    scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
+    return Scene([SceneObject(label, xy) for label, xy in layout.items()])
+
+
+def test_a_grasp_that_would_shift_the_object_is_planned_for_as_it_will_sit(sim, tmp_path):
+    """The simulated pick-up finds the pasta pushed across the fingers; the rest of the dump is planned
+    for it as it will sit, before anything moves, so nothing has to be planned again after the grasp."""
+    from lmcr.executor.plan import Plan, Planner, shifted
+    from lmcr.executor.run import run_plan
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    scene = _shift_layout()
     robot = build_world(scene, tmp_path)
     pasta, pot = scene.find("pasta"), scene.find("pot")
     planner = Planner(robot, scene, scene.table)
     plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
     assert isinstance(plan, Plan) and plan.variant.pitch > 0  # the leaning grasp
+    as_planned = replace(plan.geometry, grasped=None).in_hand(plan.variant)
+    assert plan.geometry.grasped is not None and shifted(as_planned, plan.geometry.grasped)
+    out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)], planner)
+    assert out["success"] and not out["replanned_after_grasp"] and out["target_moved_m"] < 0.02, out
+
+
+@pytest.mark.parametrize("replan", [False, True])
+def test_a_grasp_that_shifts_the_object_unforeseen_has_the_rest_planned_afresh(sim, tmp_path, monkeypatch, replan):
+    """When the run's grasp pushes the object otherwise than the simulated one did (here: the simulation
+    made to find it as planned), the pasta turned over as planned sweeps into the pot's rim and pushes the
+    pot 22 cm; planned afresh after the grasp for the pasta as it sits in the hand, the dump succeeds."""
+    from lmcr.executor import plan as planning
+    from lmcr.executor.plan import Plan, Planner
+    from lmcr.executor.run import run_plan
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    scene = _shift_layout()
+    robot = build_world(scene, tmp_path)
+    pasta, pot = scene.find("pasta"), scene.find("pot")
+    planner = Planner(robot, scene, scene.table)
+    monkeypatch.setattr(planning, "shifted", lambda planned, found: False)  # the simulation foresees nothing
+    plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
+    monkeypatch.undo()
+    assert isinstance(plan, Plan) and plan.variant.pitch > 0 and plan.geometry.grasped is None
     out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)],
                    planner if replan else None)
     assert out["replanned_after_grasp"] is replan
@@ -591,8 +620,13 @@ def test_a_grasp_that_would_push_the_object_away_is_not_planned(sim, tmp_path, m
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     pasta, pot = scene.find("pasta"), scene.find("pot")
-    holds, trials = planning._pick_up_holds, []
-    monkeypatch.setattr(planning, "_pick_up_holds", lambda *args: trials.append(holds(*args)) or trials[-1])
+    simulate, trials = planning._simulated_grasp, []
+
+    def spy(*args):
+        found = simulate(*args)
+        trials.append(found is not None)
+        return found
+    monkeypatch.setattr(planning, "_simulated_grasp", spy)
     planner = Planner(robot, scene, scene.table)
     plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
     assert isinstance(plan, Plan) and trials == [False, True]  # the first grasp found would have pushed it away

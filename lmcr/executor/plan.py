@@ -13,13 +13,15 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose
+from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose, rotation_error
 from lmcr.executor.collision import Carried, Clearance
 from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, footprint, world_xy
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, put_down, variants
 
 SIDES = ("left", "right")
+# an object the grasp pushed further than this (or turned more) is not where the plan has it in the hand
+SHIFTED, TURNED = 0.005, 0.05
 
 
 @dataclass
@@ -98,12 +100,12 @@ class Planner:
                              *task.program(g, variant, holding)]
                     result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
                     _restore(held, standing)  # the checks of carried motions left it in the hand
-                    if isinstance(result, list) and not holding and not _pick_up_holds(arm, other, getattr(arm, start),
-                                                                                      result, held):
-                        result = Infeasible(f"the {held.label} would slip from the {arm.side} hand's grasp",
-                                            pick_steps(steps) - 2)
+                    found = g
+                    if isinstance(result, list) and not holding:
+                        result, found = self._as_grasped(arm, other, getattr(arm, start), result, steps, task, g, variant)
+                        _restore(held, standing)
                     if isinstance(result, list):
-                        return Plan(arm, other, variant, result, carried, g, task)
+                        return Plan(arm, other, variant, result, carried, found, task)
                     if result.progress < pick_steps(steps):
                         failed_grasps.add(grasp)
                     if result.progress > best.progress:
@@ -148,16 +150,42 @@ class Planner:
         at pose `in_hand` relative to the gripper (as found): a grasp can push the object before the
         fingers hold it, and the planned motions then carry it somewhere else (into the target's rim).
         None when no plan is found; the simulation is left as it was."""
-        arm, held, state = plan.arm, plan.geometry.held, p.saveState()
-        g = replace(plan.geometry, grasped=in_hand)
-        carried = Carried(held.body, *in_hand)
+        state = p.saveState()
         try:
-            result = self._plan_variant(arm, Clearance(arm, self._obstacles(held)), plan.task.program(g, plan.variant, True),
-                                        held, g.target, carried, arm.config())
+            g = replace(plan.geometry, grasped=in_hand)
+            result = self._rest_in_hand(plan.arm, plan.task, plan.variant, g, plan.arm.config())
         finally:
             p.restoreState(state)
             p.removeState(state)
+        carried = Carried(g.held.body, *in_hand)
         return replace(plan, segments=result, carried=carried, geometry=g) if isinstance(result, list) else None
+
+    def _rest_in_hand(self, arm: Arm, task: Task, variant: Variant, g: Geometry, start: np.ndarray) -> list[Segment] | Infeasible:
+        """The task's steps after the pick-up, planned from joints `start` for the held object in the hand
+        at `g`'s grasped pose."""
+        held = g.held
+        return self._plan_variant(arm, Clearance(arm, self._obstacles(held)), task.program(g, variant, True),
+                                  held, g.target, Carried(held.body, *g.grasped), start)
+
+    def _as_grasped(self, arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], steps: list[Step],
+                    task: Task, g: Geometry, variant: Variant) -> tuple[list[Segment] | Infeasible, Geometry]:
+        """A planned pick-up checked by simulating it as it will run (`_simulated_grasp`), and the
+        geometry the rest of the plan holds for. A grasp that would leave the object outside the fingers
+        is infeasible; one whose fingers would push it (more than `shifted` allows) has the rest planned
+        before acting for the object as it will sit in the hand (infeasible when no such plan exists:
+        the old one would carry it into the target's rim, or pour beside the target)."""
+        picked = pick_steps(steps)
+        in_hand = _simulated_grasp(arm, other, start, segments, g.held)
+        if in_hand is None:
+            return Infeasible(f"the {g.held.label} would slip from the {arm.side} hand's grasp", picked - 2), g
+        if not shifted(g.in_hand(variant), in_hand):
+            return segments, g
+        found = replace(g, grasped=in_hand)
+        rest = self._rest_in_hand(arm, task, variant, found, segments[picked - 1].path[-1])
+        if isinstance(rest, Infeasible):
+            return replace(rest, reason=f"{rest.reason} (with the {g.held.label} as the fingers would push it)",
+                           progress=picked + rest.progress), g
+        return segments[:picked] + rest, found
 
     def on_table(self, name: str) -> SceneObject | None:
         """The object on the table a clash names ("the pot"; None for the table or the robot)."""
@@ -225,12 +253,13 @@ class Planner:
         return segments
 
 
-def _pick_up_holds(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject) -> bool:
-    """Whether the planned pick-up, simulated as it will run (the arm from `start` along the planned paths,
-    the other one parked, the fingers closing), leaves the object under the fingertips. The paths keep
-    clear of everything, but the joints track them to a few millimetres: a leaning grasp whose finger came
-    down 2 mm beside a pasta box's rim pushed it out of the hand. The simulation is left as it was, the
-    fingers driven open (as `run_plan` starts them)."""
+def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject) -> tuple | None:
+    """The held object's pose relative to the gripper once the planned pick-up, simulated as it will run
+    (the arm from `start` along the planned paths, the other one parked, the fingers closing), has closed
+    on it; None when it is then not under the fingertips. The paths keep clear of everything, but the
+    joints track them to a few millimetres: a leaning grasp whose finger came down 2 mm beside a pasta
+    box's rim pushed it out of the hand, and fingers closing on a bottle from a leaning hand turn it in
+    the grasp. The simulation is left as it was, the fingers driven open (as `run_plan` starts them)."""
     state = p.saveState()
     try:
         for a, q in ((other, other.parked), (arm, start)):
@@ -239,15 +268,24 @@ def _pick_up_holds(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segme
             a.open_fingers()
         for segment in segments:
             if segment.step.kind == "grasp":
-                return arm.close_on(held.body, footprint(held.label))
+                if not arm.close_on(held.body, footprint(held.label)):
+                    return None
+                return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
             if segment.step.moves:
                 arm.follow(segment.path)
-        return True
+        raise ValueError("a pick-up without a grasp")
     finally:
         p.restoreState(state)
         p.removeState(state)
         for a in (arm, other):
             a.open_fingers()
+
+
+def shifted(planned: tuple, found: tuple) -> bool:
+    """Whether an object at pose `found` in the hand is further than SHIFTED (or turned more than TURNED)
+    from the pose `planned` there."""
+    turned = float(np.linalg.norm(rotation_error(found[1], planned[1])))
+    return float(np.linalg.norm(np.subtract(found[0], planned[0]))) > SHIFTED or turned > TURNED
 
 
 def _other_solution(arm: Arm, position, orientation, clash) -> np.ndarray | None:

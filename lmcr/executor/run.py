@@ -6,15 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.arm import relative_pose, rotation_error, settle
-from lmcr.executor.plan import Plan, Planner, pick_steps
+from lmcr.executor.arm import relative_pose, settle
+from lmcr.executor.plan import Plan, Planner, pick_steps, shifted
 from lmcr.executor.scene import SceneObject, footprint
 from lmcr.executor.tasks import Outcome
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
-# an object the grasp pushed further than this (or turned more) is not where the plan has it in the hand
-SHIFTED, TURNED = 0.005, 0.05
 # a poured drop or grain, 6 mm across: twice that, they piled up like marbles and rolled off round food
 # (cinnamon shaken over an apple: 0.21-0.38 stayed on it, 0.75-0.96 at this size)
 GRAIN_RADIUS = 0.003
@@ -88,19 +86,10 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
         k += 1
         if k == picked and planner is not None:
             in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
-            again = planner.replan_in_hand(plan, in_hand) if _shifted(plan, in_hand) else None
+            again = planner.replan_in_hand(plan, in_hand) if shifted(plan.geometry.in_hand(plan.variant), in_hand) else None
             if again is not None:
                 plan, segments[k:], out.replanned = again, again.segments, True
     return grasped, released, knocked_during
-
-
-def _shifted(plan: Plan, in_hand: tuple) -> bool:
-    """Whether the held object, at pose `in_hand` relative to the gripper, is further than SHIFTED (or
-    turned more than TURNED) from where the plan has it."""
-    planned_pos, planned_orn = plan.geometry.in_hand(plan.variant)
-    pos, orn = in_hand
-    turned = float(np.linalg.norm(rotation_error(orn, planned_orn)))
-    return float(np.linalg.norm(np.subtract(pos, planned_pos))) > SHIFTED or turned > TURNED
 
 
 def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
