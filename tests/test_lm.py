@@ -114,7 +114,7 @@ def test_target_perplexity_stops_training(overfit):
 def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     model, vocab, _ = overfit
     path = ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})
-    scorer = LMScorer(ckpt.load(path))
+    scorer = LMScorer(ckpt.load(path), precision="fp32")
     texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
     with torch.no_grad():
         direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
@@ -130,10 +130,26 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     assert cup > scissors
 
 
+def test_a_bf16_decoder_scores_within_rounding_of_fp32(overfit, tmp_path):
+    """The decoder multiplied in bfloat16 (the default where the CPU has it) moves a text's
+    log-probability by rounding only; the LSTM and the softmax stay fp32, the checkpoint is unchanged."""
+    model, vocab, _ = overfit
+    loaded = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}))
+    exact, rounded = LMScorer(loaded, precision="fp32"), LMScorer(loaded, precision="bf16")
+    assert rounded._decoder[0].dtype == torch.bfloat16 and loaded.model.decoder.weight.dtype == torch.float32
+    texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
+    assert rounded.score(texts) == pytest.approx(exact.score(texts), abs=0.02 * 6)  # ~0.01 a token
+    assert rounded.score(texts) != exact.score(texts)  # it did multiply in bf16
+    frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors")]
+    assert rounded.score_frames(frames, "for my tea") == pytest.approx(exact.score_frames(frames, "for my tea"), abs=0.2)
+    with pytest.raises(ValueError, match="precision"):
+        LMScorer(loaded, precision="fp8")
+
+
 def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, tmp_path):
     model, vocab, _ = overfit
     frame = ("pour", {"Theme": "water", "Destination": "cup"})
-    kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
     assert kept.score_frames([frame], context="") == kept.score(["pour water into the cup"])
     assert kept.score_frames([frame], context="for my tea") == pytest.approx(kept.score(["pour water into the cup for my tea"]))
     # Past the LM's best CONTEXT_TOP frames, a frame gets the lowest context term of those.
@@ -143,12 +159,12 @@ def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, t
     assert all(g == pytest.approx(min(x for _, x in gains[:CONTEXT_TOP])) for _, g in gains[CONTEXT_TOP:])
     dropped = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}, articles=False))
     assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == ["pour", "milk", "into", "cup"]
-    assert LMScorer(dropped).score_frames([frame]) == kept.score(["pour water into cup"])
+    assert LMScorer(dropped, precision="fp32").score_frames([frame]) == kept.score(["pour water into cup"])
 
 
 def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, tmp_path):
     model, vocab, _ = overfit
-    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
     scorer.vocab = Vocab(vocab.words, unk_types=50)  # "kettle" is unknown: its <unk> share is charged too
     # A frame whose text is inside another's ("pour water into the cup" / "... cup lid"), one that shares
     # no more than the predicate, and a context with an unknown word.
@@ -192,7 +208,7 @@ def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monke
 ])
 def test_shared_prefix_scoring_equals_a_plain_forward_pass(overfit, tmp_path, texts):
     model, vocab, _ = overfit
-    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
     with torch.no_grad():
         direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
     before = torch.backends.mkldnn.enabled
