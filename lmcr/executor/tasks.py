@@ -46,6 +46,9 @@ class Step:
     touches: str = ""
     probe: str = ""  # a name to record the held object's pose under once the pose is reached
     particles: int = 0
+    # the held object goes into the target through its opening: though the motion may touch the target
+    # (what is in it), the object must pass the walls clear
+    into: bool = False
 
     @property
     def moves(self) -> bool:
@@ -196,8 +199,8 @@ def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:
                 touches)
 
 
-def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "") -> Step:
-    return Step("move", name, (np.asarray(position, dtype=float),), orientation, touches, probe)
+def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "", into: bool = False) -> Step:
+    return Step("move", name, (np.asarray(position, dtype=float),), orientation, touches, probe, into=into)
 
 
 def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -271,7 +274,7 @@ def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     orn, t = v.at_target(), g.target_top
     dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
-    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip"),
+    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=True),
             move("lift out", out, orn, touches="target", probe="lifted")]
 
 
