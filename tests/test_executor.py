@@ -657,3 +657,20 @@ def test_a_held_object_goes_into_a_container_only_where_it_fits_the_opening(sim,
     assert isinstance(plan, Plan) and (plan.arm.side == "right") is checked
     out = run_plan(plan, chicken, batter, [o for o in scene.objects if o not in (chicken, batter)], planner)
     assert out["success"] is checked and (out["target_moved_m"] < 0.02) is checked, out
+
+
+def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fit(sim, tmp_path):
+    """Dev 060, "dip the fish so it gets a nice crust": the flour is a shaker here, narrower than the
+    fish, so nothing can go in through an opening; the fish is pressed into it as before, while a dip
+    into the batter's bowl passes its walls."""
+    from lmcr.executor.plan import Infeasible, Plan, Planner
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    scene = Scene([SceneObject("fish", (0.1, -0.15)), SceneObject("flour", (0.1, 0.15)), SceneObject("batter", (-0.1, 0.2))])
+    robot = build_world(scene, tmp_path)
+    planner = Planner(robot, scene, scene.table)
+    flour = planner.plan(PROGRAMS["dip"], scene.find("fish"), scene.find("flour"), holding=False)
+    assert isinstance(flour, Plan) and [s.step.into for s in flour.segments if s.step.name == "dip"] == [False]
+    batter = planner.plan(PROGRAMS["dip"], scene.find("fish"), scene.find("batter"), holding=False)
+    assert isinstance(batter, Infeasible) and "would not fit into the batter" in batter.reason, batter

@@ -270,11 +270,12 @@ def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 
 
 def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
-    """Lower the held object below the target's rim, then lift it back out."""
+    """Lower the held object below the target's rim, then lift it back out. Into a container (a bowl of
+    batter) it must pass the walls; food that is not served in one (flour, a shaker here) it presses into."""
     orn, t = v.at_target(), g.target_top
     dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
-    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=True),
+    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=g.target.label in CONTAINERS),
             move("lift out", out, orn, touches="target", probe="lifted")]
 
 
