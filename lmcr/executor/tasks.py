@@ -275,7 +275,8 @@ def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     orn, t = v.at_target(), g.target_top
     dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
-    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=g.target.label in CONTAINERS),
+    into = g.target.label in CONTAINERS
+    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=into),
             move("lift out", out, orn, touches="target", probe="lifted")]
 
 

@@ -18,8 +18,9 @@ Precision (`precision`): "auto" multiplies the decoder in bfloat16 where the CPU
 training's "auto"), else fp32; the LSTM, the softmax and the sums stay fp32. A completion's decoder
 pass has few rows, so it is bound by reading the 14k x 256 weight matrix, and bf16 halves that:
 completion with context over 40 objects took 17.5 ms against 26.5 ms in fp32 on a 2-core AVX512-BF16
-CPU (`bench/bench_complete.py`; Fig. 4 moved by at most 0.004). Log-probabilities move by about 0.01 per token; Table I (0.922 for
-the default method, 0.846 for the sentence LM) and the dev instructions (57/60) are the same either way.
+CPU (`bench/bench_complete.py`). Log-probabilities move by about 0.01 per token; Table I (0.922 for
+the default method, 0.846 for the sentence LM) and the dev instructions (57/60) are the same either
+way, Fig. 4 moved by at most 0.004.
 """
 
 from __future__ import annotations
