@@ -4,6 +4,7 @@ the 11 predicates executed in simulation from a published checkpoint's completio
 from __future__ import annotations
 
 import json
+import math
 import xml.etree.ElementTree as ET
 from contextlib import nullcontext
 from dataclasses import replace
@@ -586,15 +587,16 @@ def test_a_grasp_that_shifts_the_object_unforeseen_has_the_rest_planned_afresh(s
 
 
 def test_a_long_object_next_to_a_neighbour_is_grasped_nearer_its_end(sim, tmp_path):
-    """The garlic lies 2 cm beside the banana's middle: held there, a finger would come against the
-    garlic, so the plan holds the banana nearer an end, and that works."""
+    """The garlic lies 1 cm beside the banana's middle: held there, a finger (even closed to the
+    banana's width) would come within a centimetre of the garlic, so the plan holds the banana nearer an
+    end, and that works."""
     from lmcr.executor.plan import Plan, Planner
     from lmcr.executor.run import run_plan
     from lmcr.executor.scene import Scene, SceneObject
     from lmcr.executor.tasks import TASKS as PROGRAMS
 
     layout = {"banana": (0.216, -0.223), "blender": (-0.167, 0.406), "sink": (0.07, 0.141), "pot": (-0.004, -0.256),
-              "glass": (0.26, -0.461), "garlic": (0.216, -0.16)}
+              "glass": (0.26, -0.461), "garlic": (0.216, -0.17)}
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     banana, blender = scene.find("banana"), scene.find("blender")
@@ -674,3 +676,42 @@ def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fi
     assert isinstance(flour, Plan) and [s.step.into for s in flour.segments if s.step.name == "dip"] == [False]
     batter = planner.plan(PROGRAMS["dip"], scene.find("fish"), scene.find("batter"), holding=False)
     assert isinstance(batter, Infeasible) and "would not fit into the batter" in batter.reason, batter
+
+
+@pytest.mark.parametrize("shaped", [True, False])
+def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_width(sim, tmp_path, monkeypatch, shaped):
+    """Bench seed 1, blend 11: the banana lies 2.3 cm from the sink's wall, along it. Fully open, a
+    finger would come within a centimetre of the wall wherever the banana is held; a top grasp's
+    fingertips stop above the object, so the hand comes with its fingers set 2 mm wider than the banana,
+    and the blend succeeds. Set open, the grasp is refused."""
+    from lmcr.executor.plan import Infeasible, Plan, Planner
+    from lmcr.executor.run import run_plan
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    layout = {"banana": (-0.1, 0.06), "blender": (0.117, -0.277), "tomato": (0.245, 0.327), "sink": (-0.019, 0.251),
+              "steak": (-0.075, -0.177), "ice": (0.249, -0.196)}
+    scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
+    robot = build_world(scene, tmp_path)
+    banana, blender = scene.find("banana"), scene.find("blender")
+    if not shaped:
+        monkeypatch.setattr(tasks.Variant, "approach_width", lambda self, label: None)
+    plan = Planner(robot, scene, scene.table).plan(PROGRAMS["blend"], banana, blender, holding=False)
+    if not shaped:
+        assert isinstance(plan, Infeasible) and "against the sink" in plan.reason, plan
+        return
+    assert isinstance(plan, Plan) and plan.half_width == pytest.approx(0.0175)
+    assert plan.fingers != plan.arm.finger_open
+    out = run_plan(plan, banana, blender, [o for o in scene.objects if o not in (banana, blender)])
+    assert out["success"], out["checks"]
+
+
+@pytest.mark.parametrize(("label", "yaw", "half"), [("banana", 0.0, 0.0175), ("banana", math.pi, 0.0175),
+                                                    ("cup", math.pi / 2, None)])
+def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
+    """A long object is held across its narrow side; a round one by its radius, from any heading."""
+    from lmcr.executor.scene import footprint
+    from lmcr.executor.tasks import Variant
+
+    assert Variant(yaw).half_across(label) == pytest.approx(half if half is not None else footprint(label))
+    assert Variant(yaw, side=True).approach_width(label) is None

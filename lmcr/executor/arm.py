@@ -25,6 +25,7 @@ JOINT_STEP = 0.012  # radians per control tick pair while following a path (abou
 SETTLED = 0.002  # radians: the joints have arrived
 IK_RESTARTS, IK_RESTART_SEED = 4, 0  # other starts for a pose whose first IK solution clashes
 FINGER_THICKNESS = 0.01  # metres, both grippers' finger pads
+FINGER_SLACK = 0.002  # metres a closing finger stops short of the object's side
 GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside the object's box to hold it
 
 
@@ -202,20 +203,33 @@ class Arm:
 
     def close_on(self, body: int, half_width: float) -> bool:
         """Close the fingers on an object `half_width` wide; whether it is under the fingertips then."""
-        # the fingers stop 2 mm short of the object's sides
-        wide, narrow = self.gaps
-        shut = float(np.clip((wide - FINGER_THICKNESS - 2 * half_width - 0.004) / (wide - narrow), 0.0, 1.0))
-        targets = [o + (s - o) * shut for o, s in zip(self.finger_open, self.finger_shut)]
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=targets)
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL,
+                                    targetPositions=self.finger_targets(half_width))
         for _ in range(60):
             p.stepSimulation()
         ee_pos, _ = self.ee_pose()
         lo, hi = p.getAABB(body)
         return all(lo[k] - GRASP_SLACK <= ee_pos[k] <= hi[k] + GRASP_SLACK for k in range(3))
 
+    def finger_targets(self, half_width: float | None) -> list[float]:
+        """Finger joint targets that stop FINGER_SLACK short of both sides of an object `half_width`
+        wide (as open as they go when it is wider, or for None)."""
+        if half_width is None:
+            return list(self.finger_open)
+        wide, narrow = self.gaps
+        shut = float(np.clip((wide - FINGER_THICKNESS - 2 * half_width - 2 * FINGER_SLACK) / (wide - narrow), 0.0, 1.0))
+        return [o + (s - o) * shut for o, s in zip(self.finger_open, self.finger_shut)]
+
+    def shape_fingers(self, targets: list[float], now: bool = False) -> None:
+        """Drive the fingers to joint `targets` (no stepping); `now`: also put them there (planning)."""
+        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=targets)
+        if now:
+            for j, v in zip(self.fingers, targets):
+                p.resetJointState(self.robot, j, v)
+
     def open_fingers(self) -> None:
         """Drive the fingers open (no stepping)."""
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=self.finger_open)
+        self.shape_fingers(self.finger_open)
 
     def attach(self, body: int) -> None:
         """Hold `body` rigidly where it is relative to the gripper."""
@@ -226,12 +240,13 @@ class Arm:
         robot_collisions(self.robot, body, False)  # held in the hand, it must not push the arm around
         self.held = body
 
-    def release(self) -> None:
-        """Open the fingers and let go; the object touches the robot again only once it has dropped
-        away (turned back on while it still overlaps the fingers, contact would throw it off the table)."""
+    def release(self, fingers: list[float] | None = None) -> None:
+        """Let go, the fingers back to `fingers` (the shape they approached in; open by default); the
+        object touches the robot again only once it has dropped away (turned back on while it still
+        overlaps the fingers, contact would throw it off the table)."""
         if self.constraint is not None:
             p.removeConstraint(self.constraint)
-        self.open_fingers()
+        self.shape_fingers(fingers or self.finger_open)
         settle(240)
         if self.held is not None:
             robot_collisions(self.robot, self.held, True)

@@ -16,14 +16,15 @@ import pybullet as p
 from lmcr.executor.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose, rotation_error
 from lmcr.executor.collision import Carried, Clearance
 from lmcr.executor.planner import PLAN_CHECKS, joint_path, segment_clash
-from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, footprint, world_xy
+from lmcr.executor.scene import TABLE_TOP, Scene, SceneObject, world_xy
 from lmcr.executor.tasks import GRIP_GAP, Geometry, Step, Task, Variant, put_down, variants
 
 SIDES = ("left", "right")
 # an object the grasp pushed further than this (or turned more) is not where the plan has it in the hand
 SHIFTED, TURNED = 0.005, 0.05
-# an object put into a container passes its walls this far clear, checked at this many points of the way
-FIT_MARGIN, FIT_SAMPLES = 0.002, 9
+# an object put into a container passes its walls this far clear, on a straight line through waypoints
+# this far apart (a joint-space segment between far-apart poses bows off the line by millimetres)
+FIT_MARGIN, INTO_STEP = 0.002, 0.01
 
 
 @dataclass
@@ -43,6 +44,16 @@ class Plan:
     geometry: Geometry
     task: Task
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
+
+    @property
+    def fingers(self) -> list[float]:
+        """The finger joint targets the hand approaches the grasp with (and goes back to on letting go)."""
+        return approach_fingers(self.arm, self.variant, self.geometry.held.label)
+
+    @property
+    def half_width(self) -> float:
+        """Half the held object's width between the fingers as they hold it."""
+        return self.variant.half_across(self.geometry.held.label)
 
     @property
     def moving_arms(self) -> list[Arm]:
@@ -84,6 +95,7 @@ class Planner:
             saved = _save(held)
             try:
                 other.set_config(other.parked)
+                other.shape_fingers(other.finger_open, now=True)
                 arm.set_config(getattr(arm, start))
                 if holding:
                     _put_in_hand(arm, held)
@@ -97,6 +109,8 @@ class Planner:
                         continue  # the same pick-up failed already: only the later steps differ
                     # the last attempt's checks left the held object in its hand: it stands where it started
                     _restore(held, standing)
+                    # the fingers as they will be on the way: collision checks see them so
+                    arm.shape_fingers(approach_fingers(arm, variant, held.label), now=True)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
                     steps = [*([Step("home", "to its start")] if start != "home" else []),
                              *task.program(g, variant, holding)]
@@ -104,7 +118,8 @@ class Planner:
                     _restore(held, standing)  # the checks of carried motions left it in the hand
                     found = g
                     if isinstance(result, list) and not holding:
-                        result, found = self._as_grasped(arm, other, getattr(arm, start), result, steps, task, g, variant)
+                        result, found = self._as_grasped(arm, other, getattr(arm, start), result, steps, task, g,
+                                                         variant)
                         _restore(held, standing)
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, found, task)
@@ -114,6 +129,7 @@ class Planner:
                         best = result
             finally:
                 arm.set_config(arm.home)
+                arm.shape_fingers(arm.finger_open, now=True)
                 _restore(held, saved)
         return best
 
@@ -177,7 +193,7 @@ class Planner:
         before acting for the object as it will sit in the hand (infeasible when no such plan exists:
         the old one would carry it into the target's rim, or pour beside the target)."""
         picked = pick_steps(steps)
-        in_hand = _simulated_grasp(arm, other, start, segments, g.held)
+        in_hand = _simulated_grasp(arm, other, start, segments, g.held, variant)
         if in_hand is None:
             return Infeasible(f"the {g.held.label} would slip from the {arm.side} hand's grasp", picked - 2), g
         if not shifted(g.in_hand(variant), in_hand):
@@ -241,12 +257,15 @@ class Planner:
                     continue
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
                 # object ignored could sweep through it
-                path = joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
-                if path is None:
-                    blocker = segment_clash(clash, q, goal)
+                into = step.into and carried is not None
+                path = (_straight_line(arm, q, goal, position, step.orientation) if into
+                        else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS))
+                blocker = _path_clash(clash, path) if into and path is not None else None
+                if path is None or blocker:
+                    blocker = blocker or segment_clash(clash, q, goal)
                     why, reach = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)", False
                     continue
-                if step.into and carried is not None and not _fits_through(arm, path, carried, target):
+                if into and not _fits_through(arm, path, carried, target):
                     why, reach, blocker = f"the {held.label} would not fit into the {target.label}", False, _named(target)
                     continue
                 found = (path, goal, position)
@@ -258,7 +277,8 @@ class Planner:
         return segments
 
 
-def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject) -> tuple | None:
+def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject,
+                     variant: Variant) -> tuple | None:
     """The held object's pose relative to the gripper once the planned pick-up, simulated as it will run
     (the arm from `start` along the planned paths, the other one parked, the fingers closing), has closed
     on it; None when it is then not under the fingertips. The paths keep clear of everything, but the
@@ -267,13 +287,14 @@ def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Seg
     the grasp. The simulation is left as it was, the fingers driven open (as `run_plan` starts them)."""
     state = p.saveState()
     try:
-        for a, q in ((other, other.parked), (arm, start)):
+        for a, q, fingers in ((other, other.parked, other.finger_open),
+                              (arm, start, approach_fingers(arm, variant, held.label))):
             a.set_config(q)
             a.hold(q)
-            a.open_fingers()
+            a.shape_fingers(fingers, now=True)
         for segment in segments:
             if segment.step.kind == "grasp":
-                if not arm.close_on(held.body, footprint(held.label)):
+                if not arm.close_on(held.body, variant.half_across(held.label)):
                     return None
                 return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
             if segment.step.moves:
@@ -286,6 +307,11 @@ def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Seg
             a.open_fingers()
 
 
+def approach_fingers(arm: Arm, variant: Variant, label: str) -> list[float]:
+    """The finger joint targets `arm` approaches a `label` object's grasp with, in this `variant`."""
+    return arm.finger_targets(variant.approach_width(label))
+
+
 def shifted(planned: tuple, found: tuple) -> bool:
     """Whether an object at pose `found` in the hand is further than SHIFTED (or turned more than TURNED)
     from the pose `planned` there."""
@@ -293,19 +319,38 @@ def shifted(planned: tuple, found: tuple) -> bool:
     return float(np.linalg.norm(np.subtract(found[0], planned[0]))) > SHIFTED or turned > TURNED
 
 
+def _straight_line(arm: Arm, start: np.ndarray, goal: np.ndarray, position, orientation) -> list[np.ndarray] | None:
+    """Joints that move the gripper from where it is at `start` to `position` along the straight line,
+    a waypoint every INTO_STEP (each solved from the last, the last one `goal`); None when one is out of
+    reach."""
+    arm.set_config(start)
+    here, turned = arm.ee_pose()
+    n = max(1, int(np.ceil(np.linalg.norm(np.asarray(position) - here) / INTO_STEP)))
+    path = [np.asarray(start, dtype=float)]
+    for k in range(1, n):
+        f = k / n
+        q, err_pos, err_rot = arm.solve(here + (np.asarray(position) - here) * f,
+                                        p.getQuaternionSlerp(turned, orientation, f), [path[-1]])
+        if err_pos > IK_POSITION or err_rot > IK_ROTATION:
+            return None
+        path.append(q)
+    return [*path, np.asarray(goal, dtype=float)]
+
+
+def _path_clash(clash, path: list[np.ndarray]) -> str | None:
+    """The first thing a motion through the waypoints of `path` comes too close to, or None."""
+    return next((hit for a, b in zip(path, path[1:]) if (hit := segment_clash(clash, a, b))), None)
+
+
 def _fits_through(arm: Arm, path: list[np.ndarray], carried: Carried, target: SceneObject) -> bool:
     """Whether the carried object, moved along the joint-space `path`, stays FIT_MARGIN clear of the
-    target (its walls, as it goes in through the opening): a 12 cm chicken turned off a 12.8 cm bowl's
-    axes meets the wall, sticks and pushes the bowl. Checked at FIT_SAMPLES configurations."""
-    points = np.asarray(path)
-    for t in np.linspace(0.0, len(points) - 1.0, FIT_SAMPLES):
-        k = min(int(t), len(points) - 2) if len(points) > 1 else 0
-        q = points[k] + (points[min(k + 1, len(points) - 1)] - points[k]) * (t - k)
+    target (its walls, as it goes in through the opening), checked as every motion is: a 12 cm chicken
+    turned off a 12.8 cm bowl's axes meets the wall, sticks and pushes the bowl."""
+    def near_walls(q) -> str | None:
         arm.set_config(q)
         carried.place(arm)
-        if p.getClosestPoints(carried.body, target.body, FIT_MARGIN):
-            return False
-    return True
+        return _named(target) if p.getClosestPoints(carried.body, target.body, FIT_MARGIN) else None
+    return _path_clash(near_walls, path) is None
 
 
 def _other_solution(arm: Arm, position, orientation, clash) -> np.ndarray | None:

@@ -8,7 +8,7 @@ import pybullet as p
 
 from lmcr.executor.arm import relative_pose, settle
 from lmcr.executor.plan import Plan, Planner, pick_steps, shifted
-from lmcr.executor.scene import SceneObject, footprint
+from lmcr.executor.scene import SceneObject
 from lmcr.executor.tasks import Outcome
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
@@ -16,6 +16,7 @@ MOVED = 0.02  # metres: an object not in the task that moved further was knocked
 # a poured drop or grain, 6 mm across: twice that, they piled up like marbles and rolled off round food
 # (cinnamon shaken over an apple: 0.21-0.38 stayed on it, 0.75-0.96 at this size)
 GRAIN_RADIUS = 0.003
+FINGERS_SET = 60  # simulation steps (1/4 s) for the fingers to take their shape before the arm moves
 
 
 def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject],
@@ -58,9 +59,13 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
     step during which it was first seen moved. Once the object is picked up, when it sits in the hand
     otherwise than planned, the rest is planned afresh (kept as planned when no new plan is found)."""
     arm = plan.arm
-    if plan.carried is not None:
+    if plan.carried is not None:  # handed over: the fingers are closed on it from the start
+        arm.shape_fingers(arm.finger_targets(plan.half_width), now=True)
         plan.carried.place(arm)
         arm.attach(held.body)
+    else:  # the hand takes the shape it was planned to approach in before it moves
+        arm.shape_fingers(plan.fingers)
+        settle(FINGERS_SET)
     grasped, released = True, False
     knocked_during: dict[str, str] = {}
     segments, picked = list(plan.segments), pick_steps([s.step for s in plan.segments])
@@ -73,11 +78,11 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
             if step.probe:
                 out.probes[step.probe] = (p.getBasePositionAndOrientation(held.body)[0], p.getAABB(held.body))
         elif step.kind == "grasp":
-            grasped = arm.grasp(held.body, footprint(held.label))
+            grasped = arm.grasp(held.body, plan.half_width)
             if not grasped:
                 break  # nothing in the hand: the rest of the program would act out nothing
         elif step.kind == "release":
-            arm.release()
+            arm.release(plan.fingers)
             released = True
         elif step.kind == "spill":
             out.particles += spill(held, plan.geometry.opening, step.particles)

@@ -68,6 +68,20 @@ class Variant:
     turn: float = 0.0  # how far the hand turns about the vertical between the grasp and the target
     shift: tuple = (0.0, 0.0)  # a top grasp this far (x, y metres) from the top's middle, along a long object
 
+    def half_across(self, label: str) -> float:
+        """Half the object's width between the fingers: a round one's radius, or a box's extent along
+        the line a top grasp's fingers close on (across a long object's narrow side)."""
+        half_x, half_y, round_ = outline(label)
+        if self.side or round_:
+            return footprint(label)
+        return abs(math.sin(self.yaw)) * half_x + abs(math.cos(self.yaw)) * half_y
+
+    def approach_width(self, label: str) -> float | None:
+        """The half-width the fingers are set for on the way to the grasp: a top grasp's fingertips stop
+        above the object, so they come already closed to its width (and pass close to its neighbours);
+        a side grasp's fingers go round the body, fully open (None)."""
+        return None if self.side else self.half_across(label)
+
     def at_target(self) -> tuple:
         """The gripper orientation over the target: the grasp's, turned about the vertical (the held
         object stays upright)."""
