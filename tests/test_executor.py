@@ -682,8 +682,8 @@ def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fi
 def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_width(sim, tmp_path, monkeypatch, shaped):
     """Bench seed 1, blend 11: the banana lies 2.3 cm from the sink's wall, along it. Fully open, a
     finger would come within a centimetre of the wall wherever the banana is held; a top grasp's
-    fingertips stop above the object, so the hand comes with its fingers set 2 mm wider than the banana,
-    and the blend succeeds. Set open, the grasp is refused."""
+    fingertips stop above the object, so when no grasp with open fingers is clear the hand comes with
+    them set 2 mm wider than the banana, and the blend succeeds. Without that, the grasp is refused."""
     from lmcr.executor.plan import Infeasible, Plan, Planner
     from lmcr.executor.run import run_plan
     from lmcr.executor.scene import Scene, SceneObject
@@ -700,7 +700,7 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
     if not shaped:
         assert isinstance(plan, Infeasible) and "against the sink" in plan.reason, plan
         return
-    assert isinstance(plan, Plan) and plan.half_width == pytest.approx(0.0175)
+    assert isinstance(plan, Plan) and plan.variant.narrow and plan.half_width == pytest.approx(0.0175)
     assert plan.fingers != plan.arm.finger_open
     out = run_plan(plan, banana, blender, [o for o in scene.objects if o not in (banana, blender)])
     assert out["success"], out["checks"]
@@ -709,9 +709,12 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
 @pytest.mark.parametrize(("label", "yaw", "half"), [("banana", 0.0, 0.0175), ("banana", math.pi, 0.0175),
                                                     ("cup", math.pi / 2, None)])
 def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
-    """A long object is held across its narrow side; a round one by its radius, from any heading."""
+    """A long object is held across its narrow side; a round one by its radius, from any heading. The
+    fingers come open but to a narrow top grasp, closed to that width."""
     from lmcr.executor.scene import footprint
     from lmcr.executor.tasks import Variant
 
-    assert Variant(yaw).half_across(label) == pytest.approx(half if half is not None else footprint(label))
-    assert Variant(yaw, side=True).approach_width(label) is None
+    across = half if half is not None else footprint(label)
+    assert Variant(yaw).half_across(label) == pytest.approx(across)
+    assert Variant(yaw, narrow=True).approach_width(label) == pytest.approx(across)
+    assert Variant(yaw).approach_width(label) is None and Variant(yaw, side=True, narrow=True).approach_width(label) is None

@@ -227,6 +227,10 @@ class Arm:
             for j, v in zip(self.fingers, targets):
                 p.resetJointState(self.robot, j, v)
 
+    def fingers_at(self, targets: list[float], tolerance: float = 0.001) -> bool:
+        """Whether the finger joints are within `tolerance` of `targets`."""
+        return all(abs(p.getJointState(self.robot, j)[0] - t) <= tolerance for j, t in zip(self.fingers, targets))
+
     def open_fingers(self) -> None:
         """Drive the fingers open (no stepping)."""
         self.shape_fingers(self.finger_open)

@@ -104,7 +104,7 @@ class Planner:
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
                 for variant in _variants(held, task, holding, arm.opening):
-                    grasp = (variant.yaw, variant.pitch, variant.side, variant.shift)
+                    grasp = (variant.yaw, variant.pitch, variant.side, variant.shift, variant.narrow)
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
                     # the last attempt's checks left the held object in its hand: it stands where it started

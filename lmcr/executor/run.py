@@ -65,7 +65,8 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
         arm.attach(held.body)
     else:  # the hand takes the shape it was planned to approach in before it moves
         arm.shape_fingers(plan.fingers)
-        settle(FINGERS_SET)
+        if not arm.fingers_at(plan.fingers):
+            settle(FINGERS_SET)
     grasped, released = True, False
     knocked_during: dict[str, str] = {}
     segments, picked = list(plan.segments), pick_steps([s.step for s in plan.segments])

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pybullet as p
@@ -67,6 +67,7 @@ class Variant:
     side: bool = False  # grasped from the side (bottles and shakers, to pour), not by the top
     turn: float = 0.0  # how far the hand turns about the vertical between the grasp and the target
     shift: tuple = (0.0, 0.0)  # a top grasp this far (x, y metres) from the top's middle, along a long object
+    narrow: bool = False  # a top grasp approached with the fingers closed to the object's width
 
     def half_across(self, label: str) -> float:
         """Half the object's width between the fingers: a round one's radius, or a box's extent along
@@ -77,10 +78,11 @@ class Variant:
         return abs(math.sin(self.yaw)) * half_x + abs(math.cos(self.yaw)) * half_y
 
     def approach_width(self, label: str) -> float | None:
-        """The half-width the fingers are set for on the way to the grasp: a top grasp's fingertips stop
-        above the object, so they come already closed to its width (and pass close to its neighbours);
-        a side grasp's fingers go round the body, fully open (None)."""
-        return None if self.side else self.half_across(label)
+        """The half-width the fingers are set for on the way to the grasp (None: fully open). A top
+        grasp's fingertips stop above the object, so a `narrow` one comes with the fingers closed to its
+        width and passes close to its neighbours; open fingers forgive an object that stands a few
+        millimetres off where it was planned (one just set down), so they are tried first."""
+        return self.half_across(label) if self.narrow and not self.side else None
 
     def at_target(self) -> tuple:
         """The gripper orientation over the target: the grasp's, turned about the vertical (the held
@@ -199,13 +201,14 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
     signs = (1, -1) if turns else (1,)
     top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
            for turn in TURNS for sign in signs]
+    narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
     if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
-        return top  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
+        return top + narrow  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
     x, y = world_xy(held.xy)
     heading = math.atan2(y, x)
     side = [Variant(heading + a, 0.0, sign, side=True, turn=turn) for a in (0.0, 0.5, -0.5) for turn in TURNS
             for sign in signs]
-    return side + top
+    return side + top + narrow
 
 
 def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:

@@ -18,7 +18,8 @@ Precision (`precision`): "auto" multiplies the decoder in bfloat16 where the CPU
 training's "auto"), else fp32; the LSTM, the softmax and the sums stay fp32. A completion's decoder
 pass has few rows, so it is bound by reading the 14k x 256 weight matrix, and bf16 halves that:
 completion with context over 40 objects took 17.5 ms against 26.5 ms in fp32 on a 2-core AVX512-BF16
-CPU (`bench/bench_complete.py`). Log-probabilities move by about 0.01 per token; Table I (0.922 for
+CPU (`bench/bench_complete.py`). The bf16 product needs oneDNN (12 rows: 0.7 ms with it, 5.9 ms
+without), so only the trie walk's LSTM calls turn it off (`_native_rnn`). Log-probabilities move by about 0.01 per token; Table I (0.922 for
 the default method, 0.846 for the sentence LM) and the dev instructions (57/60) are the same either
 way, Fig. 4 moved by at most 0.004.
 """
@@ -53,6 +54,14 @@ def _native_lstm():
         yield
     finally:
         torch.backends.mkldnn.enabled = before
+
+
+def _native_rnn(model, x: torch.Tensor, state=None):
+    """The model's LSTM on `x` with PyTorch's own kernel: oneDNN's builds a primitive per call, ~0.3 ms
+    for the trie walk's one-step, few-row calls against ~0.1 ms (same numbers to 1e-5). Only the LSTM:
+    the decoder needs oneDNN, without which a bf16 product of 12 rows took 5.9 ms instead of 0.7 ms."""
+    with _native_lstm():
+        return model.rnn(x, state)
 
 
 @dataclass
@@ -133,8 +142,7 @@ class LMScorer:
         if not ctx:
             return self.score(texts, norm)  # in chunks: a whole evaluation's frames may come at once
         seqs = [self.encode(t) for t in texts]
-        with _native_lstm():
-            walk = self._walk(seqs, keep_states=True)
+        walk = self._walk(seqs, keep_states=True)
         totals = [(walk.totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
         scores = [_normed(total, n, norm) for total, n in totals]
         top = sorted(range(len(texts)), key=lambda i: -scores[i])[:CONTEXT_TOP]
@@ -147,10 +155,7 @@ class LMScorer:
     def _score(self, seqs: list[list[int]]) -> list[float]:
         if not seqs:
             return []
-        # oneDNN's LSTM builds a primitive per call: ~0.3 ms for these one-step, few-row calls against
-        # ~0.1 ms for the native kernel (same numbers to 1e-5), and scoring is nothing but such calls.
-        with _native_lstm():
-            return self._walk(seqs).totals
+        return self._walk(seqs).totals
 
     def _edge_logprobs(self, rows: torch.Tensor, picks: torch.Tensor, tokens_: torch.Tensor) -> torch.Tensor:
         """log P(tokens_[j] | rows[picks[j]]) for each j, an unknown word charged its share of <unk>. The
@@ -187,7 +192,7 @@ class LMScorer:
         shortest = min(len(s) for s in seqs)
         shared = next((i for i in range(1, shortest) if any(s[i] != seqs[0][i] for s in seqs)), shortest)
         shared = max(1, min(shared, shortest - 1))
-        out, state = model.rnn(model.embed(torch.tensor([seqs[0][:shared]])))  # (1, L, E)
+        out, state = _native_rnn(model, model.embed(torch.tensor([seqs[0][:shared]])))  # (1, L, E)
         rows, row_of = [out[0]], {n: n for n in range(shared)}
         walk = _Walk(trie, [], {}, [])
         if keep_states:
@@ -200,7 +205,7 @@ class LMScorer:
                 break
             pick = torch.tensor([frontier_pos[trie.parent[n]] for n in grow])
             x = model.embed(torch.tensor([trie.token[n] for n in grow])).unsqueeze(1)  # (G, 1, E)
-            out, frontier = model.rnn(x, (frontier[0][:, pick], frontier[1][:, pick]))
+            out, frontier = _native_rnn(model, x, (frontier[0][:, pick], frontier[1][:, pick]))
             frontier_pos = {n: i for i, n in enumerate(grow)}
             offset = len(row_of)  # one row per node mapped so far
             rows.append(out[:, 0])
