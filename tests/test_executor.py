@@ -718,3 +718,21 @@ def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
     assert Variant(yaw).half_across(label) == pytest.approx(across)
     assert Variant(yaw, narrow=True).approach_width(label) == pytest.approx(across)
     assert Variant(yaw).approach_width(label) is None and Variant(yaw, side=True, narrow=True).approach_width(label) is None
+
+
+def test_a_dip_whose_straight_way_down_is_out_of_reach_is_refused_saying_so(sim, tmp_path, monkeypatch):
+    """Into a container the carried object goes down a straight line; an arm that cannot hold it to the
+    line (IK fails on the way) has no dip, and the reason says why rather than naming an obstacle."""
+    from lmcr.executor import plan as planning
+    from lmcr.executor.plan import Infeasible, Plan, Planner
+    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.executor.tasks import TASKS as PROGRAMS
+
+    scene = Scene([SceneObject("strawberry", (0.1, -0.15)), SceneObject("batter", (-0.05, 0.15))])
+    robot = build_world(scene, tmp_path)
+    planner = Planner(robot, scene, scene.table)
+    strawberry, batter = scene.find("strawberry"), scene.find("batter")
+    assert isinstance(planner.plan(PROGRAMS["dip"], strawberry, batter, holding=False), Plan)
+    monkeypatch.setattr(planning, "_straight_line", lambda *args: None)
+    refused = planner.plan(PROGRAMS["dip"], strawberry, batter, holding=False)
+    assert isinstance(refused, Infeasible) and "cannot go straight down to 'dip'" in refused.reason, refused

@@ -260,7 +260,10 @@ class Planner:
                 into = step.into and carried is not None
                 path = (_straight_line(arm, q, goal, position, step.orientation) if into
                         else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS))
-                blocker = _path_clash(clash, path) if into and path is not None else None
+                if into and path is None:
+                    why, reach = f"the {arm.side} arm cannot go straight down to '{step.name}'", False
+                    continue
+                blocker = _path_clash(clash, path) if into else None
                 if path is None or blocker:
                     blocker = blocker or segment_clash(clash, q, goal)
                     why, reach = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)", False
