@@ -19,15 +19,14 @@ training's "auto"), else fp32; the LSTM, the softmax and the sums stay fp32. A c
 pass has few rows, so it is bound by reading the 14k x 256 weight matrix, and bf16 halves that:
 completion with context over 40 objects took 17.5 ms against 26.5 ms in fp32 on a 2-core AVX512-BF16
 CPU (`bench/bench_complete.py`). The bf16 product needs oneDNN (12 rows: 0.7 ms with it, 5.9 ms
-without), so only the trie walk's LSTM calls turn it off (`_native_rnn`). Log-probabilities move by about 0.01 per token; Table I (0.922 for
-the default method, 0.846 for the sentence LM) and the dev instructions (57/60) are the same either
-way, Fig. 4 moved by at most 0.004.
+without), so only the trie walk's LSTM calls turn it off (`_native_rnn`). Log-probabilities move by
+about 0.01 per token; Table I (0.922 for the default method, 0.846 for the sentence LM) and the dev
+instructions (57/60) are the same either way, Fig. 4 moved by at most 0.004.
 """
 
 from __future__ import annotations
 
 import math
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import torch
@@ -45,23 +44,18 @@ CONTEXT_TOP = 10
 DECODER_BLOCK = 4096  # rows per decoder call: 4096 x 14k-word vocabulary = 235 MB of logits at most
 
 
-@contextmanager
-def _native_lstm():
-    """PyTorch's own LSTM kernel instead of oneDNN's for the duration (only that flag changes)."""
+def _native_rnn(model, x: torch.Tensor, state=None):
+    """The model's LSTM on `x` with PyTorch's own kernel (only the oneDNN flag changes, for the call):
+    oneDNN's builds a primitive per call, ~0.3 ms for the trie walk's one-step, few-row calls against
+    ~0.1 ms (same numbers to 1e-5). Only the LSTM: the decoder needs oneDNN, without which a bf16 product
+    of 12 rows took 5.9 ms instead of 0.7 ms. (`torch.backends.mkldnn.flags` would also reset the TF32
+    setting, and warn about it.)"""
     before = torch.backends.mkldnn.enabled
     torch.backends.mkldnn.enabled = False
     try:
-        yield
+        return model.rnn(x, state)
     finally:
         torch.backends.mkldnn.enabled = before
-
-
-def _native_rnn(model, x: torch.Tensor, state=None):
-    """The model's LSTM on `x` with PyTorch's own kernel: oneDNN's builds a primitive per call, ~0.3 ms
-    for the trie walk's one-step, few-row calls against ~0.1 ms (same numbers to 1e-5). Only the LSTM:
-    the decoder needs oneDNN, without which a bf16 product of 12 rows took 5.9 ms instead of 0.7 ms."""
-    with _native_lstm():
-        return model.rnn(x, state)
 
 
 @dataclass
