@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import functools
-import math
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -117,21 +116,11 @@ def lm_experts(res: MethodResources) -> list[tuple[str, float]]:
 
 def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
     def build(res: MethodResources):
-        experts = [(math.log(w), _load_lm(res, linearization, corpus).score_frames)
-                   for corpus, w in lm_experts(res) if w > 0]
-        if len(experts) == 1:
-            return experts[0][1]
+        from lmcr.lm.score import MixedLM
 
-        def mixed(frames: list[Frame], **kwargs) -> list[float]:  # log sum_i w_i P_i(text)
-            columns = [[log_w + s for s in score(frames, **kwargs)] for log_w, score in experts]
-            return [_logsumexp(values) for values in zip(*columns)]
-        return mixed
+        experts = [(w, _load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
+        return experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
     return build
-
-
-def _logsumexp(values: tuple[float, ...]) -> float:
-    top = max(values)
-    return top + math.log(sum(math.exp(v - top) for v in values))
 
 
 def lm_version_dir(res: MethodResources, linearization: str, corpus: str | None = None) -> Path:

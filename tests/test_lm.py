@@ -130,13 +130,15 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     assert cup > scissors
 
 
-def test_a_bf16_decoder_scores_within_rounding_of_fp32(overfit, tmp_path):
-    """The decoder multiplied in bfloat16 (the default where the CPU has it) moves a text's
-    log-probability by rounding only; the LSTM and the softmax stay fp32, the checkpoint is unchanged."""
+def test_bf16_scoring_is_within_rounding_of_fp32(overfit, tmp_path):
+    """The LSTM and the decoder in bfloat16 (the default where the CPU has it, as in training) move a
+    text's log-probability by rounding only; the softmax stays fp32, the checkpoint's model is unchanged."""
     model, vocab, _ = overfit
     loaded = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}))
     exact, rounded = LMScorer(loaded, precision="fp32"), LMScorer(loaded, precision="bf16")
     assert rounded._decoder[0].dtype == torch.bfloat16 and loaded.model.decoder.weight.dtype == torch.float32
+    assert rounded._rnn.weight_hh_l0.dtype == torch.bfloat16 and loaded.model.rnn.weight_hh_l0.dtype == torch.float32
+    assert exact._rnn is loaded.model.rnn
     texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
     assert rounded.score(texts) == pytest.approx(exact.score(texts), abs=0.02 * 6)  # ~0.01 a token
     assert rounded.score(texts) != exact.score(texts)  # it did multiply in bf16
@@ -191,9 +193,11 @@ def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monke
     plain = methods.MethodResources(checkpoints=tmp_path)
     mixed = methods.MethodResources(checkpoints=tmp_path, mixture=Mixture.of({"household": 9}))
     share = 9 / (99 + 9)  # household weighted 9 is 9 of 108 weighted words
-    p_all = [math.exp(x) for x in methods.make_scorer("sentence_lm", plain)(frames, "for tea")]
-    p_house = [math.exp(x) for x in LMScorer(ckpt.load(tmp_path / "sentence-household")).score_frames(frames, context="for tea")]
-    expected = [math.log((1 - share) * a + share * h) for a, h in zip(p_all, p_house)]
+    all_lm = methods.make_scorer("sentence_lm", plain)
+    p_all = [math.exp(x) for x in all_lm(frames)]
+    p_house = [math.exp(x) for x in LMScorer(ckpt.load(tmp_path / "sentence-household")).score_frames(frames)]
+    purpose = [a - b for a, b in zip(all_lm(frames, "for tea"), all_lm(frames))]  # log P_all(context | frame)
+    expected = [math.log((1 - share) * a + share * h) + g for a, h, g in zip(p_all, p_house, purpose)]
     assert methods.make_scorer("sentence_lm", mixed)(frames, "for tea") == pytest.approx(expected, rel=1e-5)
     assert methods.lm_experts(mixed) == [("all", pytest.approx(1 - share)), ("household", pytest.approx(share))]
     assert methods.scorer_fingerprint("sentence_lm", mixed).endswith("@household=9")

@@ -14,19 +14,20 @@ scored by default: the sentence LM learned instruction sentences that usually co
 stir"), so P(</s>) measures sentence length habits, not plausibility. An unknown word is charged
 log(unk_types) on top of P(<unk>): its share of the probability the model pools over rare words.
 
-Precision (`precision`): "auto" multiplies the decoder in bfloat16 where the CPU does so natively (as
-training's "auto"), else fp32; the LSTM, the softmax and the sums stay fp32. A completion's decoder
-pass has few rows, so it is bound by reading the 14k x 256 weight matrix, and bf16 halves that:
-completion with context over 40 objects took 17.5 ms against 26.5 ms in fp32 on a 2-core AVX512-BF16
-CPU (`bench/bench_complete.py`). The bf16 product needs oneDNN (12 rows: 0.7 ms with it, 5.9 ms
-without), so only the trie walk's LSTM calls turn it off (`_native_rnn`). Log-probabilities move by
-about 0.01 per token; Table I (0.922 for the default method, 0.846 for the sentence LM) and the dev
-instructions (57/60) are the same either way, Fig. 4 moved by at most 0.004.
+Precision (`precision`): "auto" runs the LSTM and multiplies the decoder in bfloat16 where the CPU
+does so natively, as training's "auto" autocast ran them (it puts the LSTM and every product in bf16),
+else fp32; the softmax and the sums stay fp32. A completion's calls have few rows, so they are bound by
+reading weights (the decoder's 14k x 256, each LSTM layer's 2 x 1024 x 256), and bf16 halves that. The
+bf16 kernels are oneDNN's; in fp32 the trie walk's one-step LSTM calls take PyTorch's own kernel
+(`_native_rnn`), for which oneDNN would build a primitive per call. Log-probabilities move by a few
+hundredths of a nat per text (README: what that does to Table I and the dev instructions).
 """
 
 from __future__ import annotations
 
+import copy
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import torch
@@ -44,16 +45,15 @@ CONTEXT_TOP = 10
 DECODER_BLOCK = 4096  # rows per decoder call: 4096 x 14k-word vocabulary = 235 MB of logits at most
 
 
-def _native_rnn(model, x: torch.Tensor, state=None):
-    """The model's LSTM on `x` with PyTorch's own kernel (only the oneDNN flag changes, for the call):
-    oneDNN's builds a primitive per call, ~0.3 ms for the trie walk's one-step, few-row calls against
-    ~0.1 ms (same numbers to 1e-5). Only the LSTM: the decoder needs oneDNN, without which a bf16 product
-    of 12 rows took 5.9 ms instead of 0.7 ms. (`torch.backends.mkldnn.flags` would also reset the TF32
-    setting, and warn about it.)"""
+def _native_rnn(rnn, x: torch.Tensor, state=None):
+    """`rnn` on `x` with PyTorch's own kernel (only the oneDNN flag changes, for the call): oneDNN's
+    builds a primitive per call, ~0.3 ms for the trie walk's one-step, few-row fp32 calls against
+    ~0.1 ms (same numbers to 1e-5). (`torch.backends.mkldnn.flags` would also reset the TF32 setting,
+    and warn about it.)"""
     before = torch.backends.mkldnn.enabled
     torch.backends.mkldnn.enabled = False
     try:
-        return model.rnn(x, state)
+        return rnn(x, state)
     finally:
         torch.backends.mkldnn.enabled = before
 
@@ -99,6 +99,18 @@ class LMScorer:
         self.precision = pick_precision(precision, decoder.weight.device)
         dtype = torch.bfloat16 if self.precision == "bf16" else decoder.weight.dtype
         self._decoder = (decoder.weight.detach().to(dtype), decoder.bias.detach())
+        # The LSTM in the same precision, a copy: the model's own weights stay fp32 for training code.
+        self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
+
+    def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
+        """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. In fp32 the
+        trie walk's one-step calls (`few_rows`) take PyTorch's own kernel (`_native_rnn`); bf16 needs
+        oneDNN's."""
+        if self._rnn is self.model.rnn:
+            return _native_rnn(self._rnn, x, state) if few_rows else self._rnn(x, state)
+        low = self._decoder[0].dtype
+        out, (h, c) = self._rnn(x.to(low), None if state is None else (state[0].to(low), state[1].to(low)))
+        return out.float(), (h.float(), c.float())
 
     def encode(self, text: str) -> list[int]:
         ids = self.vocab.encode(tokens(text, self.checkpoint.articles))
@@ -121,29 +133,38 @@ class LMScorer:
     def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum") -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
         `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"): the score
-        adds log P(context | frame), how well the frame serves what was said around it.
-
-        The context is read after the CONTEXT_TOP frames this model scores best, the others get the
-        lowest context term of those: every candidate's context costs a softmax over the vocabulary
-        per word, and a frame this far down is not what was meant. The context continues the LSTM from
-        where each frame's text ended (`_Walk`), so the frames are not read twice."""
+        adds log P(context | frame), how well the frame serves what was said around it (`add_context`:
+        read after the CONTEXT_TOP best frames). The context continues the LSTM from where each frame's
+        text ended (`_Walk`), so the frames are not read twice."""
         if norm not in NORMS:
             raise ValueError(f"norm must be one of {NORMS}")
-        if not frames:
-            return []
-        texts = [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
-        ctx = self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1]
-        if not ctx:
-            return self.score(texts, norm)  # in chunks: a whole evaluation's frames may come at once
-        seqs = [self.encode(t) for t in texts]
-        walk = self._walk(seqs, keep_states=True)
-        totals = [(walk.totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
-        scores = [_normed(total, n, norm) for total, n in totals]
-        top = sorted(range(len(texts)), key=lambda i: -scores[i])[:CONTEXT_TOP]
-        extra = self._continue(walk, [walk.trie.leaf_of[i] for i in top], ctx)  # oneDNN: one call, many rows
-        gains = {i: _normed(totals[i][0] + x, totals[i][1] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)}
-        floor = min(gains.values())
-        return [s + gains.get(i, floor) for i, s in enumerate(scores)]
+        ctx = self.context_ids(context)
+        if not frames or not ctx:
+            return self.score(self.frame_texts(frames), norm)  # in chunks: an evaluation's frames come at once
+        walk = self.read_frames(frames)
+        lengths = [len(seq) - 1 for seq in walk.seqs]
+        scores = [_normed(total, n, norm) for total, n in zip(walk.totals, lengths)]
+
+        def gains(top: list[int]) -> list[float]:
+            extra = self.context_logprobs(walk, top, ctx)
+            return [_normed(walk.totals[i] + x, lengths[i] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)]
+        return add_context(scores, gains)
+
+    def frame_texts(self, frames: list[tuple[str, dict[str, str]]]) -> list[str]:
+        return [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
+
+    def context_ids(self, context: str) -> list[int]:
+        """The context's token ids as this model reads them after a frame (no <s>, no </s>)."""
+        return self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1] if context else []
+
+    def read_frames(self, frames: list[tuple[str, dict[str, str]]]) -> _Walk:
+        """One walk over the frames' texts (`walk.totals`: each one's total log-probability) that keeps
+        the LSTM states a context is read on from (`context_logprobs`)."""
+        return self._walk([self.encode(t) for t in self.frame_texts(frames)], keep_states=True)
+
+    def context_logprobs(self, walk: _Walk, which: list[int], ctx: list[int]) -> list[float]:
+        """log P(context | frame) for the frames `which` of a `read_frames` walk."""
+        return self._continue(walk, [walk.trie.leaf_of[i] for i in which], ctx)  # oneDNN: one call, many rows
 
     @torch.no_grad()
     def _score(self, seqs: list[list[int]]) -> list[float]:
@@ -166,7 +187,7 @@ class LMScorer:
     def _logits(self, rows: torch.Tensor) -> torch.Tensor:
         """The decoder's fp32 logits of LSTM output `rows`, multiplied in the scorer's precision."""
         weight, bias = self._decoder
-        return F.linear(rows.to(weight.dtype), weight).float() + bias
+        return torch.add(F.linear(rows.to(weight.dtype), weight), bias)  # fp32 out: one pass, no copy
 
     @torch.no_grad()
     def _walk(self, seqs: list[list[int]], keep_states: bool = False) -> _Walk:
@@ -186,9 +207,9 @@ class LMScorer:
         shortest = min(len(s) for s in seqs)
         shared = next((i for i in range(1, shortest) if any(s[i] != seqs[0][i] for s in seqs)), shortest)
         shared = max(1, min(shared, shortest - 1))
-        out, state = _native_rnn(model, model.embed(torch.tensor([seqs[0][:shared]])))  # (1, L, E)
+        out, state = self._lstm(model.embed(torch.tensor([seqs[0][:shared]])), few_rows=True)  # (1, L, E)
         rows, row_of = [out[0]], {n: n for n in range(shared)}
-        walk = _Walk(trie, [], {}, [])
+        walk = _Walk(trie, seqs, [], {}, [])
         if keep_states:
             walk.states.append(state)
             walk.state_of[shared - 1] = (0, 0)
@@ -199,7 +220,7 @@ class LMScorer:
                 break
             pick = torch.tensor([frontier_pos[trie.parent[n]] for n in grow])
             x = model.embed(torch.tensor([trie.token[n] for n in grow])).unsqueeze(1)  # (G, 1, E)
-            out, frontier = _native_rnn(model, x, (frontier[0][:, pick], frontier[1][:, pick]))
+            out, frontier = self._lstm(x, (frontier[0][:, pick], frontier[1][:, pick]), few_rows=True)
             frontier_pos = {n: i for i, n in enumerate(grow)}
             offset = len(row_of)  # one row per node mapped so far
             rows.append(out[:, 0])
@@ -227,7 +248,7 @@ class LMScorer:
         h = torch.cat([walk.states[level][0][:, [pos]] for level, pos in places], dim=1)
         c = torch.cat([walk.states[level][1][:, [pos]] for level, pos in places], dim=1)
         x = model.embed(torch.tensor([[trie.token[leaf], *ctx[:-1]] for leaf in leaves]))  # (N, k, E)
-        out, _ = model.rnn(x, (h, c))
+        out, _ = self._lstm(x, (h, c))
         k = len(ctx)
         rows = out.reshape(len(leaves) * k, -1)
         edge = self._edge_logprobs(rows, torch.arange(len(rows)), torch.tensor(ctx * len(leaves)))
@@ -243,6 +264,48 @@ class _Walk:
     """A pass over a trie of texts: each text's total, and the LSTM states kept for continuing it."""
 
     trie: _Trie
+    seqs: list[list[int]]  # the texts' token ids
     totals: list[float]
     state_of: dict[int, tuple[int, int]]  # node -> (index into states, position in that batch)
     states: list[tuple[torch.Tensor, torch.Tensor]]
+
+
+def add_context(scores: list[float], gains_of: Callable[[list[int]], list[float]]) -> list[float]:
+    """`scores` plus each frame's context term: `gains_of(top)` for the CONTEXT_TOP best frames, the
+    lowest of those for the others. Every frame that reads the context costs a softmax over the
+    vocabulary per word, and a frame this far down is not what was meant."""
+    top = sorted(range(len(scores)), key=lambda i: -scores[i])[:CONTEXT_TOP]
+    gains = dict(zip(top, gains_of(top)))
+    floor = min(gains.values())
+    return [s + gains.get(i, floor) for i, s in enumerate(scores)]
+
+
+class MixedLM:
+    """Corpus LMs interpolated, P(frame) = sum_i w_i P_i(frame) (the weights from `lmcr/mixture.py`),
+    with the context read by the first, the LM of every corpus: log P(frame) + log P_1(context | frame).
+
+    Only the first reads it because only its corpus teaches purposes: 5% of the recipe sentences have a
+    "for ..." (the purpose clauses a context is made of), 0.3% of the household ones (kitchen
+    narrations: "pour milk into cup"), so a household LM's P("for my tea" | frame) says little
+    beyond its own text. And each LM that reads the context costs a decoder pass over its rows."""
+
+    def __init__(self, experts: list[tuple[float, LMScorer]]):
+        if not experts or any(w <= 0 for w, _ in experts):
+            raise ValueError("a mixture needs LMs with positive weights")
+        self.experts = [(math.log(w), lm) for w, lm in experts]
+
+    def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "") -> list[float]:
+        """log sum_i w_i P_i(frame), plus log P_1(context | frame) with a context."""
+        (first_w, first), *rest = self.experts
+        ctx = first.context_ids(context)
+        walk = first.read_frames(frames) if ctx and frames else None
+        columns = [walk.totals if walk else first.score_frames(frames), *(lm.score_frames(frames) for _, lm in rest)]
+        mixed = [logsumexp([w + s for (w, _), s in zip(self.experts, values)]) for values in zip(*columns)]
+        if walk is None:
+            return mixed
+        return add_context(mixed, lambda top: first.context_logprobs(walk, top, ctx))
+
+
+def logsumexp(values: list[float]) -> float:
+    top = max(values)
+    return top + math.log(sum(math.exp(v - top) for v in values))

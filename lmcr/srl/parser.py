@@ -139,9 +139,12 @@ class FrameParser:
         # first word -> (times repaired, times it started as a verb (repaired or not), times seen)
         self.first_words: dict[str, tuple[int, int, int]] = {}
 
-    def _parse(self, texts: Iterable[str]) -> Iterator[Doc]:
+    def _parse(self, texts: list[str]) -> Iterator[Doc]:
+        # A batch no larger than the texts: spaCy sizes its work to the batch, and one instruction
+        # parsed with batch_size 256 took 2.2 ms against 1.8 ms (the completion latency bench).
+        size = max(1, min(self.batch_size, len(texts)))
         return (self.lemmas.fill(rejoin_split_compounds(doc, self.compounds))
-                for doc in self.nlp.pipe(texts, batch_size=self.batch_size))
+                for doc in self.nlp.pipe(texts, batch_size=size))
 
     def parse(self, text: str) -> list[FrameMention]:
         return next(self.pipe([text]))
@@ -207,7 +210,7 @@ class FrameParser:
         One the parser does not read as a command after all joins `plain`."""
         parses, requests = [], []
         prefix = PREFIXES[0]
-        for seg, doc in zip(direct, self._parse(as_request(s.text, prefix) for s in direct)):
+        for seg, doc in zip(direct, self._parse([as_request(s.text, prefix) for s in direct])):
             if not _reparse_accepted(doc, prefix):
                 plain.append(seg)
                 continue
@@ -224,7 +227,7 @@ class FrameParser:
     def _parse_plain(self, plain: list[_Segment], docs: dict[int, Doc] | None = None) -> tuple[list[_Piece], list[_Piece]]:
         """Segments parsed as they are: (parses, sentences that look like misread commands)."""
         parses, requests = [], []
-        for seg, doc in zip(plain, self._parse(s.text for s in plain)):
+        for seg, doc in zip(plain, self._parse([s.text for s in plain])):
             if docs is not None and seg.depth == 0:
                 docs[seg.text_id] = doc
             for k, sent in enumerate(doc.sents):
@@ -248,7 +251,7 @@ class FrameParser:
         parses = []
         for prefix in PREFIXES:
             retry = []
-            redone = self._parse(as_request(piece.parse.text, prefix) for piece in requests)
+            redone = self._parse([as_request(piece.parse.text, prefix) for piece in requests])
             for piece, again in zip(requests, redone):
                 if _reparse_accepted(again, prefix):
                     self.stats.accepted += 1
