@@ -255,3 +255,15 @@ def test_setting_reads_both_spellings():
                         ("frame_lm/x", "corpus must be one of")):
         with pytest.raises(ValueError, match=reason):
             Setting.parse(bad)
+
+
+def test_decoder_blocks_give_the_scores_of_one_pass(overfit, tmp_path, monkeypatch):
+    """An evaluation's many rows go through the decoder a block at a time; a completion's few in one."""
+    from lmcr.lm import score as score_module
+
+    model, vocab, _ = overfit
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    texts = ["pour water into the cup", "pour water into the glass", "fill the pot with water", "pour milk"]
+    whole = scorer.score(texts)
+    monkeypatch.setattr(score_module, "DECODER_BLOCK", 3)
+    assert scorer.score(texts) == pytest.approx(whole, abs=1e-6)

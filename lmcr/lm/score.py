@@ -101,6 +101,7 @@ class LMScorer:
         self._decoder = (decoder.weight.detach().to(dtype), decoder.bias.detach())
         # The LSTM in the same precision, a copy: the model's own weights stay fp32 for training code.
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
+        self._unk = self.vocab.words.index(UNK)
 
     def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
         """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. In fp32 the
@@ -176,13 +177,15 @@ class LMScorer:
         """log P(tokens_[j] | rows[picks[j]]) for each j, an unknown word charged its share of <unk>. The
         decoder's softmax runs once over all rows, a block at a time (one read of its weights per block,
         bounded memory), instead of once per trie level."""
-        edge = torch.empty(len(picks))
-        for start in range(0, len(rows), DECODER_BLOCK):
-            logp = F.log_softmax(self._logits(rows[start:start + DECODER_BLOCK]), dim=-1)
-            mine = (picks >= start) & (picks < start + DECODER_BLOCK)
-            edge[mine] = logp[picks[mine] - start, tokens_[mine]]
-        unk = self.vocab.words.index(UNK)
-        return edge - (tokens_ == unk) * math.log(self.vocab.unk_types)
+        if len(rows) <= DECODER_BLOCK:  # a completion's few rows: no block bookkeeping
+            edge = F.log_softmax(self._logits(rows), dim=-1)[picks, tokens_]
+        else:
+            edge = torch.empty(len(picks))
+            for start in range(0, len(rows), DECODER_BLOCK):
+                logp = F.log_softmax(self._logits(rows[start:start + DECODER_BLOCK]), dim=-1)
+                mine = (picks >= start) & (picks < start + DECODER_BLOCK)
+                edge[mine] = logp[picks[mine] - start, tokens_[mine]]
+        return edge - (tokens_ == self._unk) * math.log(self.vocab.unk_types)
 
     def _logits(self, rows: torch.Tensor) -> torch.Tensor:
         """The decoder's fp32 logits of LSTM output `rows`, multiplied in the scorer's precision."""
@@ -244,9 +247,11 @@ class LMScorer:
         """log P(ctx | the text ending at each leaf): each leaf's token and the context read on from its
         parent's kept state, all leaves in one LSTM call and one decoder pass."""
         model, trie = self.model, walk.trie
-        places = [walk.state_of[trie.parent[leaf]] for leaf in leaves]
-        h = torch.cat([walk.states[level][0][:, [pos]] for level, pos in places], dim=1)
-        c = torch.cat([walk.states[level][1][:, [pos]] for level, pos in places], dim=1)
+        starts = [0]  # where each level's states begin in the states laid side by side
+        for h_level, _ in walk.states[:-1]:
+            starts.append(starts[-1] + h_level.shape[1])
+        kept = torch.tensor([starts[level] + pos for level, pos in (walk.state_of[trie.parent[leaf]] for leaf in leaves)])
+        h, c = (torch.cat([state[i] for state in walk.states], dim=1)[:, kept] for i in (0, 1))
         x = model.embed(torch.tensor([[trie.token[leaf], *ctx[:-1]] for leaf in leaves]))  # (N, k, E)
         out, _ = self._lstm(x, (h, c))
         k = len(ctx)
