@@ -177,14 +177,11 @@ class LMScorer:
         """log P(tokens_[j] | rows[picks[j]]) for each j, an unknown word charged its share of <unk>. The
         decoder's softmax runs once over all rows, a block at a time (one read of its weights per block,
         bounded memory), instead of once per trie level."""
-        if len(rows) <= DECODER_BLOCK:  # a completion's few rows: no block bookkeeping
-            edge = F.log_softmax(self._logits(rows), dim=-1)[picks, tokens_]
-        else:
-            edge = torch.empty(len(picks))
-            for start in range(0, len(rows), DECODER_BLOCK):
-                logp = F.log_softmax(self._logits(rows[start:start + DECODER_BLOCK]), dim=-1)
-                mine = (picks >= start) & (picks < start + DECODER_BLOCK)
-                edge[mine] = logp[picks[mine] - start, tokens_[mine]]
+        edge = torch.empty(len(picks))
+        for start in range(0, len(rows), DECODER_BLOCK):
+            logp = F.log_softmax(self._logits(rows[start:start + DECODER_BLOCK]), dim=-1)
+            mine = (picks >= start) & (picks < start + DECODER_BLOCK)
+            edge[mine] = logp[picks[mine] - start, tokens_[mine]]
         return edge - (tokens_ == self._unk) * math.log(self.vocab.unk_types)
 
     def _logits(self, rows: torch.Tensor) -> torch.Tensor:
@@ -247,11 +244,9 @@ class LMScorer:
         """log P(ctx | the text ending at each leaf): each leaf's token and the context read on from its
         parent's kept state, all leaves in one LSTM call and one decoder pass."""
         model, trie = self.model, walk.trie
-        starts = [0]  # where each level's states begin in the states laid side by side
-        for h_level, _ in walk.states[:-1]:
-            starts.append(starts[-1] + h_level.shape[1])
-        kept = torch.tensor([starts[level] + pos for level, pos in (walk.state_of[trie.parent[leaf]] for leaf in leaves)])
-        h, c = (torch.cat([state[i] for state in walk.states], dim=1)[:, kept] for i in (0, 1))
+        places = [walk.state_of[trie.parent[leaf]] for leaf in leaves]
+        h = torch.cat([walk.states[level][0][:, [pos]] for level, pos in places], dim=1)
+        c = torch.cat([walk.states[level][1][:, [pos]] for level, pos in places], dim=1)
         x = model.embed(torch.tensor([[trie.token[leaf], *ctx[:-1]] for leaf in leaves]))  # (N, k, E)
         out, _ = self._lstm(x, (h, c))
         k = len(ctx)
@@ -301,7 +296,7 @@ class MixedLM:
 
     def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "") -> list[float]:
         """log sum_i w_i P_i(frame), plus log P_1(context | frame) with a context."""
-        (first_w, first), *rest = self.experts
+        (_, first), *rest = self.experts
         ctx = first.context_ids(context)
         walk = first.read_frames(frames) if ctx and frames else None
         columns = [walk.totals if walk else first.score_frames(frames), *(lm.score_frames(frames) for _, lm in rest)]
