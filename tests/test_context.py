@@ -21,6 +21,14 @@ def test_purpose_phrase_is_context():
     assert utterance_context(doc, mention(doc, 0, {"Theme": 2, "Instrument": None})) == "for my tea"
 
 
+def test_the_person_served_is_the_request_not_context():
+    doc = make_doc("pour/VB/ROOT/0 me/PRP/dative/0 some/DT/det/3 water/NN/dobj/0 for/IN/prep/3 my/PRP$/poss/6 "
+                   "tea/NN/pobj/4")
+    assert utterance_context(doc, mention(doc, 0, {"Theme": 3, "Destination": None})) == "for my tea"
+    doc = make_doc("give/VB/ROOT/0 the/DT/det/2 dog/NN/dative/0 some/DT/det/4 water/NN/dobj/0")  # a noun is kept
+    assert utterance_context(doc, mention(doc, 0, {"Theme": 4, "Destination": None})) == "the dog"
+
+
 def test_request_and_function_words_alone_are_no_context():
     doc = make_doc("could/MD/aux/2 you/PRP/nsubj/2 pour/VB/ROOT/2 the/DT/det/4 milk/NN/dobj/2 for/IN/prep/2 "
                    "me/PRP/pobj/5 ?/./punct/2")

@@ -7,6 +7,7 @@ import math
 
 import pytest
 import torch
+from torch.nn import functional as F
 
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.data import bucket_batches, split_by_document
@@ -267,3 +268,23 @@ def test_decoder_blocks_give_the_scores_of_one_pass(overfit, tmp_path, monkeypat
     whole = scorer.score(texts)
     monkeypatch.setattr(score_module, "DECODER_BLOCK", 3)
     assert scorer.score(texts) == pytest.approx(whole, abs=1e-6)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.bfloat16])
+def test_one_step_and_prepacked_products_equal_torchs_own(dtype):
+    """The trie walk's one-step LSTM and the decoder's product, with weights laid out once, give what
+    `nn.LSTM` and `F.linear` give: to float rounding in fp32, to bfloat16 rounding in bf16."""
+    from lmcr.lm.score import _OneStep, _prepacked
+
+    torch.manual_seed(0)
+    rnn = torch.nn.LSTM(16, 16, 2, batch_first=True).to(dtype)
+    x, h, c = torch.randn(3, 1, 16), torch.randn(2, 3, 16), torch.randn(2, 3, 16)
+    tol = 1e-5 if dtype == torch.float32 else 0.05
+    with torch.no_grad():
+        out, (h1, c1) = rnn(x.to(dtype), (h.to(dtype), c.to(dtype)))
+        mine, (h2, c2) = _OneStep(rnn)(x, (h, c))
+        assert mine.dtype == h2.dtype == c2.dtype == torch.float32
+        for a, b in ((out, mine), (h1, h2), (c1, c2)):
+            assert torch.allclose(a.float(), b, atol=tol)
+        weight, rows = torch.randn(40, 16).to(dtype), torch.randn(5, 16).to(dtype)
+        assert torch.allclose(_prepacked(weight)(rows).float(), F.linear(rows, weight).float(), atol=tol)

@@ -18,9 +18,10 @@ Precision (`precision`): "auto" runs the LSTM and multiplies the decoder in bflo
 does so natively, as training's "auto" autocast ran them (it puts the LSTM and every product in bf16),
 else fp32; the softmax and the sums stay fp32. A completion's calls have few rows, so they are bound by
 reading weights (the decoder's 14k x 256, each LSTM layer's 2 x 1024 x 256), and bf16 halves that. The
-bf16 kernels are oneDNN's; in fp32 the trie walk's one-step LSTM calls take PyTorch's own kernel
-(`_native_rnn`), for which oneDNN would build a primitive per call. Log-probabilities move by a few
-hundredths of a nat per text (README: what that does to Table I and the dev instructions).
+kernels are oneDNN's; the decoder and the trie walk's one-step LSTM calls use weights laid out for it
+once (`_prepacked`, `_OneStep`), where `F.linear` and `nn.LSTM` would lay them out at every call.
+Log-probabilities move by a few hundredths of a nat per text (README: what that does to Table I and
+the dev instructions).
 """
 
 from __future__ import annotations
@@ -56,6 +57,47 @@ def _native_rnn(rnn, x: torch.Tensor, state=None):
         return rnn(x, state)
     finally:
         torch.backends.mkldnn.enabled = before
+
+
+def _prepacked(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Callable[[torch.Tensor], torch.Tensor]:
+    """x -> x @ weight.T + bias, the weight put in oneDNN's layout once, here. `F.linear` lays it out
+    again at every call, which for a completion's few rows costs more than the product (the decoder's
+    14k x 256 in bf16: 0.30 -> 0.14 ms for 7 rows, 0.85 -> 0.67 ms for 40). The ops are PyTorch's own,
+    those its compiler uses for frozen CPU models; `F.linear` where this build lacks them or oneDNN has
+    no bf16 on this CPU. The same numbers as `F.linear` (tests/test_lm.py)."""
+    try:
+        usable = torch.backends.mkldnn.is_available() and (
+            weight.dtype != torch.bfloat16 or torch.ops.mkldnn._is_mkldnn_bf16_supported())
+        packed = torch.ops.mkldnn._reorder_linear_weight(weight, None) if usable else None
+    except (AttributeError, RuntimeError):  # a build without these oneDNN ops
+        packed = None
+    if packed is None:
+        return lambda x: F.linear(x, weight, bias)
+    return lambda x: torch.ops.mkldnn._linear_pointwise(x, packed, bias, "none", [], "")
+
+
+class _OneStep:
+    """One time step of an LSTM, each layer's four gates one product of [input, h] with the weights laid
+    out once (`_prepacked`); the gates and the cell in fp32. The trie walk's calls below the shared
+    prefix are one step for a few rows, where oneDNN's LSTM, laying out its weights at every call, takes
+    0.3 ms and this 0.14 ms (bf16, 3 rows, 2 layers of 256)."""
+
+    def __init__(self, rnn: torch.nn.LSTM):
+        self.dtype = rnn.weight_ih_l0.dtype
+        self.layers = [_prepacked(torch.cat([getattr(rnn, f"weight_ih_l{k}"), getattr(rnn, f"weight_hh_l{k}")], 1).detach(),
+                                  (getattr(rnn, f"bias_ih_l{k}") + getattr(rnn, f"bias_hh_l{k}")).detach().float())
+                       for k in range(rnn.num_layers)]
+
+    def __call__(self, x: torch.Tensor, state: tuple[torch.Tensor, torch.Tensor]):
+        """x (B, 1, E) and state ((layers, B, H) twice), fp32, as `nn.LSTM` takes and gives them."""
+        inp, hs, cs = x[:, 0], [], []
+        for k, gates in enumerate(self.layers):
+            i, f, g, o = gates(torch.cat([inp, state[0][k]], 1).to(self.dtype)).float().chunk(4, 1)
+            c = torch.sigmoid(f) * state[1][k] + torch.sigmoid(i) * torch.tanh(g)
+            inp = torch.sigmoid(o) * torch.tanh(c)
+            hs.append(inp)
+            cs.append(c)
+        return inp.unsqueeze(1), (torch.stack(hs), torch.stack(cs))
 
 
 @dataclass
@@ -99,14 +141,18 @@ class LMScorer:
         self.precision = pick_precision(precision, decoder.weight.device)
         dtype = torch.bfloat16 if self.precision == "bf16" else decoder.weight.dtype
         self._decoder = (decoder.weight.detach().to(dtype), decoder.bias.detach())
+        self._decode = _prepacked(self._decoder[0])
         # The LSTM in the same precision, a copy: the model's own weights stay fp32 for training code.
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
+        self._step = _OneStep(self._rnn)
         self._unk = self.vocab.words.index(UNK)
 
     def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
-        """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. In fp32 the
-        trie walk's one-step calls (`few_rows`) take PyTorch's own kernel (`_native_rnn`); bf16 needs
-        oneDNN's."""
+        """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. One step
+        from a state (the trie walk below the shared prefix) is `_OneStep`; longer runs are oneDNN's in
+        bf16, and in fp32 PyTorch's own kernel for `few_rows` (`_native_rnn`)."""
+        if x.shape[1] == 1 and state is not None:
+            return self._step(x, state)
         if self._rnn is self.model.rnn:
             return _native_rnn(self._rnn, x, state) if few_rows else self._rnn(x, state)
         low = self._decoder[0].dtype
@@ -187,7 +233,7 @@ class LMScorer:
     def _logits(self, rows: torch.Tensor) -> torch.Tensor:
         """The decoder's fp32 logits of LSTM output `rows`, multiplied in the scorer's precision."""
         weight, bias = self._decoder
-        return torch.add(F.linear(rows.to(weight.dtype), weight), bias)  # fp32 out: one pass, no copy
+        return torch.add(self._decode(rows.to(weight.dtype)), bias)  # fp32 out: one pass, no copy
 
     @torch.no_grad()
     def _walk(self, seqs: list[list[int]], keep_states: bool = False) -> _Walk:

@@ -38,11 +38,13 @@ def _request_before(doc: Doc, predicate: Token) -> set[int]:
 
 def _role_words(doc: Doc, mention: FrameMention, predicate: Token) -> set[int]:
     """The stated roles' words, their left modifiers ("some oil") and the prepositions heading them; the
-    predicate's particle ("rub it in") and its object when that is no role ("dip a few", "dump some")."""
+    predicate's particle ("rub it in"), its object when that is no role ("dip a few", "dump some") and
+    the person it is done for as a pronoun ("pour me some water"): the addressee of the request, which
+    the frame's text has no place for ("pour water into the mug me for my tea")."""
     heads = [t for t in doc if _covered(t, list(mention.spans.values()))]
     words = {t.i for t in heads}
     for child in predicate.children:
-        if child.dep_ == "prt" or child.tag_ == "RP":
+        if child.dep_ == "prt" or child.tag_ == "RP" or child.dep_ == "dative" and child.tag_ == "PRP":
             words.add(child.i)
         elif child.dep_ == "dobj" and child.i not in words:
             words |= {t.i for t in child.subtree}
