@@ -736,3 +736,26 @@ def test_a_dip_whose_straight_way_down_is_out_of_reach_is_refused_saying_so(sim,
     monkeypatch.setattr(planning, "_straight_line", lambda *args: None)
     refused = planner.plan(PROGRAMS["dip"], strawberry, batter, holding=False)
     assert isinstance(refused, Infeasible) and "cannot go straight down to 'dip'" in refused.reason, refused
+
+
+def test_no_joint_angles_take_the_gripper_past_the_arms_reach(sim, tmp_path):
+    """The reach bound that lets IK and planning give up at once is a true bound: over random joint
+    angles within the limits the gripper stays inside it (and comes within a fifth of it), and a pose
+    outside it is refused without a search, by how far outside it lies."""
+    from lmcr.executor.arm import DOWN
+    from lmcr.executor.plan import Planner
+    from lmcr.executor.scene import Scene
+
+    scene = Scene([SceneObject("cup", (0.0, 0.2))])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    rng = np.random.default_rng(0)
+    for arm in planner.arms.values():
+        farthest = 0.0
+        for _ in range(300):
+            arm.set_config(rng.uniform(*arm.limits.T))
+            farthest = max(farthest, float(np.linalg.norm(arm.ee_pose()[0] - arm.shoulder)))
+        assert 0.8 * arm.reach < farthest <= arm.reach
+        far = arm.shoulder + np.array([arm.reach + 0.25, 0.0, 0.0])
+        arm.set_config(arm.home)
+        q, err_pos, _ = arm.solve(far, DOWN, [arm.home])
+        assert err_pos == pytest.approx(0.25) and np.allclose(q, arm.home)

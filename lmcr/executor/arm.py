@@ -87,6 +87,22 @@ class Arm:
         self.ik_restarts = [rng.uniform(*self.limits.T) for _ in range(IK_RESTARTS)]
         self.finger_open, self.finger_shut, self.gaps = self._finger_range()
         self.opening = self.gaps[0] - FINGER_THICKNESS  # the widest object that fits between the open fingers
+        self.shoulder, self.reach = self._reach()
+
+    def _reach(self) -> tuple[np.ndarray, float]:
+        """The first joint's origin (it turns about itself: it stays put) and the length of the chain from
+        there to the gripper, joint origin to joint origin: the links are rigid, so no joint angles put
+        the gripper farther from the shoulder than that (the triangle inequality)."""
+        saved = self.config()
+        origins = [np.asarray(p.getLinkState(self.robot, j, computeForwardKinematics=True)[4]) for j in self.joints]
+        reach = sum(float(np.linalg.norm(b - a)) for a, b in zip(origins, [*origins[1:], self.ee_pose()[0]]))
+        self.set_config(saved)
+        return origins[0], reach
+
+    def beyond_reach(self, position) -> float:
+        """How far `position` lies outside the sphere the gripper can reach (`_reach`); > 0: no joint
+        angles reach it, whatever the orientation."""
+        return float(np.linalg.norm(np.asarray(position) - self.shoulder)) - self.reach
 
     def _finger_range(self) -> tuple[list[float], list[float], tuple[float, float]]:
         """Finger joint targets that open and shut the gripper, and the distance between the fingers'
@@ -122,7 +138,11 @@ class Arm:
         """Joint angles within the limits reaching the pose: damped least squares from each seed in turn
         until one converges; (joints, position error m, orientation error rad) of the best. From the first
         seed the pose is also approached in stages (a large turn of the wrist, as in tilting to pour,
-        defeats a single local solve)."""
+        defeats a single local solve). A position beyond the arm's reach is not searched: the error is then
+        how far beyond it lies, the least any joints would leave."""
+        beyond = self.beyond_reach(position)
+        if beyond > IK_POSITION:
+            return np.asarray(seeds[0], dtype=float), beyond, math.pi
         best = None
         for seed in [*seeds, "staged"]:
             if isinstance(seed, str):
