@@ -25,7 +25,7 @@ demo: setup
 test: setup
 	-$(MAKE) browser
 	$(BIN)/ruff check lmcr flows tests bench
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q --durations=10
 
 # Headless Chromium from the npm registry (@sparticuz/chromium bundles the binary) for the HIT preview check.
 browser: annotation/browser/node_modules/.installed
