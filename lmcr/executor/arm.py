@@ -93,10 +93,8 @@ class Arm:
         """The first joint's origin (it turns about itself: it stays put) and the length of the chain from
         there to the gripper, joint origin to joint origin: the links are rigid, so no joint angles put
         the gripper farther from the shoulder than that (the triangle inequality)."""
-        saved = self.config()
         origins = [np.asarray(p.getLinkState(self.robot, j, computeForwardKinematics=True)[4]) for j in self.joints]
         reach = sum(float(np.linalg.norm(b - a)) for a, b in zip(origins, [*origins[1:], self.ee_pose()[0]]))
-        self.set_config(saved)
         return origins[0], reach
 
     def beyond_reach(self, position) -> float:

@@ -220,9 +220,9 @@ class Planner:
         # a pose beyond the arm's reach fails the variant before any motion to the steps ahead of it is
         # planned (for an object out of reach, most of the search's time went into those)
         for i, step in enumerate(steps):
-            if step.positions and all(arm.beyond_reach(x) > IK_POSITION for x in step.positions):
-                short = min(arm.beyond_reach(x) for x in step.positions)
-                return Infeasible(f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)", i, True)
+            short = min((arm.beyond_reach(x) for x in step.positions), default=0.0)
+            if short > IK_POSITION:
+                return Infeasible(_cannot_reach(arm, step, short), i, True)
         q, segments, released = start, [], False
         for i, step in enumerate(steps):
             if step.kind == "grasp":
@@ -253,7 +253,7 @@ class Planner:
             for position in step.positions:
                 goal, err_pos, err_rot = arm.solve(position, step.orientation, [q, arm.home])
                 if err_pos > IK_POSITION or err_rot > IK_ROTATION:
-                    why, reach = f"the {arm.side} arm cannot reach '{step.name}' ({err_pos * 100:.0f} cm short)", True
+                    why, reach = _cannot_reach(arm, step, err_pos), True
                     continue
                 hit = clash(goal)
                 if hit:
@@ -284,6 +284,11 @@ class Planner:
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
         return segments
+
+
+def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
+    """Why a step is out of reach: the arm and how far short of it the gripper stays (metres)."""
+    return f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)"
 
 
 def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject,
