@@ -1,10 +1,12 @@
 """Benchmark: completion on the dev instructions (accuracy, questions) and its latency.
 
 Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm+frame_counts]
-       [--corpus all] [--mixture household=30|plain] [--no-context]
+       [--corpus all] [--mixture household=30|plain] [--no-context] [--scene-size 40]
 Uses the store, checkpoints and chosen mixture of $LMCR_DATA_DIR and the calibration `lmcr evaluate` wrote there.
 1. Accuracy: an instruction counts as right when the completed frame is the expected one, with or
    without a question; a question whose best guess is wrong is wrong even when it names the object.
+   --scene-size N fills each scene with robot-vocabulary objects up to N: the same instructions among
+   many distractors (what a cap on the frames that read the context could lose).
 2. Latency: one completion of "pour me some water" and of "pour me some water for my tea" (context) with
    40 detected objects (the robot vocabulary but the theme), median and p90 of 200 runs after 20 warm-ups.
 """
@@ -39,6 +41,12 @@ def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs:
             f"p90 {1000 * times[int(0.9 * runs)]:.2f} ms ({runs} runs)")
 
 
+def filled_scene(record: dict, size: int) -> dict:
+    """The record with its objects followed by robot-vocabulary objects it lacks, up to `size` in all."""
+    objects = list(dict.fromkeys([*record["objects"], *load_lexicon().objects]))
+    return {**record, "objects": objects[:max(size, len(record["objects"]))]}
+
+
 def main() -> None:
     parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser_.add_argument("--instructions", type=Path, required=True)
@@ -47,6 +55,7 @@ def main() -> None:
     parser_.add_argument("--mixture", default=None, help="corpus weights (household=30, plain); default: the chosen one")
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
     parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
+    parser_.add_argument("--scene-size", type=int, default=0, help="fill each scene with other objects up to this")
     args = parser_.parse_args()
     ws = Workspace.from_env()
     res = ws.resources(corpus=args.corpus)
@@ -56,7 +65,11 @@ def main() -> None:
     parser = ws.parser()
     print(f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
           f"{'on' if config.context else 'off'}); {config.source}")
-    print(instruction_accuracy(parser, scorer, config, load_instructions(args.instructions)).summary())
+    records = load_instructions(args.instructions)
+    if args.scene_size:
+        records = [filled_scene(r, args.scene_size) for r in records]
+        print(f"scenes filled to {args.scene_size} objects with the robot vocabulary")
+    print(instruction_accuracy(parser, scorer, config, records).summary())
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
         print(latency(parser, scorer, config, instruction, runs=args.runs))
 

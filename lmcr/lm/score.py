@@ -40,9 +40,11 @@ from lmcr.lm.train import pick_precision
 from lmcr.lm.vocab import UNK
 
 NORMS = ("sum", "mean")
-# Frames whose score reads the instruction's context (`LMScorer.score_frames`). A dev scene holds 5-7
-# objects, so there every frame reads it; the cap bounds the cost in large scenes (40 objects: the bench).
-CONTEXT_TOP = 10
+# Frames whose score reads the instruction's context (`LMScorer.score_frames`): the best by the frame
+# alone. A dev scene holds 4-5 objects, so there every frame reads it; the cap bounds the cost in large
+# scenes. With every dev instruction's scene filled to 40 objects, the caps 3, 5, 7 and 10 pick the same
+# objects (`bench/bench_complete.py --scene-size 40`), and each frame read costs a decoder row per word.
+CONTEXT_TOP = 5
 DECODER_BLOCK = 4096  # rows per decoder call: 4096 x 14k-word vocabulary = 235 MB of logits at most
 
 
