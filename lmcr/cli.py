@@ -265,6 +265,7 @@ def train(
     batch_tokens: int = typer.Option(TrainConfig.batch_tokens, help="Padded tokens per batch."),
     lr: float = typer.Option(TrainConfig.lr, help="Adam learning rate."),
     min_freq: int = typer.Option(MIN_FREQ, help="Vocabulary frequency cut-off."),
+    seed: int = typer.Option(TrainConfig.seed, help="Seed of the initial weights and the batch order."),
     device: str | None = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
     precision: Literal["auto", "bf16", "fp32"] = typer.Option("auto", help="auto: bf16 autocast where the hardware has it."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
@@ -282,7 +283,7 @@ def train(
     path = train_setting(ws.connect, ws.checkpoints, linearization, corpus,
                          LMConfig(0, embedding, layers, dropout),
                          TrainConfig(max_epochs=max_epochs, device=device, max_minutes=max_minutes, precision=precision,
-                                     lr=lr, batch_tokens=batch_tokens),
+                                     lr=lr, batch_tokens=batch_tokens, seed=seed),
                          min_freq=min_freq, on_epoch=show)
     console.print(f"published {path}")
 

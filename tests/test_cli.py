@@ -41,6 +41,17 @@ def test_version_and_fixed_choices():
     assert typo.exit_code == 2 and "'youcook2', 'recipes', 'household', 'all'" in typo.output
 
 
+def test_train_passes_its_settings_seed_included(monkeypatch, tmp_path):
+    from lmcr.lm import run
+
+    seen = {}
+    monkeypatch.setattr(run, "train_setting", lambda *args, **kw: seen.update(config=args[5]) or tmp_path / "v1")
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    result = runner.invoke(app, ["train", "--corpus", "household", "--seed", "7", "--max-epochs", "2"])
+    assert result.exit_code == 0, result.output
+    assert seen["config"].seed == 7 and seen["config"].max_epochs == 2 and "published" in result.output
+
+
 def test_light_commands_do_not_import_the_heavy_libraries():
     import subprocess
     import sys
