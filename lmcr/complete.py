@@ -84,7 +84,7 @@ def _question(template: str, roles: dict[str, str | None], missing: list[str], c
     """'Should I pour milk into the bowl, the glass or the plate?': the predicate's sentence template with
     the choices in the missing slot (one missing role), or one filled template per choice (two)."""
     def either(items: list[str]) -> str:
-        return ", ".join(items[:-1]) + f" or {items[-1]}"
+        return ", ".join(items[:-1]) + f" or {items[-1]}" if len(items) > 1 else items[0]
 
     if len(missing) == 1:
         role = missing[0]
@@ -102,24 +102,26 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         context = utterance_context(doc, frame)
     else:
         frame, context = parse_instruction(parser, instruction), ""
-    pool = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
-    # A detection the robot has no vocabulary for is never chosen: nothing learned says what it is.
-    ignored = [o for o in pool if parser.lex.objects and o not in parser.lex.objects]
-    pool = [o for o in pool if o not in ignored]
+    detected = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
     roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
-    roles, unresolved = _ground(roles, parser.lex.objects, pool)
+    # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
+    # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
+    roles, unresolved = _ground(roles, parser.lex.objects, detected)
     missing = [r for r, v in roles.items() if v is None]
+    stated = {v for v in roles.values() if v}
+    # A detection outside the robot's object vocabulary ("salsa" typed to `lmcr complete`) is scored like
+    # any other, as the corpora know it (a word they never saw scores low), but never chosen silently.
+    unfamiliar = [o for o in detected if parser.lex.objects and o not in parser.lex.objects and o not in stated]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "unresolved": {}, "ignored_objects": ignored, "candidates": [], "question": None, "context": context}
-    stated = {v for v in roles.values() if v}
-    pool = [o for o in pool if o not in stated]
+                "unresolved": {}, "unfamiliar_objects": unfamiliar, "candidates": [], "question": None,
+                "context": context}
+    pool = [o for o in detected if o not in stated]
     if len(pool) < len(missing):
-        unknown = f" ({', '.join(ignored)}: not in the robot's object vocabulary)" if ignored else ""
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
                               f"{'no usable objects' if not pool else 'too few usable objects'} besides "
-                              f"{sorted(stated) or 'none'}{unknown}")
+                              f"{sorted(stated) or 'none'}")
     fillings = _candidate_frames(missing, pool)
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
@@ -132,13 +134,16 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     chosen = ranked[0][0]
     in_set = [c for c in candidates if c["probability"] >= config.set_threshold]
     question = None
-    if (len(in_set) != 1 or unresolved) and len(candidates) > 1:  # a replaced word is always confirmed
-        choices = (in_set if len(in_set) > 1 else candidates)[: max(config.max_choices, 2)]
+    confirm = unresolved or any(o in unfamiliar for o in chosen.values())  # always asked, however likely
+    if len(in_set) != 1 and len(candidates) > 1 or confirm:
+        # One likely object is confirmed alone, unless it stands for a word we replaced: then offer others.
+        one = len(in_set) == 1 and not unresolved
+        choices = (in_set if len(in_set) > 1 or one else candidates)[: max(config.max_choices, 2)]
         question = _question(parser.lex.predicates[frame.predicate].sentence, roles, missing, choices)
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "unresolved": unresolved, "ignored_objects": ignored, "candidates": candidates,
+            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar, "candidates": candidates,
             "question": question, "context": context}
 
 

@@ -45,7 +45,7 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "unresolved": {}, "ignored_objects": [], "candidates": [],
+                   "missing": None, "missing_roles": [], "unresolved": {}, "unfamiliar_objects": [], "candidates": [],
                    "question": None, "context": ""}
 
 
@@ -57,6 +57,17 @@ def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
     assert out["question"] == "I see no side. Should I fry the cup or the glass in the pan?"
     kept = complete(parser, scorer, "pour the water", ["cup", "bowl"])
     assert kept["unresolved"] == {} and kept["frame"]["roles"]["Theme"] == "water"
+
+
+def test_a_stated_object_that_is_detected_grounds_without_the_robot_vocabulary(parser):
+    """The person named the cucumber and the robot sees one: it is no choice of the scorer's, so it stays
+    (not 'I see no cucumber') and is no question; an unnamed detection outside the vocabulary is a candidate."""
+    out = complete(parser, scorer, "season the sliced cucumbers", ["cucumber", "salt", "kumquat", "cup"])
+    assert out["unresolved"] == {} and out["missing"] == "Instrument" and out["question"] is None
+    assert out["frame"]["roles"] == {"Theme": "cucumber", "Instrument": "cup"}  # the stand-in likes cups
+    assert out["unfamiliar_objects"] == ["kumquat"] and [c["object"] for c in out["candidates"]] == ["cup", "salt", "kumquat"]
+    unseen = complete(parser, scorer, "season the sliced cucumbers", ["salt", "cup"])
+    assert unseen["unresolved"] == {"Theme": "cucumber"} and unseen["question"].startswith("I see no cucumber.")
 
 
 def test_two_missing_roles_score_object_pairs(parser):

@@ -342,16 +342,22 @@ def test_a_copy_of_a_loaded_file_is_skipped_and_a_new_encoding_reloads(con, path
 
 
 @pytest.mark.model
-def test_unknown_objects_are_never_chosen():
-    from lmcr.complete import CompletionError, complete
+def test_unknown_objects_are_never_chosen_silently():
+    """A detection outside the robot's vocabulary may be the best guess, but it is always asked about."""
+    from lmcr.complete import CompletionConfig, complete
     from lmcr.srl.parser import load_parser
 
     parser = load_parser()
     prefer_unknown = lambda frames, context="": [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
-    out = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor", "cup"])
-    assert out["frame"]["roles"]["Destination"] == "cup" and out["ignored_objects"] == ["flux capacitor"]
-    with pytest.raises(CompletionError, match="not in the robot's object vocabulary"):
-        complete(parser, prefer_unknown, "pour me some water", ["flux capacitor"])
+    confident = CompletionConfig(set_threshold=0.5)
+    out = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor", "cup"], confident)
+    assert out["frame"]["roles"]["Destination"] == "flux capacitor" and out["unfamiliar_objects"] == ["flux capacitor"]
+    assert out["candidates"][0]["probability"] > 0.99
+    assert out["question"] == "Should I pour water into the flux capacitor?"  # confident: confirmed alone
+    alone = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor"], confident)
+    assert alone["question"] == "Should I pour water into the flux capacitor?"
+    known = complete(parser, prefer_unknown, "pour me some water", ["bowl", "cup"], confident)
+    assert known["unfamiliar_objects"] == [] and known["question"] == "Should I pour water into the bowl or the cup?"
 
 
 def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monkeypatch):
