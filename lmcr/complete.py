@@ -16,9 +16,12 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from spacy.lang.en.stop_words import STOP_WORDS
+
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
+from lmcr.lexicon import is_object_name
 from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.context import utterance_context
 from lmcr.srl.parser import FrameParser, parse_instruction, read_instruction
@@ -102,7 +105,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         context = utterance_context(doc, frame)
     else:
         frame, context = parse_instruction(parser, instruction), ""
-    detected = list(dict.fromkeys(o.strip().lower() for o in objects if o and o.strip()))
+    detected = list(dict.fromkeys(" ".join(o.split()).lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
     roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
@@ -111,17 +114,22 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     missing = [r for r, v in roles.items() if v is None]
     stated = {v for v in roles.values() if v}
     # A detection outside the robot's object vocabulary ("salsa" typed to `lmcr complete`) is scored like
-    # any other, as the corpora know it (a word they never saw scores low), but never chosen silently.
-    unfamiliar = [o for o in detected if parser.lex.objects and o not in parser.lex.objects and o not in stated]
+    # any other, as the corpora know it (a word they never saw scores low), but never chosen silently;
+    # one that names nothing (emoji, digits, a paragraph, only function words) is ignored.
+    outside = [o for o in detected if parser.lex.objects and o not in parser.lex.objects and o not in stated]
+    ignored = [o for o in outside if not is_object_name(o) or STOP_WORDS.issuperset(o.split())]  # "the", "into"
+    unfamiliar = [o for o in outside if o not in ignored]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "unresolved": {}, "unfamiliar_objects": unfamiliar, "candidates": [], "question": None,
-                "context": context}
-    pool = [o for o in detected if o not in stated]
+                "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
+                "question": None, "context": context}
+    pool = [o for o in detected if o not in stated and o not in ignored]
     if len(pool) < len(missing):
+        shown = [repr(o if len(o) <= 30 else o[:27] + "...") for o in ignored[:3]]  # the error stays one short line
+        unnamed = f" ({', '.join(shown)}{', ...' if len(ignored) > 3 else ''}: no object name)" if ignored else ""
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
                               f"{'no usable objects' if not pool else 'too few usable objects'} besides "
-                              f"{sorted(stated) or 'none'}")
+                              f"{sorted(stated) or 'none'}{unnamed}")
     fillings = _candidate_frames(missing, pool)
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
@@ -143,7 +151,8 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar, "candidates": candidates,
+            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored,
+            "candidates": candidates,
             "question": question, "context": context}
 
 

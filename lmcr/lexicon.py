@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -11,6 +12,15 @@ from pathlib import Path
 LEXICON_PATH = Path(__file__).with_name("lexicon.json")
 # What the lexicon is made of: a change to either changes every frame the parser finds.
 LEXICON_FILES = (Path(__file__), LEXICON_PATH)
+# What can name a thing on the table: one to four words of letters ("salsa", "crème fraîche", "half-and-half"),
+# at most 40 characters; emoji, digits or a pasted paragraph name nothing a robot could pick up.
+_OBJECT_NAME_RE = re.compile(r"[^\W\d_]+(?:[ '-][^\W\d_]+){0,3}")
+MAX_OBJECT_NAME_CHARS = 40
+
+
+def is_object_name(label: str) -> bool:
+    """True when `label` (lowercase, single spaces) could name an object: words of letters, not too long."""
+    return len(label) <= MAX_OBJECT_NAME_CHARS and _OBJECT_NAME_RE.fullmatch(label) is not None
 
 
 @dataclass(frozen=True)

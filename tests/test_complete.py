@@ -45,7 +45,7 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "unresolved": {}, "unfamiliar_objects": [], "candidates": [],
+                   "missing": None, "missing_roles": [], "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
                    "question": None, "context": ""}
 
 

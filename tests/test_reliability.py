@@ -360,6 +360,26 @@ def test_unknown_objects_are_never_chosen_silently():
     assert known["unfamiliar_objects"] == [] and known["question"] == "Should I pour water into the bowl or the cup?"
 
 
+@pytest.mark.model
+def test_labels_that_name_nothing_are_ignored():
+    """Emoji, digits, invisible characters or a paragraph are no object: never scored, never chosen."""
+    from lmcr.complete import CompletionError, complete
+    from lmcr.lexicon import is_object_name
+    from lmcr.srl.parser import load_parser
+
+    junk = ["😀😀", "\u200b", "123", "x" * 41, "pour the water into the cup and then wash it"]
+    assert not any(is_object_name(j.strip()) for j in junk)
+    junk.append("into the")  # words, but only function words: the LM's text would lose them
+    assert all(map(is_object_name, ["salsa", "crème fraîche", "half-and-half", "cutting board"]))
+    seen = []
+    prefer_junk = lambda frames, context="": [seen.extend(f.role_map.values()) or 0.0 for f in frames]  # noqa: E731
+    out = complete(load_parser(), prefer_junk, "pour it", [*junk, "water", "Cutting  Board"])
+    assert sorted(out["ignored_objects"]) == sorted(j.strip() for j in junk if j.strip())
+    assert set(out["frame"]["roles"].values()) == {"water", "cutting board"} and set(seen) == {"water", "cutting board"}
+    with pytest.raises(CompletionError, match="no usable objects besides .*no object name"):
+        complete(load_parser(), prefer_junk, "pour me some water", junk)
+
+
 def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monkeypatch):
     import lmcr.complete as completion
 
