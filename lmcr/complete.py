@@ -16,8 +16,6 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from spacy.lang.en.stop_words import STOP_WORDS
-
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
@@ -117,7 +115,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     # any other, as the corpora know it (a word they never saw scores low), but never chosen silently;
     # one that names nothing (emoji, digits, a paragraph, only function words) is ignored.
     outside = [o for o in detected if parser.lex.objects and o not in parser.lex.objects and o not in stated]
-    ignored = [o for o in outside if not is_object_name(o) or STOP_WORDS.issuperset(o.split())]  # "the", "into"
+    ignored = [o for o in outside if not is_object_name(o)]
     unfamiliar = [o for o in outside if o not in ignored]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
@@ -151,9 +149,8 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored,
-            "candidates": candidates,
-            "question": question, "context": context}
+            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
+            "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context}
 
 
 def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str = "") -> CompletionConfig:

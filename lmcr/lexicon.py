@@ -13,14 +13,19 @@ LEXICON_PATH = Path(__file__).with_name("lexicon.json")
 # What the lexicon is made of: a change to either changes every frame the parser finds.
 LEXICON_FILES = (Path(__file__), LEXICON_PATH)
 # What can name a thing on the table: one to four words of letters ("salsa", "crème fraîche", "half-and-half"),
-# at most 40 characters; emoji, digits or a pasted paragraph name nothing a robot could pick up.
+# at most 40 characters, not only function words; emoji, digits, "into the" or a pasted paragraph name
+# nothing a robot could pick up (and an LM that drops articles would score "the" as an empty filler).
 _OBJECT_NAME_RE = re.compile(r"[^\W\d_]+(?:[ '-][^\W\d_]+){0,3}")
 MAX_OBJECT_NAME_CHARS = 40
 
 
 def is_object_name(label: str) -> bool:
-    """True when `label` (lowercase, single spaces) could name an object: words of letters, not too long."""
-    return len(label) <= MAX_OBJECT_NAME_CHARS and _OBJECT_NAME_RE.fullmatch(label) is not None
+    """True when `label` (lowercase, single spaces) could name an object: words of letters, not too long,
+    not only function words."""
+    from spacy.lang.en.stop_words import STOP_WORDS  # here, not at import: the CLI starts without spaCy
+
+    return len(label) <= MAX_OBJECT_NAME_CHARS and _OBJECT_NAME_RE.fullmatch(label) is not None \
+        and not STOP_WORDS.issuperset(label.split())
 
 
 @dataclass(frozen=True)

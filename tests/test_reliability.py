@@ -370,6 +370,7 @@ def test_labels_that_name_nothing_are_ignored():
     junk = ["😀😀", "\u200b", "123", "x" * 41, "pour the water into the cup and then wash it"]
     assert not any(is_object_name(j.strip()) for j in junk)
     junk.append("into the")  # words, but only function words: the LM's text would lose them
+    assert not is_object_name("into the")
     assert all(map(is_object_name, ["salsa", "crème fraîche", "half-and-half", "cutting board"]))
     seen = []
     prefer_junk = lambda frames, context="": [seen.extend(f.role_map.values()) or 0.0 for f in frames]  # noqa: E731
