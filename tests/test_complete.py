@@ -76,6 +76,8 @@ def test_two_missing_roles_score_object_pairs(parser):
     assert set(out["frame"]["roles"].values()) == {"cup", "water"}  # the best-scoring pair
     assert all(c["objects"]["Theme"] != c["objects"]["Destination"] for c in out["candidates"])
     assert len(out["candidates"]) == 12
+    vague = complete(parser, scorer, "I'm thirsty, pour me something", ["water", "milk", "cup", "scissors"])
+    assert vague["missing_roles"] == ["Theme", "Destination"] and vague["unresolved"] == {}  # no "I see no something"
 
 
 def test_empty_objects_and_unknown_verbs_are_clear_errors(parser):
@@ -136,13 +138,15 @@ def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_pa
     lines = [{"instruction": "pour me some water", "objects": ["scissors", "cup", "bowl"], "expected": pour("cup")},
              {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("cup")},  # asks, cup first
              {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("glass")},  # asks, wrong guess
-             {"instruction": "pour me some water", "objects": ["bowl", "scissors"], "expected": pour("scissors")}]
+             {"instruction": "pour me some water", "objects": ["bowl", "scissors"], "expected": pour("scissors")},
+             {"instruction": "wash the cup", "objects": ["cup", "sink"], "expected": pour("cup")}]  # no robot verb
     path = tmp_path / "instructions.jsonl"
     path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
     done = instruction_accuracy(parser, scorer, CompletionConfig(set_threshold=0.3), load_instructions(path))
-    assert (done.total, done.answered_right, done.asked, done.asked_right, done.right) == (4, 1, 2, 1, 2)
-    assert done.accuracy == 0.5 and [roles["Destination"] for _, roles, _ in done.wrong] == ["cup", "bowl"]
-    assert done.summary().splitlines()[0] == ("dev instructions: 2/4 = 0.500 right (1 answered right, 2 questions "
+    assert (done.total, done.answered_right, done.asked, done.asked_right, done.right) == (5, 1, 2, 1, 2)
+    assert done.accuracy == 0.4 and [roles.get("Destination") for _, roles, _ in done.wrong] == ["cup", "bowl", None]
+    assert "no known predicate in 'wash the cup'" in done.wrong[-1][1]["error"]  # counted wrong, not a crash
+    assert done.summary().splitlines()[0] == ("dev instructions: 2/5 = 0.400 right (1 answered right, 2 questions "
                                               "of which 1 guess right)")
     path.write_text(json.dumps(lines[0]) + "\n" + '{"instruction": "pour it"}\n', encoding="utf-8")
     with pytest.raises(InputError, match=r"instructions.jsonl:2"):

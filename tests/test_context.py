@@ -41,6 +41,17 @@ def test_a_second_clause_is_context_and_the_request_is_not():
     assert utterance_context(doc, mention(doc, 4, {"Destination": 6, "Theme": None})) == "the dog is thirsty"
 
 
+def test_a_clause_before_the_request_is_context_when_it_says_something():
+    doc = make_doc("I/PRP/nsubj/1 'm/VBP/ROOT/1 thirsty/JJ/acomp/1 ,/,/punct/1 pour/VB/conj/1 me/PRP/dative/4 "
+                   "some/DT/det/7 water/NN/dobj/4")
+    assert utterance_context(doc, mention(doc, 4, {"Theme": 7, "Destination": None})) == "i 'm thirsty"
+    doc = make_doc("please/UH/intj/2 ,/,/punct/2 pour/VB/ROOT/2 the/DT/det/4 wine/NN/dobj/2")
+    assert utterance_context(doc, mention(doc, 2, {"Theme": 4, "Destination": None})) == ""
+    doc = make_doc("ok/UH/intj/6 ,/,/punct/6 so/RB/advmod/6 ,/,/punct/6 could/MD/aux/6 you/PRP/nsubj/6 fill/VB/ROOT/6 "
+                   "the/DT/det/8 glass/NN/dobj/6")
+    assert utterance_context(doc, mention(doc, 6, {"Destination": 8, "Theme": None})) == ""
+
+
 def test_placeholder_object_particle_and_stated_role_prepositions_are_the_frame():
     doc = make_doc("dump/VB/ROOT/0 some/DT/dobj/0 into/IN/prep/0 the/DT/det/4 pot/NN/pobj/2 to/TO/aux/6 "
                    "boil/VB/advcl/0")

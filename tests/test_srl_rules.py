@@ -90,6 +90,21 @@ def test_passive_subject_is_the_theme():
     assert frames(doc) == [("season", {"Theme": "steak", "Instrument": "salt"})]
 
 
+def test_a_participles_object_stands_elsewhere():
+    """Requests said with a participle ("I want the steak seasoned") keep what they are about."""
+    small_clause = "I/PRP/nsubj/1 want/VBP/ROOT/1 the/DT/det/3 steak/NN/nsubj/4 seasoned/VBD/ccomp/1/season"
+    assert ("season", {"Theme": "steak", "Instrument": None}) in frames(small_clause)
+    control = "the/DT/det/1 chicken/NN/nsubj/2 needs/VBZ/ROOT/2/need to/TO/aux/5 be/VB/auxpass/5 fried/VBN/xcomp/2/fry"
+    assert ("fry", {"Theme": "chicken", "Instrument": None}) in frames(control)
+    described = "serve/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 fried/VBN/acl/2/fry in/IN/prep/3 butter/NN/pobj/4"
+    assert ("fry", {"Theme": "fish", "Instrument": "butter"}) in frames(described)
+    assert ("fry", {"Theme": "it", "Instrument": None}) in frames("get/VB/ROOT/0 it/PRP/nsubj/2 fried/VBN/ccomp/0/fry")
+    # a person does the frying; a participle with its own object needs nothing from elsewhere
+    assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [("fry", {"Theme": None, "Instrument": None})]
+    own = "I/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry the/DT/det/4 fish/NN/dobj/2"
+    assert frames(own) == [("fry", {"Theme": "fish", "Instrument": None})]
+
+
 def test_adjectival_participles_and_nouns_are_not_predicates():
     doc = "add/VB/ROOT/0 the/DT/det/3 fried/VBN/amod/3/fry onions/NNS/dobj/0/onion"
     assert frames(doc) == [("add", {"Theme": "onion"})]
@@ -142,6 +157,11 @@ def test_imperative_repair_triggers():
     # How the tagger reads a bare "fry the chicken": a preposition heading a sentence with no verb.
     preposition_root = make_doc("fry/IN/ROOT/0 the/DT/det/2 chicken/NN/dobj/0")
     assert needs_reparse(preposition_root[:])
+    # "pour milk, I'm making tea": tagged a verb, parsed as a modifier of the noun after it
+    modifier = make_doc("pour/VB/compound/1 milk/NN/dep/5 ,/,/punct/5 I/PRP/nsubj/5 'm/VBP/aux/5 making/VBG/ROOT/5 "
+                        "tea/NN/dobj/5")
+    assert needs_reparse(modifier[:])
+    assert not needs_reparse(make_doc("boiling/VB/amod/1 water/NN/nsubj/2 hisses/VBZ/ROOT/2")[:])  # a subject
     leading_prep = make_doc("In/IN/prep/3 a/DT/det/2 bowl/NN/pobj/0 mix/VB/ROOT/3 flour/NN/dobj/3")
     assert not needs_reparse(leading_prep[:])
     clause = make_doc("brush/VB/ROOT/0 bread/NN/dobj/0 and/CC/cc/1 season/NN/conj/1 with/IN/prep/3 salt/NN/pobj/4")

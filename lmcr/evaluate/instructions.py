@@ -2,7 +2,8 @@
 
 An instruction record is `{instruction, objects, expected: {predicate, roles}}` (the dev set's lines; other
 fields are ignored). It counts as right when the completed frame is the expected one: a completion that
-asks a question counts only when its best guess, what the question proposes, is right.
+asks a question counts only when its best guess, what the question proposes, is right; an instruction
+that cannot be completed (no robot predicate found) counts as wrong, with the reason.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig, complete
+from lmcr.errors import LMCRError
 from lmcr.jsonl import InputError, read_jsonl
 
 FIELDS = {"instruction": str, "objects": list, "expected": dict}
@@ -25,7 +27,8 @@ class InstructionAccuracy:
     answered_right: int = 0  # completed without a question, right
     asked: int = 0  # completions that asked
     asked_right: int = 0  # ... whose best guess was right
-    wrong: list[tuple[str, dict, str]] = field(default_factory=list)  # (instruction, completed roles, context)
+    # (instruction, completed roles or {"error": why there is no completion}, context)
+    wrong: list[tuple[str, dict, str]] = field(default_factory=list)
 
     @property
     def right(self) -> int:
@@ -62,7 +65,12 @@ def instruction_accuracy(parser, scorer: Callable, config: CompletionConfig, rec
     total = answered_right = asked = asked_right = 0
     wrong = []
     for record in records:
-        out = complete(parser, scorer, record["instruction"], record["objects"], config)
+        try:
+            out = complete(parser, scorer, record["instruction"], record["objects"], config)
+        except LMCRError as exc:  # no predicate found, nothing to fill with: no answer, so a wrong one
+            total += 1
+            wrong.append((record["instruction"], {"error": str(exc)}, ""))
+            continue
         guessed = out["frame"] == record["expected"]
         total += 1
         asked += bool(out["question"])

@@ -24,15 +24,28 @@ def _predicate(doc: Doc, mention: FrameMention) -> Token | None:
     return next((t for t in doc if t.idx <= mention.start < t.idx + max(len(t), 1)), None)
 
 
+def _clauses_before(doc: Doc, predicate: Token) -> list[list[int]]:
+    """The word indices before the predicate in its sentence, cut at clause breaks, nearest first (the
+    predicate's own clause may be empty); each earlier clause holds the break that ends it."""
+    clauses: list[list[int]] = [[]]
+    for token in reversed(doc[predicate.sent.start: predicate.i]):
+        if token.text in CLAUSE_BREAKS:
+            clauses.append([])
+        clauses[-1].append(token.i)
+    return clauses
+
+
 def _request_before(doc: Doc, predicate: Token) -> set[int]:
-    """Indices of the words before the predicate in its clause: the request wrapped around it."""
-    request = set()
-    for token in reversed(doc[: predicate.i]):
-        if token.text in CLAUSE_BREAKS and token.sent == predicate.sent and request:
+    """Indices of the words before the predicate that wrap the request around it: its own clause
+    ("could you", "go ahead and") and, back across clause breaks, clauses without a content word
+    ("please, pour the wine"). A clause that says something ("I'm thirsty, pour me some water") ends
+    the request: it is context, as is anything in an earlier sentence."""
+    own, *earlier = _clauses_before(doc, predicate)
+    request = set(own)
+    for clause in earlier:
+        if any(is_content(doc[i]) for i in clause):
             break
-        if token.sent != predicate.sent:
-            break
-        request.add(token.i)
+        request |= set(clause)
     return request
 
 

@@ -119,12 +119,42 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
             preps += _attached_preps(obj, frozenset())
         else:  # a measure's "of" leads to the head, whose own PPs count too
             preps += _attached_preps(obj, frozenset({"of"})) + _attached_preps(head, frozenset())
+    if not objects:  # "I want the steak seasoned": the participle's object stands elsewhere
+        objects = _understood_object(verb, lex)
     # A PP hung on the object of another PP ("for five minutes in the butter", "with a ladle over the
     # pasta", "on both sides in hot oil") belongs to the verb too; which one names a role is decided
     # by how usual its preposition is (`_known_frame`).
     if spec:
         preps += [more for _, obj in list(preps) for more in _attached_preps(obj, frozenset({"of"}))]
     return _Args(objects, preps, particles)
+
+
+def _is_person(token: Token, lex: Lexicon) -> bool:
+    return token.tag_ == "PRP" and token.lower_ not in lex.object_pronouns
+
+
+def _understood_object(verb: Token, lex: Lexicon) -> list[Token]:
+    """The object of a participle that has none after it, where the syntax puts it elsewhere:
+    - the subject of a participle clause ("I want the steak seasoned", "get the chicken fried", "once
+      the oil has heated"): a past participle's subject undergoes it, unless it is a person ("I have
+      fried", "we fried");
+    - the noun a participle describes ("the steak seasoned with salt", "the fish fried in butter");
+    - the subject that controls a subjectless passive ("the chicken needs to be fried") or, when there
+      is one, the object ("I want the chicken to be fried" read as want + chicken + to be fried).
+    The small tagger reads a participle after its subject as a past tense ("want the steak seasoned/VBD"),
+    so a past tense in a complement clause counts too."""
+    participle = verb.tag_ == "VBN" or verb.tag_ == "VBD" and verb.dep_ in ("ccomp", "xcomp", "oprd")
+    if not participle or any(c.dep_ in OBJECT_DEPS or c.dep_ == "expl" for c in verb.children):
+        return []
+    subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
+    if subject is not None:
+        return [] if _is_person(subject, lex) else [subject]
+    if verb.dep_ == "acl" and verb.head.i < verb.i and verb.head.tag_.startswith("NN"):
+        return [verb.head]
+    if verb.dep_ == "xcomp" and any(c.dep_ == "auxpass" for c in verb.children):
+        controller = next((c for dep in ("dobj", "nsubj") for c in verb.head.children if c.dep_ == dep), None)
+        return [] if controller is None or _is_person(controller, lex) else [controller]
+    return []
 
 
 def _right_node_object(verb: Token) -> list[Token]:

@@ -34,6 +34,7 @@ from lmcr.workspace import spacy_model_from_env
 PREFIXES = ("Please ", "You should ")
 NOUNISH_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS", "JJ", "VBN"})
 SUBJECT_DEPS = frozenset({"nsubj", "nsubjpass", "csubj"})
+MODIFIER_DEPS = frozenset({"compound", "amod"})
 # Once a first word has needed the repair DIRECT_AFTER times and starts a text as a verb at least
 # DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass (the re-parse
 # would mostly have been needed anyway, and a request form does not hurt an imperative); `_direct`.
@@ -59,16 +60,19 @@ def load_nlp(model: str | None = None) -> Language:
 
 def needs_reparse(sent: Span) -> bool:
     """True when the sentence's first word looks like a misread imperative verb and is not the subject
-    of a verb ("Chicken should be fried" is a real declarative): tagged as a noun/adjective, or tagged
+    of a verb ("Chicken should be fried" is a real declarative): tagged as a noun/adjective, tagged
     as anything but a verb while heading the whole sentence (the tagger reads a bare "fry the chicken"
-    as a preposition at the root, a sentence without any verb)."""
+    as a preposition at the root, a sentence without any verb), or tagged as a verb but parsed as a
+    modifier of the noun after it ("pour/compound milk, I'm making tea")."""
     first = next((t for t in sent if t.is_alpha), None)
     if first is None or first.i != sent.start + (sent[0].is_punct):
         return False
     misread_root = first.dep_ == "ROOT" and not first.tag_.startswith(("VB", "MD"))
-    if first.tag_ not in NOUNISH_TAGS and not misread_root:
+    # "pour milk, I'm making tea": the verb tagged right but parsed as a modifier of its object
+    misread_modifier = first.tag_ == "VB" and first.dep_ in MODIFIER_DEPS
+    if first.tag_ not in NOUNISH_TAGS and not misread_root and not misread_modifier:
         return False
-    phrase_head = first.head if first.dep_ in ("compound", "amod") else first
+    phrase_head = first.head if first.dep_ in MODIFIER_DEPS else first
     # A real declarative's subject hangs on a verb; "Heat oil in a pan, then season..." can come out
     # as "oil" subject of "season/NN", which is the same misreading again.
     return not (phrase_head.dep_ in SUBJECT_DEPS and phrase_head.head.tag_[:2] in ("VB", "MD"))
