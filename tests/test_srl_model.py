@@ -45,6 +45,11 @@ def test_misread_imperatives_are_repaired(parser):
     assert spans[0].start == 0 and spans[0].spans["Theme"] == (11, 18)  # offsets in the original text
     bare = parse_instruction(parser, "fry the chicken")  # tagged fry/IN at the root: no verb at all
     assert bare.to_json() == {"predicate": "fry", "roles": {"Theme": "chicken", "Instrument": None}}
+    # a verb tagged right but parsed as its noun's modifier, first as is, then after "Please" too
+    modifier = parse_instruction(parser, "pour milk, I'm making tea")
+    assert modifier.to_json() == {"predicate": "pour", "roles": {"Theme": "milk", "Destination": None}}
+    narration = parse_instruction(parser, "pour spice into pan")  # EPIC-KITCHENS' terse register
+    assert narration.to_json() == {"predicate": "pour", "roles": {"Theme": "spice", "Destination": "pan"}}
 
 
 @pytest.mark.shared

@@ -83,8 +83,10 @@ def as_request(text: str, prefix: str) -> str:
 
 
 def _reparse_accepted(doc: Doc, prefix: str) -> bool:
+    """The re-parse reads the first word as a verb, and not as a modifier of the noun after it ("Please
+    pour/VB/compound spice into pan": the next prefix may do better)."""
     k = len(prefix.split())
-    return len(doc) > k and doc[k].tag_.startswith("VB")
+    return len(doc) > k and doc[k].tag_.startswith("VB") and doc[k].dep_ not in MODIFIER_DEPS
 
 
 def find_split(span: Span, lex: Lexicon) -> Token | None:
