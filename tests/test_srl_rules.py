@@ -99,6 +99,10 @@ def test_a_participles_object_stands_elsewhere():
     described = "serve/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 fried/VBN/acl/2/fry in/IN/prep/3 butter/NN/pobj/4"
     assert ("fry", {"Theme": "fish", "Instrument": "butter"}) in frames(described)
     assert ("fry", {"Theme": "it", "Instrument": None}) in frames("get/VB/ROOT/0 it/PRP/nsubj/2 fried/VBN/ccomp/0/fry")
+    coordinated = ("the/DT/det/1 chicken/NN/nsubjpass/3 is/VBZ/auxpass/3 seasoned/VBN/ROOT/3/season and/CC/cc/3 "
+                   "fried/VBN/conj/3/fry")
+    assert frames(coordinated) == [("season", {"Theme": "chicken", "Instrument": None}),
+                                   ("fry", {"Theme": "chicken", "Instrument": None})]
     # a person does the frying; a participle with its own object needs nothing from elsewhere
     assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [("fry", {"Theme": None, "Instrument": None})]
     own = "I/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry the/DT/det/4 fish/NN/dobj/2"

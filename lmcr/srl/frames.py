@@ -140,7 +140,9 @@ def _understood_object(verb: Token, lex: Lexicon) -> list[Token]:
       fried", "we fried");
     - the noun a participle describes ("the steak seasoned with salt", "the fish fried in butter");
     - the subject that controls a subjectless passive ("the chicken needs to be fried") or, when there
-      is one, the object ("I want the chicken to be fried" read as want + chicken + to be fried).
+      is one, the object ("I want the chicken to be fried" read as want + chicken + to be fried);
+    - the object of the participle it is coordinated with ("the chicken is seasoned and fried",
+      "2 potatoes, peeled and chopped").
     The small tagger reads a participle after its subject as a past tense ("want the steak seasoned/VBD"),
     so a past tense in a complement clause counts too."""
     participle = verb.tag_ == "VBN" or verb.tag_ == "VBD" and verb.dep_ in ("ccomp", "xcomp", "oprd")
@@ -149,6 +151,8 @@ def _understood_object(verb: Token, lex: Lexicon) -> list[Token]:
     subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
     if subject is not None:
         return [] if _is_person(subject, lex) else [subject]
+    if verb.dep_ == "conj" and verb.head.tag_ == "VBN":  # the first participle's object is shared
+        return [c for c in verb.head.children if c.dep_ in OBJECT_DEPS][:1] or _understood_object(verb.head, lex)
     if verb.dep_ == "acl" and verb.head.i < verb.i and verb.head.tag_.startswith("NN"):
         return [verb.head]
     if verb.dep_ == "xcomp" and any(c.dep_ == "auxpass" for c in verb.children):
