@@ -65,14 +65,13 @@ def instruction_accuracy(parser, scorer: Callable, config: CompletionConfig, rec
     total = answered_right = asked = asked_right = 0
     wrong = []
     for record in records:
+        total += 1
         try:
             out = complete(parser, scorer, record["instruction"], record["objects"], config)
         except LMCRError as exc:  # no predicate found, nothing to fill with: no answer, so a wrong one
-            total += 1
             wrong.append((record["instruction"], {"error": str(exc)}, ""))
             continue
         guessed = out["frame"] == record["expected"]
-        total += 1
         asked += bool(out["question"])
         asked_right += bool(out["question"]) and guessed
         answered_right += not out["question"] and guessed
