@@ -34,7 +34,9 @@ from lmcr.workspace import spacy_model_from_env
 PREFIXES = ("Please ", "You should ")
 NOUNISH_TAGS = frozenset({"NN", "NNS", "NNP", "NNPS", "JJ", "VBN"})
 SUBJECT_DEPS = frozenset({"nsubj", "nsubjpass", "csubj"})
-MODIFIER_DEPS = frozenset({"compound", "amod"})
+# A first word read as a modifier of the noun after it. Narrower than `lemmas.MODIFIER_DEPS`: a first word
+# hung on a noun as nmod ("Heat/NN/nmod 3 tablespoons of oil ...") is judged by itself, not by that noun.
+PREMODIFIER_DEPS = frozenset({"compound", "amod"})
 # Once a first word has needed the repair DIRECT_AFTER times and starts a text as a verb at least
 # DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass (the re-parse
 # would mostly have been needed anyway, and a request form does not hurt an imperative); `_direct`.
@@ -69,10 +71,10 @@ def needs_reparse(sent: Span) -> bool:
         return False
     misread_root = first.dep_ == "ROOT" and not first.tag_.startswith(("VB", "MD"))
     # "pour milk, I'm making tea": the verb tagged right but parsed as a modifier of its object
-    misread_modifier = first.tag_ == "VB" and first.dep_ in MODIFIER_DEPS
+    misread_modifier = first.tag_ == "VB" and first.dep_ in PREMODIFIER_DEPS
     if first.tag_ not in NOUNISH_TAGS and not misread_root and not misread_modifier:
         return False
-    phrase_head = first.head if first.dep_ in MODIFIER_DEPS else first
+    phrase_head = first.head if first.dep_ in PREMODIFIER_DEPS else first
     # A real declarative's subject hangs on a verb; "Heat oil in a pan, then season..." can come out
     # as "oil" subject of "season/NN", which is the same misreading again.
     return not (phrase_head.dep_ in SUBJECT_DEPS and phrase_head.head.tag_[:2] in ("VB", "MD"))
@@ -86,7 +88,7 @@ def _reparse_accepted(doc: Doc, prefix: str) -> bool:
     """The re-parse reads the first word as a verb, and not as a modifier of the noun after it ("Please
     pour/VB/compound spice into pan": the next prefix may do better)."""
     k = len(prefix.split())
-    return len(doc) > k and doc[k].tag_.startswith("VB") and doc[k].dep_ not in MODIFIER_DEPS
+    return len(doc) > k and doc[k].tag_.startswith("VB") and doc[k].dep_ not in PREMODIFIER_DEPS
 
 
 def find_split(span: Span, lex: Lexicon) -> Token | None:
