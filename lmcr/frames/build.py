@@ -1,4 +1,5 @@
-"""The frames stage: learn compounds, export shards, parse them on some worker pool, load the store.
+"""The frames stage: learn compounds, export shards, learn first words, parse the shards on some worker
+pool, load the store.
 
 `build_frame_corpus` runs the steps once; what differs between the CLI (a process pool with a
 progress bar) and the Prefect flow (a task per shard on its task runner) is only `parse_all`, the
@@ -23,6 +24,7 @@ from lmcr.frames.shards import (
     ShardResult,
     build_fingerprint,
     export_shards,
+    learn_first_words,
     parse_shard,
 )
 from lmcr.srl.compounds import learn_compounds
@@ -87,9 +89,11 @@ def build_frame_corpus(con: duckdb.DuckDBPyConnection, staging: Path, srl_dir: P
         log("frame corpus unchanged: skipped")
         return None
     fingerprint, shards = prepared
+    started = time.perf_counter()  # the wall time and words/s include the first words' minute
+    log(f"learning first words from up to {config.first_word_sample:,} texts")
+    job = learn_first_words(shards, shard_job(staging, srl_dir, config), config.first_word_sample)
     log(f"parsing {len(shards)} shards of {sum(s.sentences for s in shards):,} sentences")
-    started = time.perf_counter()
-    results = list((parse_all or process_pool())(shards, shard_job(staging, srl_dir, config)))
+    results = list((parse_all or process_pool())(shards, job))
     build = summarize_build(fingerprint, config, results, time.perf_counter() - started)
     log(f"{build['words']:,} words at {build['words_per_s']:,.0f} words/s")
     finish_build(con, srl_dir, results, build)

@@ -12,7 +12,7 @@ Offsets are mapped back to the original text.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -41,8 +41,9 @@ PREMODIFIER_DEPS = frozenset({"compound", "amod"})
 # DIRECT_RATE of the time, texts starting with it are parsed as requests in one pass; `_direct`. Not for
 # speed (on recipe text it saves no time) but for reading: a first verb the plain parse loses without
 # looking misread ("Sprinkle sugar over butter in skillet, then place ...") is found. Only a parser told
-# to learn does so (the frame build, afresh for each shard), so a text's frames never depend on the
-# texts parsed before it in the same process.
+# to learn does so: the frame build, each shard from the same table learned on a sample of the corpus
+# first (`frames.shards.learn_first_words`), so a text's frames never depend on which texts the same
+# process parsed before it.
 FIRST_WORD = re.compile(r"^\W*([A-Za-z]+)")
 DIRECT_AFTER = 3
 DIRECT_RATE = 0.9
@@ -144,7 +145,7 @@ class FrameParser:
     stats: ParseStats = field(default_factory=ParseStats)
     batch_size: int = 256
     repair: bool = True  # off only to measure what the imperative repair is worth
-    learn_first_words: bool = False  # on for corpus shards; `forget_first_words` starts each afresh
+    learn_first_words: bool = False  # on for corpus shards; `forget_first_words` starts each from one table
 
     def __post_init__(self) -> None:
         self.lemmas = LazyLemmas(self.nlp, self.compounds.singular_counts if self.compounds else None)
@@ -199,9 +200,10 @@ class FrameParser:
         repaired, verb, seen = self.first_words.get(match.group(1).lower(), (0, 0, 0)) if match else (0, 0, 0)
         return seg.depth == 0 and repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
 
-    def forget_first_words(self) -> None:
-        """Start learning first words afresh: what a batch of texts yields then depends on it alone."""
-        self.first_words.clear()
+    def forget_first_words(self, start: Mapping[str, Sequence[int]] | None = None) -> None:
+        """Learn first words afresh from the table `start` (or from nothing): what a batch of texts yields
+        then depends on that table and the batch alone."""
+        self.first_words = {word: (int(r), int(v), int(n)) for word, (r, v, n) in (start or {}).items()}
 
     def _learn_first_word(self, sent: Span, repaired: bool) -> None:
         first = next((t for t in sent if t.is_alpha), None)
