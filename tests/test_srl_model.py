@@ -148,6 +148,15 @@ def test_a_text_reads_the_same_whatever_was_parsed_before(parser):
     assert _predicates(parser.parse(LONG_SPRINKLE)) == _predicates(load_parser().parse(LONG_SPRINKLE))
 
 
+def test_a_first_word_read_as_a_subject_is_no_evidence_about_it(parser):
+    learning = FrameParser(parser.nlp, compounds=parser.compounds, learn_first_words=True)
+    learning.parse("Heat oven to 425 degrees F.")  # Heat/NN subject of oven/VBD: a misread imperative
+    learning.parse("Sugar is added according to taste.")  # a real declarative: the parse cannot tell them apart
+    assert "heat" not in learning.first_words and "sugar" not in learning.first_words
+    learning.parse("Heat the oil in a pan.")
+    assert learning.first_words["heat"][1:] == (1, 1)  # read as a verb, once
+
+
 def _shard(tmp_path, number: int, texts: list[str]) -> Shard:
     path = tmp_path / f"input-{number}.parquet"
     occurrences = [[{"corpus": "recipes", "doc_id": f"d{number}", "sent_id": i}] for i in range(len(texts))]

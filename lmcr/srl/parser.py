@@ -64,24 +64,40 @@ def load_nlp(model: str | None = None) -> Language:
                            f"or set LMCR_SPACY_MODEL)") from exc
 
 
-def needs_reparse(sent: Span) -> bool:
-    """True when the sentence's first word looks like a misread imperative verb and is not the subject
-    of a verb ("Chicken should be fried" is a real declarative): tagged as a noun/adjective, tagged
-    as anything but a verb while heading the whole sentence (the tagger reads a bare "fry the chicken"
-    as a preposition at the root, a sentence without any verb), or tagged as a verb but parsed as a
-    modifier of the noun after it ("pour/compound milk, I'm making tea")."""
+def _looks_misread(sent: Span) -> Token | None:
+    """The sentence's first word when it looks like a misread imperative verb: tagged as a noun/adjective,
+    tagged as anything but a verb while heading the whole sentence (the tagger reads a bare "fry the
+    chicken" as a preposition at the root, a sentence without any verb), or tagged as a verb but parsed
+    as a modifier of the noun after it ("pour/compound milk, I'm making tea")."""
     first = next((t for t in sent if t.is_alpha), None)
     if first is None or first.i != sent.start + (sent[0].is_punct):
-        return False
+        return None
     misread_root = first.dep_ == "ROOT" and not first.tag_.startswith(("VB", "MD"))
-    # "pour milk, I'm making tea": the verb tagged right but parsed as a modifier of its object
     misread_modifier = first.tag_ == "VB" and first.dep_ in PREMODIFIER_DEPS
-    if first.tag_ not in NOUNISH_TAGS and not misread_root and not misread_modifier:
-        return False
+    return first if first.tag_ in NOUNISH_TAGS or misread_root or misread_modifier else None
+
+
+def _subject_of_verb(first: Token) -> bool:
+    """The first word (or the phrase it modifies) is the subject of a verb: a real declarative ("Chicken
+    should be fried") or an imperative whose object the tagger took for the verb ("Heat/NN oven/VBD to
+    425"). The parse alone cannot tell which. "Heat oil in a pan, then season..." can come out as "oil"
+    subject of "season/NN", which is the same misreading again."""
     phrase_head = first.head if first.dep_ in PREMODIFIER_DEPS else first
-    # A real declarative's subject hangs on a verb; "Heat oil in a pan, then season..." can come out
-    # as "oil" subject of "season/NN", which is the same misreading again.
-    return not (phrase_head.dep_ in SUBJECT_DEPS and phrase_head.head.tag_[:2] in ("VB", "MD"))
+    return phrase_head.dep_ in SUBJECT_DEPS and phrase_head.head.tag_[:2] in ("VB", "MD")
+
+
+def needs_reparse(sent: Span) -> bool:
+    """True when the sentence's first word looks like a misread imperative verb (`_looks_misread`) and is
+    not the subject of a verb (`_subject_of_verb`: a first word learned as a command is re-read even then,
+    by the frame build's direct requests)."""
+    first = _looks_misread(sent)
+    return first is not None and not _subject_of_verb(first)
+
+
+def _reads_as_subject(sent: Span) -> bool:
+    """The first word looks misread but is the subject of a verb: evidence neither way about the word."""
+    first = _looks_misread(sent)
+    return first is not None and _subject_of_verb(first)
 
 
 def as_request(text: str, prefix: str) -> str:
@@ -253,7 +269,9 @@ class FrameParser:
                     requests.append(_Piece(seg, sent, seg.offset))
                 else:
                     parses.append(_Piece(seg, sent, seg.offset))
-                    if k == 0 and seg.depth == 0:
+                    # A first word read as a subject says nothing about the word: counted, "Heat/NN oven/VBD
+                    # to 425" would make "heat" look like a noun a fifth of the time.
+                    if k == 0 and seg.depth == 0 and not _reads_as_subject(sent):
                         self._learn_first_word(sent, False)
         return parses, requests
 
