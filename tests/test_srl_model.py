@@ -178,6 +178,9 @@ def test_every_shard_starts_from_the_first_words_learned_on_a_sample(tmp_path):
     job = learn_first_words(shards, ShardJob(str(tmp_path / "out"), None, str(tmp_path / "none.json")), sample=100)
     assert json.loads(Path(job.first_words).read_text())["sprinkle"][0] >= len(WARM_UP) - 1  # repaired
     assert learn_first_words(shards, job, sample=100) == job  # the same sample: the same table, not learned again
+    table = Path(job.first_words).read_text()
+    Path(job.first_words).write_text(table[:20])  # damaged: learned again
+    assert learn_first_words(shards, job, sample=100) == job and Path(job.first_words).read_text() == table
     result = parse_shard(shards[1], job)  # the sample taught "sprinkle": read as a command at once
     assert "sprinkle" in pq.read_table(result.frames_path).column("predicate").to_pylist()
     half = learn_first_words(shards, job, sample=2)  # every 7th text: a sample of its own, a table of its own

@@ -17,7 +17,7 @@ import duckdb
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from lmcr.files import atomic_path
+from lmcr.files import atomic_path, cached_json
 from lmcr.frames.config import FrameCorpusConfig
 from lmcr.ingest.stage import write_parquet_atomic
 from lmcr.lexicon import LEXICON_FILES
@@ -141,14 +141,22 @@ def learn_first_words(shards: list[Shard], job: ShardJob, sample: int) -> ShardJ
     chosen = texts[::max(1, -(-len(texts) // max(1, sample)))]
     key = hashlib.sha256("\n".join([code_fingerprint(), str(job.model), _file_hash(job.compounds), *chosen]).encode())
     path = Path(job.out_dir) / f"first-words-{key.hexdigest()[:24]}.json"
-    if not path.exists():
+
+    def learn() -> dict[str, tuple[int, int, int]]:
         parser = _worker_parser(job.model, job.compounds)
         parser.forget_first_words()
         for _ in parser.pipe(chosen):
             pass
-        with atomic_path(path) as tmp:
-            tmp.write_text(json.dumps(parser.first_words, sort_keys=True), encoding="utf-8")
+        return dict(sorted(parser.first_words.items()))
+
+    cached_json(path, _is_first_word_table, learn)  # a damaged file is learned again, not trusted
     return replace(job, first_words=str(path))
+
+
+def _is_first_word_table(value: object) -> bool:
+    return isinstance(value, dict) and all(
+        isinstance(counts, list) and len(counts) == 3 and all(type(n) is int for n in counts)
+        for counts in value.values())
 
 
 def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention]) -> tuple[list[dict], list[dict]]:
