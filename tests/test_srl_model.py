@@ -22,7 +22,15 @@ from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.lemmas import LazyLemmas, lemma
-from lmcr.srl.parser import FrameParser, NoPredicateError, load_parser, parse_instruction
+from lmcr.srl.parser import (
+    FIRST_WORDS_FILE,
+    FrameParser,
+    NoPredicateError,
+    ResourceError,
+    load_parser,
+    parse_instruction,
+    read_first_words,
+)
 from lmcr.store import check_contracts, connect
 from lmcr.workspace import Workspace
 
@@ -114,6 +122,7 @@ def test_frame_corpus_on_sample(con, paths, sample_dir, tmp_path):
                         "where f.predicate = 'pour' and r.role = 'Destination' and r.value is not null").fetchall()
     assert ("blender",) in pours and ("glass",) in pours
     assert (paths.srl_dir / "compounds.json").exists() and (paths.srl_dir / "role_priors.json").exists()
+    assert read_first_words(paths.srl_dir / FIRST_WORDS_FILE)  # the table the shards started from, published
     before = con.execute("select * from frame_roles order by all").fetchall()
     assert build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2)) is None  # unchanged: skipped
     assert con.execute("select * from frame_roles order by all").fetchall() == before
@@ -155,6 +164,20 @@ def test_a_first_word_read_as_a_subject_is_no_evidence_about_it(parser):
     assert "heat" not in learning.first_words and "sugar" not in learning.first_words
     learning.parse("Heat the oil in a pan.")
     assert learning.first_words["heat"][1:] == (1, 1)  # read as a verb, once
+
+
+def test_the_builds_first_words_let_a_parser_reread_a_command_taken_for_a_subject(parser, tmp_path):
+    text = "Heat oven to 425 degrees F."  # Heat/NN subject of oven/VBD: left alone without the table
+    assert "heat" not in _predicates(parser.parse(text))
+    (tmp_path / FIRST_WORDS_FILE).write_text(json.dumps({"heat": [5, 5, 5], "sugar": [1, 1, 1]}))
+    informed = load_parser(resources=tmp_path)
+    assert "heat" in _predicates(informed.parse(text))
+    assert not informed.learn_first_words and informed.first_words["heat"] == (5, 5, 5)  # frozen: read, not learned
+    assert _predicates(informed.parse("Sugar is added according to taste.")) == _predicates(
+        parser.parse("Sugar is added according to taste."))  # not a command word: a declarative stays one
+    (tmp_path / FIRST_WORDS_FILE).write_text('{"heat": [5, 5]}')
+    with pytest.raises(ResourceError, match="first_words.json: not a first-word table"):
+        load_parser(resources=tmp_path)
 
 
 def _shard(tmp_path, number: int, texts: list[str]) -> Shard:

@@ -9,6 +9,7 @@ settings, SRL code, compounds) matches the last one.
 
 from __future__ import annotations
 
+import shutil
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -16,6 +17,7 @@ from pathlib import Path
 
 import duckdb
 
+from lmcr.files import atomic_path
 from lmcr.frames.config import FrameCorpusConfig
 from lmcr.frames.load import last_build, load_frames
 from lmcr.frames.shards import (
@@ -28,7 +30,7 @@ from lmcr.frames.shards import (
     parse_shard,
 )
 from lmcr.srl.compounds import learn_compounds
-from lmcr.srl.parser import COMPOUNDS_FILE, PRIORS_FILE
+from lmcr.srl.parser import COMPOUNDS_FILE, FIRST_WORDS_FILE, PRIORS_FILE
 
 # Parses every shard of a build (in any order), each with `parse_shard(shard, job)`.
 ParseAll = Callable[[list[Shard], ShardJob], Iterable[ShardResult]]
@@ -55,10 +57,14 @@ def summarize_build(fingerprint: str, config: FrameCorpusConfig, results: list[S
             "words_per_s": round(parsed_words / wall, 1) if parsed_words else 0.0}
 
 
-def finish_build(con: duckdb.DuckDBPyConnection, srl_dir: Path, results: list[ShardResult], build: dict) -> None:
-    """Load the shards (one transaction) and publish the learned role priors beside the compounds."""
+def finish_build(con: duckdb.DuckDBPyConnection, srl_dir: Path, results: list[ShardResult], build: dict,
+                 job: ShardJob) -> None:
+    """Load the shards (one transaction) and publish the learned role priors and the first-word table
+    the shards started from beside the compounds (`load_parser` reads all three)."""
     results = sorted(results, key=lambda r: r.shard.number)
     load_frames(con, results, build).save(srl_dir / PRIORS_FILE)
+    with atomic_path(srl_dir / FIRST_WORDS_FILE) as tmp:
+        shutil.copyfile(job.first_words, tmp)
 
 
 def shard_job(staging: Path, srl_dir: Path, config: FrameCorpusConfig) -> ShardJob:
@@ -96,5 +102,5 @@ def build_frame_corpus(con: duckdb.DuckDBPyConnection, staging: Path, srl_dir: P
     results = list((parse_all or process_pool())(shards, job))
     build = summarize_build(fingerprint, config, results, time.perf_counter() - started)
     log(f"{build['words']:,} words at {build['words_per_s']:,.0f} words/s")
-    finish_build(con, srl_dir, results, build)
+    finish_build(con, srl_dir, results, build, job)
     return build

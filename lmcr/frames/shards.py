@@ -8,7 +8,6 @@ unchanged shard is never parsed twice.
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
@@ -23,7 +22,7 @@ from lmcr.ingest.stage import write_parquet_atomic
 from lmcr.lexicon import LEXICON_FILES
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention
-from lmcr.srl.parser import FrameParser, load_nlp
+from lmcr.srl.parser import FrameParser, is_first_word_table, load_nlp, read_first_words
 
 SRL_CODE = Path(__file__).parent.parent / "srl"
 FRAME_SCHEMA = pa.schema([
@@ -149,14 +148,8 @@ def learn_first_words(shards: list[Shard], job: ShardJob, sample: int) -> ShardJ
             pass
         return dict(sorted(parser.first_words.items()))
 
-    cached_json(path, _is_first_word_table, learn)  # a damaged file is learned again, not trusted
+    cached_json(path, is_first_word_table, learn)  # a damaged file is learned again, not trusted
     return replace(job, first_words=str(path))
-
-
-def _is_first_word_table(value: object) -> bool:
-    return isinstance(value, dict) and all(
-        isinstance(counts, list) and len(counts) == 3 and all(type(n) is int for n in counts)
-        for counts in value.values())
 
 
 def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention]) -> tuple[list[dict], list[dict]]:
@@ -186,7 +179,7 @@ def parse_shard(shard: Shard, job: ShardJob) -> ShardResult:
         return ShardResult(shard, str(frames_path), str(roles_path), n, 0, 0, cached=True)
     parser = _worker_parser(job.model, job.compounds)
     # Every shard starts from the same table: its frames must not depend on which shards this worker parsed before.
-    parser.forget_first_words(json.loads(Path(job.first_words).read_text("utf-8")) if job.first_words else None)
+    parser.forget_first_words(read_first_words(Path(job.first_words)) if job.first_words else None)
     before = (parser.stats.reparsed, parser.stats.accepted)
     table = pq.read_table(shard.path).to_pylist()
     all_frames, all_roles = [], []

@@ -11,6 +11,7 @@ Offsets are mapped back to the original text.
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -209,12 +210,25 @@ class FrameParser:
         return frames
 
     def _direct(self, seg: _Segment) -> bool:
-        """Parse as a request at once: its first word has needed (and got) the repair nearly always."""
-        if not self.repair:
+        """Parse as a request at once (a learning parser only): its first word has needed (and got) the
+        repair nearly always."""
+        if not self.repair or not self.learn_first_words or seg.depth:
             return False
         match = FIRST_WORD.match(seg.text)
-        repaired, verb, seen = self.first_words.get(match.group(1).lower(), (0, 0, 0)) if match else (0, 0, 0)
-        return seg.depth == 0 and repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
+        return match is not None and self._command_word(match.group(1).lower())
+
+    def _command_word(self, word: str) -> bool:
+        repaired, verb, seen = self.first_words.get(word, (0, 0, 0))
+        return repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
+
+    def _learned_command(self, sent: Span) -> bool:
+        """A parser that does not learn, given the frame build's table (`load_parser`), re-reads a
+        sentence whose first word the table knows as a command but the parse made a subject ("Heat/NN
+        oven/VBD to 425"), which `needs_reparse` leaves alone (it could be a declarative). The build
+        reaches these through its direct requests; an instruction's own parse is kept otherwise."""
+        first = _looks_misread(sent)
+        return (not self.learn_first_words and first is not None and _subject_of_verb(first)
+                and self._command_word(first.lower_))
 
     def forget_first_words(self, start: Mapping[str, Sequence[int]] | None = None) -> None:
         """Learn first words afresh from the table `start` (or from nothing): what a batch of texts yields
@@ -265,7 +279,7 @@ class FrameParser:
             if docs is not None and seg.depth == 0:
                 docs[seg.text_id] = doc
             for k, sent in enumerate(doc.sents):
-                if self.repair and needs_reparse(sent):
+                if self.repair and (needs_reparse(sent) or self._learned_command(sent)):
                     requests.append(_Piece(seg, sent, seg.offset))
                 else:
                     parses.append(_Piece(seg, sent, seg.offset))
@@ -321,20 +335,47 @@ class NoPredicateError(LMCRError, ValueError):
 
 COMPOUNDS_FILE = "compounds.json"
 PRIORS_FILE = "role_priors.json"
+FIRST_WORDS_FILE = "first_words.json"  # the table the frame build's shards started from
 
 
 def load_parser(model: str | None = None, resources: Path | None = None) -> FrameParser:
-    """A parser with the learned compounds and role priors of `resources` where they exist.
+    """A parser with the learned compounds, role priors and command first words of `resources` where
+    they exist.
 
     They are built by the frames stage (`lmcr frames`); without them only noun-tagged modifiers
-    join a name and a lone object of an alternating verb keeps its syntactic default role.
+    join a name, a lone object of an alternating verb keeps its syntactic default role, and a first
+    word parsed as a subject stays one (`FrameParser._learned_command`).
     """
     compounds = priors = None
     if resources is not None and (resources / COMPOUNDS_FILE).exists():
         compounds = Compounds.load(resources / COMPOUNDS_FILE)
     if resources is not None and (resources / PRIORS_FILE).exists():
         priors = RolePriors.load(resources / PRIORS_FILE)
-    return FrameParser(load_nlp(model), compounds=compounds, priors=priors)
+    parser = FrameParser(load_nlp(model), compounds=compounds, priors=priors)
+    if resources is not None and (resources / FIRST_WORDS_FILE).exists():
+        parser.forget_first_words(read_first_words(resources / FIRST_WORDS_FILE))
+    return parser
+
+
+class ResourceError(LMCRError, RuntimeError):
+    """A learned SRL resource that cannot be read."""
+
+
+def is_first_word_table(value: object) -> bool:
+    """A first-word table as JSON holds it: word -> [times repaired, times a verb, times seen]."""
+    return isinstance(value, dict) and all(
+        isinstance(counts, list) and len(counts) == 3 and all(type(n) is int for n in counts)
+        for counts in value.values())
+
+
+def read_first_words(path: Path) -> dict[str, list[int]]:
+    try:
+        table = json.loads(Path(path).read_text("utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ResourceError(f"{path}: cannot read the first-word table ({exc}); run `lmcr frames` again") from exc
+    if not is_first_word_table(table):
+        raise ResourceError(f"{path}: not a first-word table (word -> [repaired, verb, seen]); run `lmcr frames` again")
+    return table
 
 
 def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
