@@ -228,6 +228,15 @@ def test_lemmas_are_chosen_by_the_corpus_and_stable(parser):
     assert [lemma(t) for t in counted] == ["cookie", "leaf", "pancake", "glass"]
 
 
+def test_a_words_lemma_does_not_depend_on_the_texts_before_it(parser):
+    def lemmas(*texts):
+        filler = LazyLemmas(parser.nlp)
+        return [[lemma(t) for t in filler.fill(_tagged(parser, text))] for text in texts]
+    name, plural = "Apples/NNPS/ROOT/0", "blend/VB/ROOT/0 apples/NNPS/dobj/0"  # a name; a misread plural
+    assert lemmas(name, plural)[1] == lemmas(plural)[0] == ["blend", "apple"]
+    assert lemmas(plural, name)[1] == lemmas(name)[0]
+
+
 def test_participle_modifiers_are_marked(parser):
     doc = LazyLemmas(parser.nlp).fill(_tagged(
         parser, "chopped/JJ/amod/3 frying/NN/amod/3 frozen/JJ/amod/3 peas/NNS/ROOT/3 red/JJ/amod/5 wine/NN/dobj/3"))

@@ -55,7 +55,7 @@ class LazyLemmas:
         lookups = self.lemmatizer.lookups if self.active else None
         self.verb_index = frozenset(lookups.get_table("lemma_index").get("verb", ())) if lookups else frozenset()
         self.verb_exceptions = frozenset(lookups.get_table("lemma_exc").get("verb", {})) if lookups else frozenset()
-        self.cache: dict[tuple[str, str], str] = {}
+        self.cache: dict[tuple[str, str, bool], str] = {}
         self.participles: dict[str, bool] = {}
 
     def fill(self, doc: Doc) -> Doc:
@@ -63,9 +63,12 @@ class LazyLemmas:
             return doc
         for token in doc:
             tag = token.tag_
-            if tag not in INFLECTED_TAGS and not self._maybe_plural(token):
+            plural = self._maybe_plural(token)
+            if tag not in INFLECTED_TAGS and not plural:
                 continue
-            key = (token.lower_, tag)
+            # the lemma depends on the case too ("Apples/NNPS" a name, "apples/NNPS" a misread plural): keyed
+            # without it, whichever came first decided for both, and a build depended on the texts' order
+            key = (token.lower_, tag, plural)
             found = self.cache.get(key)
             if found is None:
                 found = self.cache[key] = self._lemmatize(token)
