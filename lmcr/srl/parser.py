@@ -95,12 +95,6 @@ def needs_reparse(sent: Span) -> bool:
     return first is not None and not _subject_of_verb(first)
 
 
-def _reads_as_subject(sent: Span) -> bool:
-    """The first word looks misread but is the subject of a verb: evidence neither way about the word."""
-    first = _looks_misread(sent)
-    return first is not None and _subject_of_verb(first)
-
-
 def as_request(text: str, prefix: str) -> str:
     return prefix + text[:1].lower() + text[1:]
 
@@ -221,14 +215,12 @@ class FrameParser:
         repaired, verb, seen = self.first_words.get(word, (0, 0, 0))
         return repaired >= DIRECT_AFTER and verb >= DIRECT_RATE * seen
 
-    def _learned_command(self, sent: Span) -> bool:
+    def _learned_command(self, first: Token) -> bool:
         """A parser that does not learn, given the frame build's table (`load_parser`), re-reads a
-        sentence whose first word the table knows as a command but the parse made a subject ("Heat/NN
-        oven/VBD to 425"), which `needs_reparse` leaves alone (it could be a declarative). The build
-        reaches these through its direct requests; an instruction's own parse is kept otherwise."""
-        first = _looks_misread(sent)
-        return (not self.learn_first_words and first is not None and _subject_of_verb(first)
-                and self._command_word(first.lower_))
+        sentence whose first word, read as a subject, the table knows as a command ("Heat/NN oven/VBD to
+        425"), which `needs_reparse` leaves alone (it could be a declarative). The build reaches these
+        through its direct requests; an instruction's own parse is kept otherwise."""
+        return not self.learn_first_words and self._command_word(first.lower_)
 
     def forget_first_words(self, start: Mapping[str, Sequence[int]] | None = None) -> None:
         """Learn first words afresh from the table `start` (or from nothing): what a batch of texts yields
@@ -279,13 +271,15 @@ class FrameParser:
             if docs is not None and seg.depth == 0:
                 docs[seg.text_id] = doc
             for k, sent in enumerate(doc.sents):
-                if self.repair and (needs_reparse(sent) or self._learned_command(sent)):
+                first = _looks_misread(sent)  # judged once: `needs_reparse` is `first and not as_subject`
+                as_subject = first is not None and _subject_of_verb(first)
+                if self.repair and first is not None and (not as_subject or self._learned_command(first)):
                     requests.append(_Piece(seg, sent, seg.offset))
                 else:
                     parses.append(_Piece(seg, sent, seg.offset))
                     # A first word read as a subject says nothing about the word: counted, "Heat/NN oven/VBD
                     # to 425" would make "heat" look like a noun a fifth of the time.
-                    if k == 0 and seg.depth == 0 and not _reads_as_subject(sent):
+                    if k == 0 and seg.depth == 0 and not as_subject:
                         self._learn_first_word(sent, False)
         return parses, requests
 
