@@ -81,6 +81,11 @@ def code_fingerprint() -> str:
     return digest.hexdigest()
 
 
+def _parser_setup(job: ShardJob) -> str:
+    """What a worker's parser is made of: the SRL code, the spaCy model, the learned compounds."""
+    return f"{code_fingerprint()}|{job.model}|{_file_hash(job.compounds)}"
+
+
 def build_fingerprint(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, compounds_path: Path) -> str:
     """Everything a frame corpus depends on: ingested files, settings, SRL code, learned compounds."""
     files = con.execute("select source_file, sha256, corpus from ingested_files order by all").fetchall()
@@ -138,7 +143,7 @@ def learn_first_words(shards: list[Shard], job: ShardJob, sample: int) -> ShardJ
     (two builds of the same corpus differed by about 55 frames)."""
     texts = [t for shard in shards for t in pq.read_table(shard.path, columns=["text"]).column("text").to_pylist()]
     chosen = texts[::max(1, -(-len(texts) // max(1, sample)))]
-    key = hashlib.sha256("\n".join([code_fingerprint(), str(job.model), _file_hash(job.compounds), *chosen]).encode())
+    key = hashlib.sha256("\n".join([_parser_setup(job), *chosen]).encode())
     path = Path(job.out_dir) / f"first-words-{key.hexdigest()[:24]}.json"
 
     def learn() -> dict[str, tuple[int, int, int]]:
@@ -169,8 +174,8 @@ def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention
 def parse_shard(shard: Shard, job: ShardJob) -> ShardResult:
     """Parse one shard into frame and role Parquet files (reused when already parsed by this code, model
     and compounds)."""
-    setup = hashlib.sha256(f"{code_fingerprint()}|{job.model}|{_file_hash(job.compounds)}|"
-                           f"{_file_hash(job.first_words) if job.first_words else ''}".encode()).hexdigest()
+    first_words = _file_hash(job.first_words) if job.first_words else ""
+    setup = hashlib.sha256(f"{_parser_setup(job)}|{first_words}".encode()).hexdigest()
     tag = f"{shard.fingerprint}-{setup[:12]}"
     out = Path(job.out_dir)
     frames_path, roles_path = out / f"frames-{tag}.parquet", out / f"roles-{tag}.parquet"
