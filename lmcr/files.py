@@ -1,4 +1,4 @@
-"""File helpers shared by every stage: atomic writes and content hashes."""
+"""File helpers shared by every stage: atomic writes, content hashes and reading the learned resources."""
 
 from __future__ import annotations
 
@@ -9,8 +9,11 @@ import shutil
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TypeVar
 
-from lmcr.errors import LMCRError
+from lmcr.errors import LMCRError, one_line
+
+T = TypeVar("T")
 
 # Written into every folder LMCR publishes, listing the files it wrote: a folder is replaced only when
 # everything in it is LMCR's own, so a user's files are never deleted.
@@ -19,6 +22,21 @@ OUTPUT_MARKER = ".lmcr-output.json"
 
 class OutputError(LMCRError, ValueError):
     """An output path LMCR must not write to (a user's folder, a folder where a file is expected)."""
+
+
+class ResourceError(LMCRError, RuntimeError):
+    """A learned resource (compounds, role priors, first words) that cannot be read."""
+
+
+def read_resource(path: Path, what: str, build: Callable[[object], T]) -> T:
+    """`build` of the JSON a stage wrote at `path`. A file that cannot be read, is not JSON or is not
+    shaped as `build` expects (it indexes into the value and converts it freely: a wrong shape raises a
+    KeyError, TypeError or ValueError there) is a one-line ResourceError naming the file."""
+    try:
+        return build(json.loads(Path(path).read_text(encoding="utf-8")))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, IndexError) as exc:
+        raise ResourceError(f"{path}: cannot read the {what} ({one_line(exc, 200)}); "
+                            "run `lmcr frames` again") from exc
 
 
 @contextmanager

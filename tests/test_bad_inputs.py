@@ -424,6 +424,28 @@ def test_ingest_virtualhome_never_tracebacks(programs, garbage):
     _count("VirtualHome JSON")
 
 
+# --- the learned SRL resources the frames stage publishes, damaged -----------------------------
+
+RESOURCE_KEYS = {"compounds.json": ("head_rates", "strong_bigrams", "predicative", "proper", "singular_counts"),
+                 "role_priors.json": ("by_verb", "pooled"), "first_words.json": ("heat", "pour")}
+
+
+@FUZZ
+@given(name=st.sampled_from(sorted(RESOURCE_KEYS)), data=st.data(), garbage=st.binary(max_size=3))
+def test_a_damaged_srl_resource_is_one_line_naming_it(name, data, garbage):
+    shaped = st.fixed_dictionaries({k: ANY_JSON for k in RESOURCE_KEYS[name]})  # the right keys, any values
+    value = data.draw(st.one_of(ANY_JSON, shaped), label="content")
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        path = tmp / "srl" / name
+        path.parent.mkdir()
+        path.write_bytes(json.dumps(value).encode() + garbage)
+        result = invoke(["srl", "pour the milk", "--resources", str(path.parent)], tmp)
+        if result.exit_code != 0:  # what reads as a resource of its kind ({} for first words) may be used
+            assert "cannot read the" in assert_one_line_error(result, path)
+    _count(f"SRL resource {name}")
+
+
 # --- batch execute: a bad line is reported in its output line, the run goes on ------------------
 
 BAD_EXECUTE_LINES = st.one_of(

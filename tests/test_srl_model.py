@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from lmcr.cli import app
 from lmcr.config import REPO_ROOT
+from lmcr.files import ResourceError
 from lmcr.frames.build import build_frame_corpus, process_pool
 from lmcr.frames.config import FrameCorpusConfig
 from lmcr.frames.shards import Shard, ShardJob, learn_first_words, parse_shard
@@ -26,7 +27,6 @@ from lmcr.srl.parser import (
     FIRST_WORDS_FILE,
     FrameParser,
     NoPredicateError,
-    ResourceError,
     load_parser,
     parse_instruction,
     read_first_words,
@@ -176,7 +176,7 @@ def test_the_builds_first_words_let_a_parser_reread_a_command_taken_for_a_subjec
     assert _predicates(informed.parse("Sugar is added according to taste.")) == _predicates(
         parser.parse("Sugar is added according to taste."))  # not a command word: a declarative stays one
     (tmp_path / FIRST_WORDS_FILE).write_text('{"heat": [5, 5]}')
-    with pytest.raises(ResourceError, match="first_words.json: not a first-word table"):
+    with pytest.raises(ResourceError, match="first_words.json: cannot read the first-word table .not a first-word table"):
         load_parser(resources=tmp_path)
 
 

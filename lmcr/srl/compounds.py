@@ -23,7 +23,7 @@ from pathlib import Path
 
 import duckdb
 
-from lmcr.files import atomic_path
+from lmcr.files import atomic_path, read_resource
 
 HEAD_RATE_MIN = 0.10  # nouns measured 0.10-0.49, adjectives/participles 0.00-0.08 (closing note)
 NPMI_MIN = 0.65  # "black pepper" 0.75, "olive oil" 0.84; "salted water" 0.61, "melted butter" 0.52
@@ -136,10 +136,27 @@ class Compounds:
 
     @classmethod
     def load(cls, path: Path) -> Compounds:
-        data = json.loads(Path(path).read_text("utf-8"))
-        return cls(data["head_rates"], frozenset(data["strong_bigrams"]),
-                   frozenset(data.get("predicative", ())), frozenset(data.get("proper", ())),
-                   data.get("singular_counts"))
+        """The statistics `save` wrote; a damaged file is a ResourceError naming it."""
+        return read_resource(path, "learned compounds", cls._from_json)
+
+    @classmethod
+    def _from_json(cls, data: dict) -> Compounds:
+        singular = data.get("singular_counts")
+        return cls({_word(w): float(r) for w, r in data["head_rates"].items()}, _words(data["strong_bigrams"]),
+                   _words(data.get("predicative", [])), _words(data.get("proper", [])),
+                   None if singular is None else {_word(w): int(n) for w, n in singular.items()})
+
+
+def _word(value: object) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{value!r} is not a word")
+    return value
+
+
+def _words(values: object) -> frozenset[str]:
+    if not isinstance(values, list):
+        raise TypeError(f"{str(values)[:40]!r} is not a list of words")
+    return frozenset(_word(v) for v in values)
 
 
 def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Compounds:

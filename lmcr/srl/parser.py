@@ -11,7 +11,6 @@ Offsets are mapped back to the original text.
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -22,6 +21,7 @@ from spacy.language import Language
 from spacy.tokens import Doc, Span, Token
 
 from lmcr.errors import LMCRError
+from lmcr.files import read_resource
 from lmcr.jsonl import check_text
 from lmcr.lexicon import Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
@@ -351,10 +351,6 @@ def load_parser(model: str | None = None, resources: Path | None = None) -> Fram
     return parser
 
 
-class ResourceError(LMCRError, RuntimeError):
-    """A learned SRL resource that cannot be read."""
-
-
 def is_first_word_table(value: object) -> bool:
     """A first-word table as JSON holds it: word -> [times repaired, times a verb, times seen]."""
     return isinstance(value, dict) and all(
@@ -362,14 +358,15 @@ def is_first_word_table(value: object) -> bool:
         for counts in value.values())
 
 
+def _first_word_table(value: object) -> dict[str, list[int]]:
+    if not is_first_word_table(value):
+        raise ValueError("not a first-word table: word -> [repaired, verb, seen]")
+    return value
+
+
 def read_first_words(path: Path) -> dict[str, list[int]]:
-    try:
-        table = json.loads(Path(path).read_text("utf-8"))
-    except (OSError, ValueError) as exc:
-        raise ResourceError(f"{path}: cannot read the first-word table ({exc}); run `lmcr frames` again") from exc
-    if not is_first_word_table(table):
-        raise ResourceError(f"{path}: not a first-word table (word -> [repaired, verb, seen]); run `lmcr frames` again")
-    return table
+    """The first-word table the frame build published (`FIRST_WORDS_FILE`)."""
+    return read_resource(path, "first-word table", _first_word_table)
 
 
 def parse_instruction(parser: FrameParser, text: str) -> FrameMention:

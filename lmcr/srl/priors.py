@@ -15,7 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lmcr.files import atomic_path
+from lmcr.files import atomic_path, read_resource
 from lmcr.srl.frames import FrameMention
 
 SMOOTHING = 1.0
@@ -70,6 +70,15 @@ class RolePriors:
 
     @classmethod
     def load(cls, path: Path) -> RolePriors:
-        data = json.loads(Path(path).read_text("utf-8"))
-        return cls(Counter({tuple(r[:-1]): r[-1] for r in data["by_verb"]}),
-                   Counter({tuple(r[:-1]): r[-1] for r in data["pooled"]}))
+        """The counts `save` wrote; a damaged file is a ResourceError naming it."""
+        return read_resource(path, "role priors", lambda data: cls(_counts(data["by_verb"], 3), _counts(data["pooled"], 2)))
+
+
+def _counts(rows: list, keys: int) -> Counter:
+    """Rows [key words..., count] as a Counter; a row of another shape is a ValueError."""
+    def key(row: object) -> tuple[str, ...]:
+        if not (isinstance(row, list) and len(row) == keys + 1 and all(isinstance(k, str) for k in row[:-1])
+                and type(row[-1]) is int):
+            raise ValueError(f"{str(row)[:60]} is not [{', '.join(['word'] * keys)}, count]")
+        return tuple(row[:-1])
+    return Counter({key(r): r[-1] for r in rows})
