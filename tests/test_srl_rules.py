@@ -84,6 +84,20 @@ def test_argument_values():
         ("fry", {"Theme": "them", "Instrument": "oil"})]
 
 
+@pytest.mark.parametrize(("before", "expected"), [
+    ("2/CD/nummod/2 tablespoons/NNS/compound/3/tablespoon", "oil"),  # counted: a quantity, not a name
+    ("1/CD/nummod/2 tablespoon/NN/compound/3", "oil"),
+    ("tablespoons/NNS/compound/2/tablespoon", "oil"),  # a plural unit before a noun is counted too
+    ("a/DT/det/3 tablespoon/NN/compound/3", "tablespoon oil"),  # uncounted: the parse's compound stands
+])
+def test_a_counted_measure_is_no_part_of_a_name(before, expected):
+    n = len(before.split())
+    doc = f"heat/VB/ROOT/0 {before} oil/NN/dobj/0 in/IN/prep/0 a/DT/det/{n + 4} pan/NN/pobj/{n + 2}"
+    assert frames(doc) == [("heat", {"Theme": expected, "Instrument": "pan"})]
+    loaf = "pour/VB/ROOT/0 into/IN/prep/0 a/DT/det/7 9/CD/nummod/5 -/HYPH/punct/5 inch/NN/compound/7 loaf/NN/compound/7 pan/NN/pobj/1"
+    assert frames(loaf) == [("pour", {"Theme": None, "Destination": "loaf pan"})]
+
+
 def test_passive_subject_is_the_theme():
     doc = ("the/DT/det/1 steak/NN/nsubjpass/4 should/MD/aux/4 be/VB/auxpass/4 seasoned/VBN/ROOT/4/season "
            "with/IN/prep/4 salt/NN/pobj/5")
@@ -107,6 +121,18 @@ def test_a_participles_object_stands_elsewhere():
     assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [("fry", {"Theme": None, "Instrument": None})]
     own = "I/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry the/DT/det/4 fish/NN/dobj/2"
     assert frames(own) == [("fry", {"Theme": "fish", "Instrument": None})]
+
+
+def test_a_gerund_after_a_thing_is_done_to_it():
+    """"the chicken needs frying" means it needs to be fried; a person with a gerund does the frying."""
+    needs = "the/DT/det/1 chicken/NN/nsubj/2 needs/VBZ/ROOT/2/need frying/VBG/xcomp/2/fry in/IN/prep/3 oil/NN/pobj/4"
+    assert ("fry", {"Theme": "chicken", "Instrument": "oil"}) in frames(needs)
+    up = "the/DT/det/1 soup/NN/nsubj/2 needs/VBZ/ROOT/2/need heating/VBG/xcomp/2/heat up/RP/prt/3"
+    assert ("heat", {"Theme": "soup", "Instrument": None}) in frames(up)
+    person = "I/PRP/nsubj/1 like/VBP/ROOT/1 frying/VBG/xcomp/1/fry"
+    assert ("fry", {"Theme": None, "Instrument": None}) in frames(person)
+    own = "I/PRP/nsubj/1 keep/VBP/ROOT/1 frying/VBG/xcomp/1/fry the/DT/det/4 fish/NN/dobj/2"
+    assert ("fry", {"Theme": "fish", "Instrument": None}) in frames(own)
 
 
 def test_adjectival_participles_and_nouns_are_not_predicates():

@@ -4,7 +4,8 @@ Determiners, numbers, possessives and ordinary adjectives are dropped ("the melt
 "chocolate"); compounds stay ("bell pepper", "soy sauce"); a noun-tagged or compound-marked modifier
 is part of the name ("frying pan", "piping bag") while a participle adjective is not ("remaining
 butter"); measure and quantity nouns give way to their of-phrase ("3 tablespoons of olive oil" ->
-"olive oil"); pronouns stay as written.
+"olive oil"), and a counted measure before a noun is no part of its name ("2 tablespoons oil" ->
+"oil"); pronouns stay as written.
 """
 
 from __future__ import annotations
@@ -45,8 +46,18 @@ def resolve_head(token: Token, lex: Lexicon) -> Token | None:
     return token if token.tag_ in HEAD_TAGS or token.pos_ in ("NOUN", "PROPN") else None
 
 
-def _is_name_part(child: Token, head: Token, compounds: Compounds | None) -> bool:
-    if child.dep_ not in ("compound", "amod", "nmod") or not child.is_alpha:
+def _counted_measure(token: Token, lex: Lexicon) -> bool:
+    """A unit with a number of its own ("2 tablespoons", "1 cup", "9-inch"): a quantity, not a name's
+    part. A plural unit before a noun is counted too ("tablespoons oil"); an uncounted one may name a
+    kind of thing ("loaf pan", "glass jar")."""
+    if lemma_of(token) not in lex.measure_nouns:
+        return False
+    before = [t for t in token.doc[max(token.i - 2, 0): token.i] if t.text != "-"]
+    return token.tag_ == "NNS" or bool(before) and (before[-1].like_num or before[-1].tag_ == "CD")
+
+
+def _is_name_part(child: Token, head: Token, lex: Lexicon, compounds: Compounds | None) -> bool:
+    if child.dep_ not in ("compound", "amod", "nmod") or not child.is_alpha or _counted_measure(child, lex):
         return False
     # A past participle describes the thing ("boiled water", "chopped garlic"), whatever its tag.
     if child._.participle or child.tag_ in ("VBN", "VBD"):
@@ -78,7 +89,7 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
     # Name parts right before the head, each a modifier of the head or of a part ("ice cube tray").
     while head.i - len(parts) > 0:
         child = head.doc[head.i - len(parts) - 1]
-        if child.head.i not in {head.i, *(p.i for p in parts)} or not _is_name_part(child, head, compounds):
+        if child.head.i not in {head.i, *(p.i for p in parts)} or not _is_name_part(child, head, lex, compounds):
             break
         parts.insert(0, child)
     start = parts[0].idx if parts else head.idx

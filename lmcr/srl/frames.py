@@ -143,10 +143,16 @@ def _understood_object(verb: Token, lex: Lexicon) -> list[Token]:
       is one, the object ("I want the chicken to be fried" read as want + chicken + to be fried);
     - the object of the participle it is coordinated with ("the chicken is seasoned and fried",
       "2 potatoes, peeled and chopped").
+    - the subject of the verb a gerund complements ("the chicken needs frying", "the soup wants
+      heating up"): an object-less gerund after a thing is done to it, as a passive would be.
     The small tagger reads a participle after its subject as a past tense ("want the steak seasoned/VBD"),
     so a past tense in a complement clause counts too."""
-    participle = verb.tag_ == "VBN" or verb.tag_ == "VBD" and verb.dep_ in ("ccomp", "xcomp", "oprd")
-    if not participle or any(c.dep_ in OBJECT_DEPS or c.dep_ == "expl" for c in verb.children):
+    if any(c.dep_ in OBJECT_DEPS or c.dep_ == "expl" for c in verb.children):
+        return []
+    if verb.tag_ == "VBG" and verb.dep_ == "xcomp":
+        subject = next((c for c in verb.head.children if c.dep_ == "nsubj"), None)
+        return [] if subject is None or _is_person(subject, lex) else [subject]
+    if not (verb.tag_ == "VBN" or verb.tag_ == "VBD" and verb.dep_ in ("ccomp", "xcomp", "oprd")):
         return []
     subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
     if subject is not None:
