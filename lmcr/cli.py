@@ -837,7 +837,7 @@ def srl_eval(
                 frame = parse_instruction(parser, task["instruction"]).to_json()
             except NoPredicateError:
                 frame = None
-            right.append(instruction_correct(frame, task["expected"], task.get("missing")))
+            right.append(instruction_correct(frame, task["expected"], task.get("missing"), parser.lex.object_pronouns))
             if not right[-1]:
                 console.print(f"  wrong: {task['instruction']!r} -> {frame}", highlight=False)
         console.print(f"instructions: {sum(right)}/{len(right)} = {sum(right) / len(right):.3f} parsed right")

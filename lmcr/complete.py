@@ -21,8 +21,9 @@ from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.lexicon import is_object_name
 from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
-from lmcr.srl.context import utterance_context
-from lmcr.srl.parser import FrameParser, parse_instruction, read_instruction
+from lmcr.srl.context import antecedents, utterance_context
+from lmcr.srl.frames import FrameMention
+from lmcr.srl.parser import FrameParser, read_instruction
 
 
 class CompletionError(LMCRError, ValueError):
@@ -68,6 +69,20 @@ def _grounded(value: str, known: set[str]) -> str | None:
     return next((" ".join(words[i:]) for i in range(len(words)) if " ".join(words[i:]) in known), None)
 
 
+def _referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
+    """Pronoun roles that refer back to a detected object the instruction named before them ("I'd love
+    some wine, could you pour it?": Theme wine): the nearest such name that no other role states."""
+    seen, stated = set(detected), {v for v in frame.roles.values() if v and v not in parser.lex.object_pronouns}
+    referred: dict[str, str] = {}
+    for role in frame.roles:
+        for name in antecedents(doc, frame, role, parser.lex, parser.compounds):
+            obj = _grounded(name, seen)
+            if obj is not None and obj not in stated and obj not in referred.values():
+                referred[role] = obj
+                break
+    return referred
+
+
 def _ground(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) \
         -> tuple[dict[str, str | None], dict[str, str]]:
     """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
@@ -98,14 +113,13 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
              config: CompletionConfig = CompletionConfig()) -> dict:
     """The completion of one instruction in the CLI contract's output format (without the id); the
     scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so."""
-    if config.context:  # the Doc only when it is read: the parser may have to make one
-        frame, doc = read_instruction(parser, instruction)
-        context = utterance_context(doc, frame)
-    else:
-        frame, context = parse_instruction(parser, instruction), ""
+    frame, doc = read_instruction(parser, instruction)
+    context = utterance_context(doc, frame) if config.context else ""
     detected = list(dict.fromkeys(" ".join(o.split()).lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
-    roles = {r: (None if v in pronouns else v) for r, v in frame.roles.items()}  # "pour it": who knows what
+    referred = _referents(parser, doc, frame, detected)
+    # "pour it": who knows what, unless "it" points back to an object named before ("some wine")
+    roles = {r: referred.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
     roles, unresolved = _ground(roles, parser.lex.objects, detected)
@@ -119,7 +133,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     unfamiliar = [o for o in outside if o not in ignored]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
+                "referred": referred, "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
                 "question": None, "context": context}
     pool = [o for o in detected if o not in stated and o not in ignored]
     if len(pool) < len(missing):
@@ -149,7 +163,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
+            "missing_roles": missing, "referred": referred, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
             "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context}
 
 

@@ -45,7 +45,7 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
+                   "missing": None, "missing_roles": [], "referred": {}, "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
                    "question": None, "context": ""}
 
 
@@ -57,6 +57,16 @@ def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
     assert out["question"] == "I see no side. Should I fry the cup or the glass in the pan?"
     kept = complete(parser, scorer, "pour the water", ["cup", "bowl"])
     assert kept["unresolved"] == {} and kept["frame"]["roles"]["Theme"] == "water"
+
+
+def test_a_pronoun_refers_back_to_a_detected_object_named_before_it(parser):
+    out = complete(parser, scorer, "I'd love some wine, could you pour it?", ["wine", "water", "cup", "glass"])
+    assert out["frame"]["roles"] == {"Theme": "wine", "Destination": "cup"} and out["referred"] == {"Theme": "wine"}
+    assert out["missing_roles"] == ["Destination"]  # the stand-in likes water better: the speaker said wine
+    unseen = complete(parser, scorer, "I'd love some juice, could you pour it?", ["wine", "water", "cup", "glass"])
+    assert unseen["referred"] == {} and unseen["missing_roles"] == ["Theme", "Destination"]  # no juice: the scene decides
+    plain = complete(parser, scorer, "pour it into the cup", ["wine", "water", "cup"])
+    assert plain["referred"] == {} and plain["frame"]["roles"]["Theme"] == "water"
 
 
 def test_a_stated_object_that_is_detected_grounds_without_the_robot_vocabulary(parser):

@@ -3,7 +3,8 @@ request or the frame itself, and that context reaches only the scorers that read
 
 from __future__ import annotations
 
-from lmcr.srl.context import utterance_context
+from lmcr.lexicon import load_lexicon
+from lmcr.srl.context import antecedents, utterance_context
 from lmcr.srl.frames import FrameMention
 from tests.srl_docs import make_doc
 
@@ -78,3 +79,25 @@ def test_only_text_reading_scorers_see_the_context(monkeypatch):
     scorer = methods.make_scorer("reader+counter", methods.MethodResources(checkpoints=__import__("pathlib").Path(".")))
     assert scorer([("pour", {"Theme": "milk", "Destination": "mug"})], "for my tea") == [0.0]
     assert seen == {"reader": "for my tea", "counter": None}
+
+
+def test_a_pronoun_role_refers_back_to_the_nouns_before_it_that_agree():
+    doc = make_doc("I/PRP/nsubj/2 'd/MD/aux/2 love/VB/ROOT/2 some/DT/det/4 wine/NN/dobj/2 ,/,/punct/2 could/MD/aux/8 "
+                   "you/PRP/nsubj/8 pour/VB/ccomp/2 it/PRP/dobj/8 ?/./punct/2")
+    wine = mention(doc, 8, {"Theme": 9, "Destination": None})
+    assert antecedents(doc, wine, "Theme", load_lexicon()) == ["wine"]
+    assert antecedents(doc, wine, "Destination", load_lexicon()) == []  # no pronoun there
+    doc = make_doc("take/VB/ROOT/0 the/DT/det/2 strawberries/NNS/dobj/0/strawberry and/CC/cc/0 dip/VB/conj/0 "
+                   "them/PRP/dobj/4 in/IN/prep/4 the/DT/det/9 melted/JJ/amod/9 chocolate/NN/pobj/6")
+    dip = mention(doc, 4, {"Theme": 5, "Destination": 9})
+    assert antecedents(doc, dip, "Theme", load_lexicon()) == ["strawberry"]  # the chocolate is after, and a role
+    doc = make_doc("the/DT/det/1 bread/NN/nsubj/2 is/VBZ/ROOT/2 here/RB/advmod/2 ,/,/punct/2 dip/VB/conj/2 "
+                   "them/PRP/dobj/5")
+    assert antecedents(doc, mention(doc, 5, {"Theme": 6, "Destination": None}), "Theme", load_lexicon()) == []  # number
+
+
+def test_an_antecedent_is_a_verbs_argument_before_a_prepositions_and_never_the_frames_own_words():
+    doc = make_doc("take/VB/ROOT/0 the/DT/det/2 pan/NN/dobj/0 from/IN/prep/0 the/DT/det/5 sink/NN/pobj/3 and/CC/cc/0 "
+                   "heat/VB/conj/0 some/DT/det/9 oil/NN/dobj/7 in/IN/prep/7 it/PRP/pobj/10")
+    heat = mention(doc, 7, {"Theme": 9, "Instrument": 11})
+    assert antecedents(doc, heat, "Instrument", load_lexicon()) == ["pan", "sink"]  # not the oil: the frame's Theme

@@ -5,7 +5,7 @@ from __future__ import annotations
 import duckdb
 
 from lmcr.srl.compounds import Compounds, learn_compounds
-from lmcr.srl.evaluate import classify_errors
+from lmcr.srl.evaluate import classify_errors, instruction_correct
 
 
 def frame(pred: str, a: str | None, b: str | None, roles=("Theme", "Destination")) -> dict:
@@ -23,6 +23,18 @@ def test_every_error_has_its_class():
     assert errors[1] == [("boundary", "pour.Theme"), ("lemma", "pour.Destination")]
     assert errors[2] == [("extra role", "dip.Destination"), ("extra predicate", "fry"), ("missed predicate", "pour")]
     assert errors[3] == [("boundary", "pour.Theme"), ("missed role", "pour.Destination")]
+
+
+def test_an_instruction_parse_is_right_with_the_open_role_open_and_a_pronoun_for_a_role():
+    expected = {"predicate": "pour", "roles": {"Theme": "wine", "Destination": "glass"}}
+    pronouns = frozenset({"it", "them"})
+    assert instruction_correct(frame("pour", "wine", None), expected, "Destination")
+    assert not instruction_correct(frame("pour", "wine", "glass"), expected, "Destination")  # not left open
+    assert not instruction_correct(frame("pour", "water", None), expected, "Destination")
+    assert instruction_correct(frame("pour", "it", None), expected, "Destination", pronouns)  # "could you pour it?"
+    assert not instruction_correct(frame("pour", "it", None), expected, "Destination")  # not a pronoun it knows
+    assert not instruction_correct(frame("pour", "wine", "it"), expected, "Destination", pronouns)  # the open role
+    assert not instruction_correct(frame("heat", "it", None), expected, "Destination", pronouns)
 
 
 def test_lexical_statistics_are_learned_from_sentences():

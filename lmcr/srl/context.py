@@ -4,16 +4,25 @@ meant; completion hands it to the scorer, which reads it after the filled frame 
 my tea"). Left out: the predicate, its stated roles with their determiners and prepositions, and the
 request around the predicate ("could you", "I need you to", "go ahead and", "please"). What is left is
 context only when it holds a content word: "for me" or "a little" leave the instruction as it was.
+
+A pronoun role may point back to a thing named before it ("I'd love some wine, could you pour it?",
+"take the strawberries and dip them in the chocolate"): `antecedents` lists what it may refer to.
 """
 
 from __future__ import annotations
 
 from spacy.tokens import Doc, Token
 
+from lmcr.lexicon import Lexicon
+from lmcr.srl.arguments import NOUN_TAGS, argument_value
+from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention
 
 CONTENT_TAGS = ("NN", "VB", "JJ")  # nouns, verbs, adjectives (Penn tags: hand-built Docs have no POS)
 CLAUSE_BREAKS = frozenset({",", ";", ":", ".", "!", "?"})
+# Pronouns that point back to a thing named before them, by grammatical number: "it" to a singular or
+# mass noun ("some wine"), "them" to a plural ("the strawberries"). English grammar, not knowledge of things.
+ANAPHOR_PLURAL = {"it": False, "this": False, "that": False, "them": True, "these": True, "those": True}
 
 
 def _covered(token: Token, spans: list[tuple[int, int]]) -> bool:
@@ -84,3 +93,26 @@ def utterance_context(doc: Doc, mention: FrameMention) -> str:
     if not any(is_content(t) for t in words):
         return ""
     return " ".join(t.lower_ for t in words)
+
+
+def antecedents(doc: Doc, mention: FrameMention, role: str, lex: Lexicon, compounds: Compounds | None = None) -> list[str]:
+    """The names a pronoun role may refer back to, most likely first: the heads of the noun phrases
+    before the pronoun, outside the frame's own words, that agree with it in number ("I'd love some
+    wine, could you pour it?" -> ["wine"]); [] when the role is no such pronoun. A verb's subject or
+    object comes before a preposition's ("take the pan from the sink and heat oil in it": the pan),
+    then the nearer before the farther. Which one the speaker meant is for the caller to judge
+    (completion takes the first the robot sees)."""
+    pronoun = mention.roles.get(role)
+    if pronoun not in ANAPHOR_PLURAL or role not in mention.spans:
+        return []
+    predicate = _predicate(doc, mention)
+    frame_words = _role_words(doc, mention, predicate) if predicate is not None else set()
+    found: list[tuple[bool, int, str]] = []
+    for token in doc:
+        if token.idx >= mention.spans[role][0] or token.i in frame_words or token.tag_ not in NOUN_TAGS \
+                or token.dep_ == "compound" or (token.tag_ in ("NNS", "NNPS")) != ANAPHOR_PLURAL[pronoun]:
+            continue
+        value = argument_value(token, lex, compounds)
+        if value is not None:
+            found.append((token.dep_ == "pobj", -token.i, value[0]))
+    return list(dict.fromkeys(name for *_, name in sorted(found)))

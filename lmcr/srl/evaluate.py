@@ -68,13 +68,17 @@ def score_frames(gold: list[list[dict]], predicted: list[list[dict]], known: set
     return scores
 
 
-def instruction_correct(frame: dict | None, expected: dict, missing: str | None) -> bool:
-    """Right predicate, every stated role right, and the right role (or none) marked missing."""
+def instruction_correct(frame: dict | None, expected: dict, missing: str | None,
+                        pronouns: frozenset[str] = frozenset()) -> bool:
+    """Right predicate, every stated role right, and the right role (or none) marked missing. A role
+    said with a pronoun of `pronouns` is right as the pronoun ("I'd love some wine, could you pour it?":
+    what "it" refers to is completion's to find, not the parse's)."""
     if frame is None or frame["predicate"] != expected["predicate"]:
         return False
     for role, value in expected["roles"].items():
         want = None if role == missing else value
-        if frame["roles"].get(role) != want:
+        got = frame["roles"].get(role)
+        if got != want and not (got in pronouns and role != missing):
             return False
     return True
 
