@@ -114,7 +114,6 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     """The completion of one instruction in the CLI contract's output format (without the id); the
     scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so."""
     frame, doc = read_instruction(parser, instruction)
-    context = utterance_context(doc, frame) if config.context else ""
     detected = list(dict.fromkeys(" ".join(o.split()).lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
     referred = _referents(parser, doc, frame, detected)
@@ -123,6 +122,9 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
     roles, unresolved = _ground(roles, parser.lex.objects, detected)
+    # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
+    # seen: the mug): its phrase is read as context, as the rest of the utterance is.
+    context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""
     missing = [r for r, v in roles.items() if v is None]
     stated = {v for v in roles.values() if v}
     # A detection outside the robot's object vocabulary ("salsa" typed to `lmcr complete`) is scored like

@@ -57,6 +57,11 @@ def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
     assert out["question"] == "I see no side. Should I fry the cup or the glass in the pan?"
     kept = complete(parser, scorer, "pour the water", ["cup", "bowl"])
     assert kept["unresolved"] == {} and kept["frame"]["roles"]["Theme"] == "water"
+    heard = []
+    coffee = complete(parser, lambda frames, context="": heard.append(context) or scorer(frames),
+                      "pour a little milk in my coffee", ["mug", "bowl", "milk"])
+    assert coffee["unresolved"] == {"Destination": "coffee"} and heard == ["in my coffee"]  # what it says of the mug
+    assert coffee["context"] == "in my coffee" and coffee["question"].startswith("I see no coffee. ")
 
 
 def test_a_pronoun_refers_back_to_a_detected_object_named_before_it(parser):

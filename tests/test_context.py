@@ -61,6 +61,16 @@ def test_placeholder_object_particle_and_stated_role_prepositions_are_the_frame(
     assert utterance_context(doc, mention(doc, 0, {"Theme": 2, "Destination": None})) == ""
 
 
+def test_a_role_the_robot_cannot_ground_is_said_words_read_as_context():
+    doc = make_doc("pour/VB/ROOT/0 a/DT/det/3 little/JJ/amod/3 milk/NN/dobj/0 in/IN/prep/0 my/PRP$/poss/6 "
+                   "coffee/NN/pobj/4")
+    pour = mention(doc, 0, {"Theme": 3, "Destination": 6})
+    assert utterance_context(doc, pour) == ""  # "in my coffee" is the frame's Destination
+    assert utterance_context(doc, pour, said=frozenset({"Destination"})) == "in my coffee"
+    doc = make_doc("fill/VB/ROOT/0 the/DT/det/2 thermos/NN/dobj/0")  # a said object is no placeholder
+    assert utterance_context(doc, mention(doc, 0, {"Destination": 2, "Theme": None}), said=frozenset({"Destination"})) == "the thermos"
+
+
 def test_only_text_reading_scorers_see_the_context(monkeypatch):
     from lmcr import methods
 

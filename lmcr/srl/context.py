@@ -58,17 +58,19 @@ def _request_before(doc: Doc, predicate: Token) -> set[int]:
     return request
 
 
-def _role_words(doc: Doc, mention: FrameMention, predicate: Token) -> set[int]:
+def _role_words(doc: Doc, mention: FrameMention, predicate: Token, said: frozenset[str] = frozenset()) -> set[int]:
     """The stated roles' words, their left modifiers ("some oil") and the prepositions heading them; the
     predicate's particle ("rub it in"), its object when that is no role ("dip a few", "dump some") and
     the person it is done for as a pronoun ("pour me some water"): the addressee of the request, which
-    the frame's text has no place for ("pour water into the mug me for my tea")."""
-    heads = [t for t in doc if _covered(t, list(mention.spans.values()))]
+    the frame's text has no place for ("pour water into the mug me for my tea"). The roles in `said`
+    are not the frame's: their words are left to the context."""
+    heads = [t for t in doc if _covered(t, [span for role, span in mention.spans.items() if role not in said])]
     words = {t.i for t in heads}
+    said_words = {t.i for t in doc if _covered(t, [span for role, span in mention.spans.items() if role in said])}
     for child in predicate.children:
         if child.dep_ == "prt" or child.tag_ == "RP" or child.dep_ == "dative" and child.tag_ == "PRP":
             words.add(child.i)
-        elif child.dep_ == "dobj" and child.i not in words:
+        elif child.dep_ == "dobj" and child.i not in words and child.i not in said_words:
             words |= {t.i for t in child.subtree}
     for head in heads:
         words |= {t.i for t in head.lefts}
@@ -82,13 +84,15 @@ def is_content(token: Token) -> bool:
     return token.tag_.startswith(CONTENT_TAGS) and not token.is_stop and token.is_alpha
 
 
-def utterance_context(doc: Doc, mention: FrameMention) -> str:
+def utterance_context(doc: Doc, mention: FrameMention, said: frozenset[str] = frozenset()) -> str:
     """The instruction's words besides the frame and the request, lowercased in their order ("for my
-    tea"); "" when none of them is a content word. `doc` is a parse of the text `mention` came from."""
+    tea"); "" when none of them is a content word. `doc` is a parse of the text `mention` came from.
+    The roles in `said` count as words of the utterance, not of the frame ("pour milk in my coffee"
+    with no coffee to pour it into: "in my coffee")."""
     predicate = _predicate(doc, mention)
     if predicate is None:
         return ""
-    skip = _request_before(doc, predicate) | _role_words(doc, mention, predicate) | {predicate.i}
+    skip = _request_before(doc, predicate) | _role_words(doc, mention, predicate, said) | {predicate.i}
     words = [t for t in doc if t.i not in skip and not t.is_punct and not t.is_space]
     if not any(is_content(t) for t in words):
         return ""
