@@ -71,7 +71,8 @@ def _grounded(value: str, known: set[str]) -> str | None:
 
 def _referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
     """Pronoun roles that refer back to a detected object the instruction named before them ("I'd love
-    some wine, could you pour it?": Theme wine): the nearest such name that no other role states."""
+    some wine, could you pour it?": Theme wine): the first of `antecedents` that names one and that no
+    other role states."""
     seen, stated = set(detected), {v for v in frame.roles.values() if v and v not in parser.lex.object_pronouns}
     referred: dict[str, str] = {}
     for role in frame.roles:
