@@ -117,6 +117,11 @@ def test_a_participles_object_stands_elsewhere():
                    "fried/VBN/conj/3/fry")
     assert frames(coordinated) == [("season", {"Theme": "chicken", "Instrument": None}),
                                    ("fry", {"Theme": "chicken", "Instrument": None})]
+    # the participle's preposition right after it is a role's, not a particle, when its object stands elsewhere
+    sprinkled = ("I/PRP/nsubj/2 'd/MD/aux/2 like/VB/ROOT/2 some/DT/det/4 cheese/NN/nsubj/5 sprinkled/VBD/ccomp/2/sprinkle "
+                 "on/IN/prep/5 my/PRP$/poss/8 pasta/NN/pobj/6")
+    assert ("sprinkle", {"Theme": "cheese", "Destination": "pasta"}) in frames(sprinkled)
+    assert frames("pour/VB/ROOT/0 in/IN/prep/0 the/DT/det/3 milk/NN/pobj/1") == [("pour", {"Theme": "milk", "Destination": None})]
     # a person does the frying; a participle with its own object needs nothing from elsewhere
     assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [("fry", {"Theme": None, "Instrument": None})]
     own = "I/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry the/DT/det/4 fish/NN/dobj/2"

@@ -106,8 +106,11 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
                 and prt.i == verb.i + 1 and objects[0].i > prt.i:
             preps.insert(0, (prt.lower_, objects.pop(0)))
             particles.remove(prt.lower_)
-    # "pour in the milk": a particle right after the verb whose "object" is really the verb's object.
-    if spec and not objects and preps:
+    # "I want the steak seasoned": a participle's object may stand elsewhere.
+    understood = _understood_object(verb, lex) if not objects else []
+    # "pour in the milk": a particle right after the verb whose "object" is really the verb's object;
+    # not when the object stands elsewhere ("some cheese sprinkled on my pasta": a role's preposition).
+    if spec and not objects and not understood and preps:
         prep, obj = preps[0]
         if prep in spec.particles and obj.head.i == verb.i + 1:
             objects, preps, particles = [obj], preps[1:], particles + [prep]
@@ -119,8 +122,7 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
             preps += _attached_preps(obj, frozenset())
         else:  # a measure's "of" leads to the head, whose own PPs count too
             preps += _attached_preps(obj, frozenset({"of"})) + _attached_preps(head, frozenset())
-    if not objects:  # "I want the steak seasoned": the participle's object stands elsewhere
-        objects = _understood_object(verb, lex)
+    objects = objects or understood
     # A PP hung on the object of another PP ("for five minutes in the butter", "with a ladle over the
     # pasta", "on both sides in hot oil") belongs to the verb too; which one names a role is decided
     # by how usual its preposition is (`_known_frame`).
