@@ -814,14 +814,13 @@ def srl_eval(
 ) -> None:
     """Predicate and role precision/recall/F1 against gold frames, per predicate and overall, and the errors
     by class (missed/extra predicate, boundary, lemma, role, missed/extra role, wrong filler)."""
-    from lmcr.jsonl import read_jsonl
-    from lmcr.srl.evaluate import instruction_correct, score_frames
+    from lmcr.srl.evaluate import instruction_correct, read_gold, read_instruction_tasks, score_frames
     from lmcr.srl.parser import NoPredicateError, parse_instruction
 
-    records = [check_record_text(line, r, "text", gold) for line, r in read_jsonl(gold, {"text": str, "frames": list})]
+    records = read_gold(gold)
     if not records:
         fail(f"{gold}: no gold sentences to score")
-    tasks = [r for _, r in read_jsonl(instructions, {"instruction": str, "expected": dict})] if instructions else []
+    tasks = read_instruction_tasks(instructions) if instructions else []
     parser = Workspace.from_env().parser(model, resources)
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
     scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))

@@ -187,6 +187,59 @@ def test_listen_batch_rejects_malformed_jsonl(case):
         _count("listen JSONL")
 
 
+SRL_INSTRUCTION_FIELDS = {key: value for key, value in INSTRUCTION_FIELDS.items() if key != "objects"}  # no scene read
+GOLD_FIELDS = {"text": "pour the water into the cup", "frames": [{"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}]}
+
+
+def _srl_eval_argv(gold: Path | None = None) -> Callable[[Path, Path], list[str]]:
+    """srl-eval on the generated file as its gold (or, with `gold`, as its instructions)."""
+    def argv(path: Path, folder: Path) -> list[str]:
+        if gold is None:
+            return ["srl-eval", "--gold", str(path)]
+        (folder / "gold.jsonl").write_text(json.dumps(GOLD_FIELDS) + "\n")
+        return ["srl-eval", "--gold", str(folder / "gold.jsonl"), "--instructions", str(path)]
+    return argv
+
+
+def _is_gold_frame(value) -> bool:
+    return isinstance(value, dict) and isinstance(value.get("predicate"), str) and isinstance(value.get("roles"), dict) \
+        and all(v is None or isinstance(v, str) for v in value["roles"].values())
+
+
+@FUZZ
+@given(case=_jsonl_case(GOLD_FIELDS, "text", None),
+       frame=st.one_of(ANY_JSON, st.fixed_dictionaries({"predicate": ANY_JSON, "roles": ANY_JSON}),
+                       st.fixed_dictionaries({"predicate": st.just("pour"), "roles": st.dictionaries(st.text(max_size=5), ANY_JSON, max_size=2)})))
+def test_srl_eval_rejects_malformed_gold(case, frame):
+    """`lmcr srl-eval --gold`: the line's fields, or one of its frames not shaped as a frame."""
+    if _check_rejected("srl-eval", GOLD_FIELDS, "text", None, case, _srl_eval_argv()):
+        _count("SRL gold JSONL")
+    if not _is_gold_frame(frame):
+        valid, at, _ = case
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            _write_jsonl(tmp / "gold.jsonl", valid, at, json.dumps({**GOLD_FIELDS, "frames": [frame]}).encode())
+            assert "field 'frames'" in assert_one_line_error(invoke(["srl-eval", "--gold", str(tmp / "gold.jsonl")], tmp),
+                                                             tmp / "gold.jsonl", at)
+        _count("SRL gold frames")
+
+
+@FUZZ
+@given(case=_jsonl_case(SRL_INSTRUCTION_FIELDS, "instruction", None), missing=st.one_of(ANY_JSON, st.sampled_from(["Theme", "Tool"])))
+def test_srl_eval_rejects_malformed_instructions(case, missing):
+    """`lmcr srl-eval --instructions`: the line's fields, or a `missing` that is no expected role."""
+    if _check_rejected("srl-eval", SRL_INSTRUCTION_FIELDS, "instruction", None, case, _srl_eval_argv(Path("gold"))):
+        _count("SRL instructions JSONL")
+    if missing is not None and not (isinstance(missing, str) and missing in INSTRUCTION_FIELDS["expected"]["roles"]):
+        valid, at, _ = case
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            _write_jsonl(tmp / "in.jsonl", valid, at, json.dumps({**SRL_INSTRUCTION_FIELDS, "missing": missing}).encode())
+            line = assert_one_line_error(invoke(_srl_eval_argv(Path("gold"))(tmp / "in.jsonl", tmp), tmp), tmp / "in.jsonl", at)
+            assert "field 'missing'" in line
+        _count("SRL instructions missing")
+
+
 def test_srl_batch_text_over_the_length_cap_is_one_line(tmp_path):
     path = tmp_path / "in.jsonl"
     path.write_text(json.dumps({"id": 1, "text": "pour water " + "🥛" * 5000}) + "\n", encoding="utf-8")

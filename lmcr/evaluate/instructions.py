@@ -15,6 +15,7 @@ from pathlib import Path
 from lmcr.complete import CompletionConfig, complete
 from lmcr.errors import LMCRError
 from lmcr.jsonl import InputError, read_jsonl
+from lmcr.srl.evaluate import check_expected
 
 FIELDS = {"instruction": str, "objects": list, "expected": dict}
 
@@ -50,13 +51,9 @@ def load_instructions(path: Path) -> list[dict]:
     """The records of an instructions JSONL file; a bad line raises InputError naming file and line."""
     records = []
     for line_no, record in read_jsonl(path, FIELDS):
-        expected = record["expected"]
         if not all(isinstance(o, str) for o in record["objects"]):
             raise InputError(f"{path}:{line_no}: field 'objects' must be a list of strings")
-        if not (isinstance(expected.get("predicate"), str) and isinstance(expected.get("roles"), dict)
-                and all(isinstance(v, str) for v in expected["roles"].values())):
-            raise InputError(f"{path}:{line_no}: field 'expected' must be {{\"predicate\": str, \"roles\": {{role: object}}}}")
-        records.append(record)
+        records.append(check_expected(record, f"{path}:{line_no}"))
     return records
 
 

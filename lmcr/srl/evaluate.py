@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
+from pathlib import Path
+
+from lmcr.jsonl import InputError, check_text, read_jsonl
+
+FRAME_SHAPE = '{"predicate": str, "roles": {role: str or null}}'
 
 
 @dataclass
@@ -66,6 +71,40 @@ def score_frames(gold: list[list[dict]], predicted: list[list[dict]], known: set
                     scores.roles[key].fn += sum(gold_set.values()) - hits
                     scores.roles[key].fp += sum(pred_set.values()) - hits
     return scores
+
+
+def _is_frame(value: object, open_roles: bool = True) -> bool:
+    """A frame as the gold files write it; without `open_roles` every role has a value."""
+    return isinstance(value, dict) and isinstance(value.get("predicate"), str) and isinstance(value.get("roles"), dict) \
+        and all(isinstance(v, str) or open_roles and v is None for v in value["roles"].values())
+
+
+def read_gold(path: Path) -> list[dict]:
+    """The records of an SRL gold file ({text, frames}); a bad line is an InputError naming file and line."""
+    records = []
+    for line, record in read_jsonl(path, {"text": str, "frames": list}):
+        check_text(record["text"], f"{path}:{line}")
+        if not all(_is_frame(f) for f in record["frames"]):
+            raise InputError(f"{path}:{line}: field 'frames' must be a list of {FRAME_SHAPE}")
+        records.append(record)
+    return records
+
+
+def check_expected(record: dict, where: str) -> dict:
+    """An instruction record whose `expected` frame names every role's object and whose `missing`
+    (when given) is null or one of those roles; else the InputError for `where` (file:line)."""
+    if not _is_frame(record["expected"], open_roles=False):
+        raise InputError(f"{where}: field 'expected' must be {{\"predicate\": str, \"roles\": {{role: object}}}}")
+    missing = record.get("missing")
+    if missing is not None and (not isinstance(missing, str) or missing not in record["expected"]["roles"]):
+        raise InputError(f"{where}: field 'missing' must be null or one of the expected roles "
+                         f"{sorted(record['expected']['roles'])}")
+    return record
+
+
+def read_instruction_tasks(path: Path) -> list[dict]:
+    """Instruction records ({instruction, expected, missing}) to score instruction parsing."""
+    return [check_expected(r, f"{path}:{line}") for line, r in read_jsonl(path, {"instruction": str, "expected": dict})]
 
 
 def instruction_correct(frame: dict | None, expected: dict, missing: str | None,
