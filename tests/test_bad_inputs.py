@@ -282,6 +282,34 @@ def test_score_rejects_malformed_frames_csv(defect, before, after):
     _count("frames CSV")
 
 
+# --- word vectors (score/evaluate/complete --vectors) ---------------------------------------------
+
+VECTOR_LINES = ["water 1 0", "cup 0.5 -0.5", "2 2"]
+VECTOR_DEFECTS = st.one_of(
+    st.sampled_from(["milk 1", "milk 1 0 2", "milk nan 0", "milk 1 inf", "milk 1 x", "milk", "milk\t1\t2\t3"]),
+    st.lists(st.text(alphabet="ab1.e-+ ", max_size=4), min_size=1, max_size=4).map(lambda p: "milk " + " ".join(p)),
+)
+
+
+@FUZZ
+@given(before=st.lists(st.sampled_from(VECTOR_LINES[:2]), max_size=3), defect=VECTOR_DEFECTS,
+       header=st.booleans(), garbage=st.sampled_from([b"", b"\xff"]))
+def test_a_malformed_vector_file_is_one_line_naming_its_line(before, defect, header, garbage):
+    lines = ([VECTOR_LINES[2]] if header else []) + ["pour 0 1", *before, defect]
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
+        (tmp / "v.txt").write_bytes("\n".join(lines).encode() + b"\n" + garbage)
+        result = invoke(["score", "--frames", str(tmp / "frames.csv"), "--out", str(tmp / "scores.csv"),
+                         "--methods", "word2vec", "--vectors", str(tmp / "v.txt")], tmp)
+        if result.exit_code == 0:  # the defect made a valid line after all ("milk 1 2")
+            assert not garbage and len(defect.split()) == 3
+        else:
+            assert_one_line_error(result, tmp / "v.txt", None if garbage else len(lines))
+            assert not (tmp / "scores.csv").exists()
+    _count("vector text")
+
+
 # --- MTurk results CSV (lmcr annotate ingest) ------------------------------------------------------
 
 MTURK_META = ["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "WorkTimeInSeconds"]

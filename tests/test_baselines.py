@@ -98,11 +98,32 @@ def test_npy_vectors_with_a_word_list_load_without_pickle(tmp_path):
         load_vectors(tmp_path / "glove.npy")
 
 
-def test_a_malformed_vector_file_is_a_vector_file_error(tmp_path):
+@pytest.mark.parametrize(("text", "reason"), [
+    (b"pour 1 0\nwater 1 nope\n", "v.txt:2: not a word and 2 numbers"),
+    (b"pour 1 0\nwater 1\n", "v.txt:2: 1 numbers where the vectors have 2"),  # gensim repeated the 1
+    (b"2 2\npour 1 0\nwater 1 0 3\n", "v.txt:3: 3 numbers where the vectors have 2"),
+    (b"pour 1 0\nwater nan 0\n", "v.txt:2: a value is not a finite number"),
+    (b"pour\n", "v.txt:1: a word without numbers"),
+    (b"\xff\xfe", "v.txt: not a readable vector file"),
+    (b"\n\n", "v.txt: no vectors"),
+])
+def test_a_malformed_vector_file_is_a_vector_file_error_naming_the_line(tmp_path, text, reason):
     bad = tmp_path / "v.txt"
-    bad.write_bytes(b"pour 1 0\nwater 1 nope\n")
-    with pytest.raises(VectorFileError, match="v.txt"):
+    bad.write_bytes(text)
+    with pytest.raises(VectorFileError, match=reason):
         load_vectors(bad)
+    np.save(tmp_path / "m.npy", np.array([[1.0, 0.0], [np.inf, 0.1]], dtype=np.float32))
+    (tmp_path / "m.words.txt").write_text("water\ncup\n", encoding="utf-8")
+    with pytest.raises(VectorFileError, match="m.npy: row 1 is not finite"):
+        load_vectors(tmp_path / "m.npy")
+
+
+def test_glove_and_word2vec_text_load_alike(tmp_path):
+    (tmp_path / "g.txt").write_text("water 1 0\ncup 0.5 -0.5 \n\n", encoding="utf-8")
+    (tmp_path / "w.txt").write_text("2 2\nwater 1 0\ncup 0.5 -0.5\n", encoding="utf-8")
+    for name in ("g.txt", "w.txt"):
+        kv = load_vectors(tmp_path / name)
+        assert kv.index_to_key == ["water", "cup"] and kv["cup"].tolist() == [0.5, -0.5]
 
 
 def _tiny_vectors(words: dict[str, list[float]]):

@@ -62,13 +62,55 @@ def load_vectors(path: Path) -> KeyedVectors:
         if path.suffix.lower() == ".npy":
             return _load_npy(path)
         if path.suffix.lower() == ".bin":
-            return KeyedVectors.load_word2vec_format(str(path), binary=True)
-        with open(path, encoding="utf-8") as handle:
-            first = handle.readline().split()
-        has_header = len(first) == 2 and all(x.isdigit() for x in first)
-        return KeyedVectors.load_word2vec_format(str(path), binary=False, no_header=not has_header)
+            return _finite(path, KeyedVectors.load_word2vec_format(str(path), binary=True))
+        return _load_text(path)
     except (ValueError, UnicodeDecodeError, EOFError, OSError, IndexError) as exc:
+        if isinstance(exc, VectorFileError):
+            raise
         raise VectorFileError(f"{path}: not a readable vector file: {one_line(exc, 200)}") from exc
+
+
+def _finite(path: Path, kv: KeyedVectors) -> KeyedVectors:
+    """`kv` when every value is a finite number (a NaN would make every distance NaN)."""
+    bad = np.flatnonzero(~np.isfinite(kv.vectors).all(axis=1))
+    if bad.size:
+        raise VectorFileError(f"{path}: the vector of {kv.index_to_key[bad[0]]!r} is not finite")
+    return kv
+
+
+def _load_text(path: Path) -> KeyedVectors:
+    """GloVe text, or word2vec text with its "COUNT DIM" header: each line a word and DIM numbers. A
+    line with another count or a value that is no finite number is an error naming it (gensim's reader
+    would repeat a short line's numbers to fill the vector)."""
+    words: list[str] = []
+    rows: list[np.ndarray] = []
+    dim = None
+    with open(path, encoding="utf-8") as handle:
+        for line_no, line in enumerate(handle, 1):
+            parts = line.split()
+            if line_no == 1 and len(parts) == 2 and all(x.isdigit() for x in parts):
+                dim = int(parts[1])  # word2vec's header
+                continue
+            if not parts:
+                continue
+            dim = dim or len(parts) - 1
+            try:
+                row = np.array(parts[1:], dtype=np.float32)
+            except ValueError:
+                raise VectorFileError(f"{path}:{line_no}: not a word and {dim} numbers") from None
+            if not len(row):
+                raise VectorFileError(f"{path}:{line_no}: a word without numbers")
+            if len(row) != dim:
+                raise VectorFileError(f"{path}:{line_no}: {len(row)} numbers where the vectors have {dim}")
+            if not np.isfinite(row).all():
+                raise VectorFileError(f"{path}:{line_no}: a value is not a finite number")
+            words.append(parts[0])
+            rows.append(row)
+    if not rows:
+        raise VectorFileError(f"{path}: no vectors")
+    kv = KeyedVectors(dim, count=0)
+    kv.add_vectors(words, np.stack(rows))
+    return kv
 
 
 def _word_list(path: Path) -> tuple[list[str], str]:
@@ -97,6 +139,8 @@ def _load_npy(path: Path) -> KeyedVectors:
     matrix = np.load(path, allow_pickle=False)
     if matrix.ndim != 2 or len(words) != matrix.shape[0]:
         raise VectorFileError(f"{path}: {matrix.shape} matrix does not match {len(words)} words in {source}")
+    if not np.isfinite(matrix).all():
+        raise VectorFileError(f"{path}: row {int(np.flatnonzero(~np.isfinite(matrix).all(axis=1))[0])} is not finite")
     kv = KeyedVectors(matrix.shape[1], count=0)
     # Set the table directly: `add_vectors` checks each of 400k keys against the growing index.
     kv.vectors = np.ascontiguousarray(matrix, dtype=np.float32)
