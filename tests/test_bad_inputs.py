@@ -310,6 +310,30 @@ def test_a_malformed_vector_file_is_one_line_naming_its_line(before, defect, hea
     _count("vector text")
 
 
+EDGE_LINES = ["RelatedTo\tcup\tmug", "/a/[x]\t/r/AtLocation\t/c/en/milk\t/c/en/fridge\t{}", "RelatedTo\t/c/fr/tasse\t/c/fr/bol"]
+
+
+@FUZZ
+@given(before=st.lists(st.sampled_from(EDGE_LINES), max_size=3),
+       defect=st.one_of(st.text(alphabet="ab\t /", max_size=6).filter(lambda t: t.count("\t") < 2 and t.strip()),
+                        st.just("\udcff")),
+       gz=st.sampled_from(["plain", "gzip", "corrupt gzip"]))
+def test_a_malformed_conceptnet_edge_file_is_one_line(before, defect, gz):
+    lines = [EDGE_LINES[0], *before, defect]
+    raw = "\n".join(lines).encode("utf-8", "surrogateescape") + b"\n"
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        path = tmp / ("edges.txt.gz" if gz != "plain" else "edges.txt")
+        path.write_bytes(gzip.compress(raw) if gz == "gzip" else raw if gz == "plain" else b"\x1f\x8b" + raw)
+        (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
+        result = invoke(["score", "--frames", str(tmp / "frames.csv"), "--out", str(tmp / "scores.csv"),
+                         "--methods", "conceptnet", "--conceptnet", str(path)], tmp)
+        named_line = gz != "corrupt gzip" and defect != "\udcff"
+        assert "edge" in assert_one_line_error(result, path, len(lines) if named_line else None)
+        assert not (tmp / "scores.csv").exists()
+    _count("ConceptNet edges")
+
+
 # --- MTurk results CSV (lmcr annotate ingest) ------------------------------------------------------
 
 MTURK_META = ["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "WorkTimeInSeconds"]

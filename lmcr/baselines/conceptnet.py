@@ -4,8 +4,8 @@ the added term is constant within a scenario, see `cooccur`).
 The paper queried the ConceptNet API's relatedness, the cosine of ConceptNet Numberbatch vectors.
 Offline we rebuild the same kind of quantity from an edge list: Numberbatch starts from the PPMI of
 the ConceptNet graph's adjacency matrix reduced by SVD, so we embed every English concept by a
-truncated SVD of the PPMI-weighted symmetric adjacency (edges of all relations, weight 1 each, or the
-file's weight) and take cosines. Without Numberbatch's retrofitting onto word2vec/GloVe and with only
+truncated SVD of the PPMI-weighted symmetric adjacency (edges of all relations, weight 1 each) and
+take cosines. Without Numberbatch's retrofitting onto word2vec/GloVe and with only
 100k edges (`cn100k`) the vectors are coarser than the API's. A user-supplied Numberbatch text file is
 used directly. A concept missing from the graph is looked up by its words; with none known its
 relatedness is 0.
@@ -24,6 +24,7 @@ from scipy.sparse.linalg import svds
 
 from lmcr.baselines.cooccur import Frame, pair_sum
 from lmcr.baselines.vectors import load_vectors
+from lmcr.errors import LMCRError, one_line
 
 
 def _concept(uri_or_text: str) -> str | None:
@@ -37,26 +38,37 @@ def _concept(uri_or_text: str) -> str | None:
     return text.replace("_", " ").lower() or None
 
 
+class ConceptNetFileError(LMCRError, ValueError):
+    """A ConceptNet edge file that cannot be read, or a line that is no edge."""
+
+
 def read_edges(path: Path) -> list[tuple[str, str, float]]:
     """(head, tail, weight) from `relation<TAB>head<TAB>tail[<TAB>...]` lines (cn100k, file or folder:
-    its `train.txt`) or ConceptNet assertion CSVs (`uri, rel, /c/en/.., /c/en/.., json`), `.gz` allowed."""
+    its `train.txt`) or ConceptNet assertion CSVs (`uri, rel, /c/en/.., /c/en/.., json`), `.gz` allowed.
+    Edges of other languages are left out; a line with fewer than three fields is an error naming it."""
     path = Path(path)
     if path.is_dir():
         path = path / "train.txt"
     opener = gzip.open if path.suffix == ".gz" else open
     edges = []
-    with opener(path, "rt", encoding="utf-8") as handle:
-        for row in csv.reader(handle, delimiter="\t", quoting=csv.QUOTE_NONE):
-            if len(row) >= 5 and row[2].startswith("/c/"):  # assertions: uri, rel, start, end, info
-                head, tail = _concept(row[2]), _concept(row[3])
-            elif len(row) >= 3:
-                head, tail = _concept(row[1]), _concept(row[2])
-            else:
-                continue
-            if head and tail and head != tail:
-                edges.append((head, tail, 1.0))
+    try:
+        with opener(path, "rt", encoding="utf-8") as handle:
+            for line, row in enumerate(csv.reader(handle, delimiter="\t", quoting=csv.QUOTE_NONE), 1):
+                if len(row) >= 5 and row[2].startswith("/c/"):  # assertions: uri, rel, start, end, info
+                    head, tail = _concept(row[2]), _concept(row[3])
+                elif len(row) >= 3:
+                    head, tail = _concept(row[1]), _concept(row[2])
+                elif not row:
+                    continue  # a blank line
+                else:
+                    raise ConceptNetFileError(f"{path}:{line}: {len(row)} tab-separated field(s); an edge is "
+                                              "relation, head, tail")
+                if head and tail and head != tail:
+                    edges.append((head, tail, 1.0))
+    except (OSError, EOFError, UnicodeDecodeError, csv.Error) as exc:
+        raise ConceptNetFileError(f"{path}: not a readable ConceptNet edge file: {one_line(exc, 200)}") from exc
     if not edges:
-        raise ValueError(f"{path}: no English ConceptNet edges found")
+        raise ConceptNetFileError(f"{path}: no English ConceptNet edges found")
     return edges
 
 
