@@ -67,8 +67,11 @@ def test_conceptnet_relatedness_from_an_edge_list(tmp_path):
 
 
 def test_conceptnet_without_english_edges_is_an_error(tmp_path):
-    (tmp_path / "train.txt").write_text("only one column\n")
+    (tmp_path / "train.txt").write_text("RelatedTo\t/c/fr/tasse\t/c/fr/bol\n\n")
     with pytest.raises(ValueError, match="no English ConceptNet edges"):
+        read_edges(tmp_path)
+    (tmp_path / "train.txt").write_text("RelatedTo\tcup\tmug\nonly one column\n")
+    with pytest.raises(ValueError, match="train.txt:2: 1 tab-separated field"):
         read_edges(tmp_path)
 
 
