@@ -38,3 +38,20 @@ def test_plural_read_as_a_second_object():
     # a pair the corpus does not join stays as parsed
     assert roles(spec, Compounds(strong_bigrams=frozenset({"bay leaves"}))) == [
         {"Theme": "bread", "Destination": "casserole"}]
+
+
+def test_a_gerund_read_as_a_verb_with_its_object():
+    """Terse narrations: "pour oil in frying pan" is no fry frame of the pan but a pour into it."""
+    learned = Compounds(strong_bigrams=frozenset({"frying pan"}))
+    spec = "pour/VB/ROOT/0 oil/NN/dobj/0 in/IN/prep/0 frying/VBG/pcomp/2/fry pan/NN/dobj/3"
+    doc = rejoin_split_compounds(make_doc(spec), learned)
+    assert [(f.predicate, f.roles) for f in extract_frames(doc, LEX, learned)] == [
+        ("pour", {"Theme": "oil", "Destination": "frying pan"})]
+    assert [(f.predicate, f.roles) for f in extract_frames(make_doc(spec), LEX, None) if f.known] == [
+        ("pour", {"Theme": "oil", "Destination": None}), ("fry", {"Theme": "pan", "Instrument": None})]
+    stir = rejoin_split_compounds(make_doc("stir/VB/ROOT/0 frying/VBG/xcomp/0/fry pan/NN/dobj/1"), learned)
+    assert [(t.text, t.dep_, t.head.text) for t in stir] == [("stir", "ROOT", "stir"), ("frying", "compound", "pan"),
+                                                             ("pan", "dobj", "stir")]
+    # a gerund and its object the corpus does not join are a verb and its object
+    spec = "start/VB/ROOT/0 frying/VBG/xcomp/0/fry onions/NNS/dobj/1/onion"
+    assert roles(spec, learned) == [{"Theme": "onion", "Instrument": None}]

@@ -76,6 +76,10 @@ def test_argument_values():
     assert frames("fill/VB/ROOT/0 each/DT/det/2 cup/NN/dobj/0") == [("fill", {"Destination": "cup", "Theme": None})]
     assert frames("dip/VB/ROOT/0 a/DT/det/2 few/JJ/dobj/0 in/IN/prep/0 the/DT/det/5 chocolate/NN/pobj/3") == [
         ("dip", {"Theme": None, "Destination": "chocolate"})]
+    # a number gives way to its of-phrase too, and names nothing alone
+    assert frames("sprinkle/VB/ROOT/0 3/CD/dobj/0 of/IN/prep/1 the/DT/det/4 pepper/NN/pobj/2 over/RP/prt/0") == [
+        ("sprinkle", {"Theme": "pepper", "Destination": None})]
+    assert frames("heat/VB/ROOT/0 350/CD/dobj/0") == [("heat", {"Theme": None, "Instrument": None})]
     # adjectives and determiners go, plurals become singular, noun-tagged modifiers stay
     doc = ("pour/VB/ROOT/0 the/DT/det/3 melted/JJ/amod/3 chocolate/NN/dobj/0 into/IN/prep/0 "
            "the/DT/det/7 frying/NN/amod/7 pans/NNS/pobj/4/pan")

@@ -28,15 +28,17 @@ def _of_object(token: Token) -> Token | None:
 
 
 def resolve_head(token: Token, lex: Lexicon) -> Token | None:
-    """Follow measure/quantity nouns to their of-object; None where nothing nameable is left."""
+    """Follow measure/quantity nouns and numbers to their of-object ("1/4 of the pepper"); None where
+    nothing nameable is left."""
     for _ in range(4):  # "half of a cup of milk": at most a few hops
         lemma = lemma_of(token)
-        if lemma in lex.measure_nouns or lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns:
+        quantity = lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns or token.tag_ == "CD"
+        if lemma in lex.measure_nouns or quantity:
             inner = _of_object(token)
             if inner is not None:
                 token = inner
                 continue
-            if lemma in lex.quantity_nouns or token.lower_ in lex.quantity_nouns:
+            if quantity:
                 return None
         break
     if token.tag_ == "PRP" or token.lower_ in lex.object_pronouns:

@@ -5,7 +5,10 @@ oil over the chili flakes" as "flakes" a verb coordinated with "pour"; "sprinkle
 as two objects. When the two words are a strong bigram of the corpus (`Compounds.strong_bigrams`:
 "bay leaves", "chili flakes", "bread crumbs"), the plural is the head noun and the word before it a
 modifier, and the tree is mended so: the plural takes the place of the noun phrase, the noun becomes
-its compound. Without learned compounds nothing is changed.
+its compound. Terse narrations bring a fourth: "pour oil in frying pan" comes out as a gerund "frying"
+with the object "pan" (a fry frame of the pan, and no destination for the pour); when the two words are
+a strong bigram ("frying pan", "measuring cup", "cutting board") the noun takes the gerund's place and
+the gerund becomes its compound. Without learned compounds nothing is changed.
 """
 
 from __future__ import annotations
@@ -16,6 +19,9 @@ from lmcr.srl.compounds import Compounds
 
 CLAUSE_DEPS = frozenset({"ccomp", "conj", "dep", "xcomp", "advcl"})
 PHRASE_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "obj"})
+# Where a gerund read as a verb stood, and what its noun is there: a preposition's object ("in frying
+# pan"), a verb's object ("stir frying pan"), the sentence's head ("frying pan on the hob").
+GERUND_PLACES = {"pcomp": "pobj", "xcomp": "dobj", "ROOT": "ROOT"}
 
 
 def _split(noun: Token, plural: Token) -> str | None:
@@ -31,10 +37,27 @@ def _split(noun: Token, plural: Token) -> str | None:
     return None
 
 
+def _rejoin_gerund(gerund: Token, noun: Token) -> None:
+    """"frying/VBG pan/dobj" -> "frying/NN pan": the noun takes the gerund's place, with its other words."""
+    noun.dep_ = GERUND_PLACES[gerund.dep_]
+    noun.head = noun if gerund.dep_ == "ROOT" else gerund.head
+    for child in list(gerund.children):
+        if child.i != noun.i:
+            child.head = noun
+    gerund.head, gerund.dep_ = noun, "compound"
+    gerund.tag_, gerund.pos_ = "NN", "NOUN"
+
+
 def rejoin_split_compounds(doc: Doc, compounds: Compounds | None) -> Doc:
-    """Mend the three misreadings of a corpus compound with a plural head (module docstring)."""
+    """Mend the misreadings of a corpus compound: three with a plural head, and a gerund read as a verb
+    with its object (module docstring)."""
     if compounds is None:
         return doc
+    for gerund, noun in zip(doc[:-1], doc[1:]):
+        if gerund.tag_ == "VBG" and gerund.dep_ in GERUND_PLACES and noun.head.i == gerund.i \
+                and noun.dep_ == "dobj" and noun.tag_.startswith("NN") \
+                and f"{gerund.lower_} {noun.lower_}" in compounds.strong_bigrams:
+            _rejoin_gerund(gerund, noun)
     for noun, plural in zip(doc[:-1], doc[1:]):
         if noun.tag_ not in ("NN", "NNP") or not plural.lower_.endswith("s") \
                 or f"{noun.lower_} {plural.lower_}" not in compounds.strong_bigrams:
