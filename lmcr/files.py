@@ -14,6 +14,9 @@ from typing import TypeVar
 from lmcr.errors import LMCRError, one_line
 
 T = TypeVar("T")
+# What reading a JSON file LMCR wrote can raise when the file is missing, not JSON, or not shaped as its
+# reader expects (a reader indexes into the value and converts it freely).
+UNREADABLE_JSON = (OSError, ValueError, KeyError, TypeError, AttributeError, IndexError)
 
 # Written into every folder LMCR publishes, listing the files it wrote: a folder is replaced only when
 # everything in it is LMCR's own, so a user's files are never deleted.
@@ -34,7 +37,7 @@ def read_resource(path: Path, what: str, build: Callable[[object], T]) -> T:
     KeyError, TypeError or ValueError there) is a one-line ResourceError naming the file."""
     try:
         return build(json.loads(Path(path).read_text(encoding="utf-8")))
-    except (OSError, ValueError, KeyError, TypeError, AttributeError, IndexError) as exc:
+    except UNREADABLE_JSON as exc:
         raise ResourceError(f"{path}: cannot read the {what} ({one_line(exc, 200)}); "
                             "run `lmcr frames` again") from exc
 
@@ -62,7 +65,7 @@ def cached_json(path: Path, usable: Callable[[object], bool], make: Callable[[],
         saved = json.loads(Path(path).read_text(encoding="utf-8"))
         if usable(saved):
             return saved
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+    except UNREADABLE_JSON:
         pass  # no cache yet, or not one of ours
     made = make()
     with atomic_path(path) as tmp:

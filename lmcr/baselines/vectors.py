@@ -64,9 +64,9 @@ def load_vectors(path: Path) -> KeyedVectors:
         if path.suffix.lower() == ".bin":
             return _finite(path, KeyedVectors.load_word2vec_format(str(path), binary=True))
         return _load_text(path)
+    except VectorFileError:
+        raise  # already names the file (and line)
     except (ValueError, UnicodeDecodeError, EOFError, OSError, IndexError) as exc:
-        if isinstance(exc, VectorFileError):
-            raise
         raise VectorFileError(f"{path}: not a readable vector file: {one_line(exc, 200)}") from exc
 
 

@@ -64,9 +64,11 @@ def _role_words(doc: Doc, mention: FrameMention, predicate: Token, said: frozens
     the person it is done for as a pronoun ("pour me some water"): the addressee of the request, which
     the frame's text has no place for ("pour water into the mug me for my tea"). The roles in `said`
     are not the frame's: their words are left to the context."""
-    heads = [t for t in doc if _covered(t, [span for role, span in mention.spans.items() if role not in said])]
+    frame_spans = [span for role, span in mention.spans.items() if role not in said]
+    said_spans = [span for role, span in mention.spans.items() if role in said]
+    heads = [t for t in doc if _covered(t, frame_spans)]
     words = {t.i for t in heads}
-    said_words = {t.i for t in doc if _covered(t, [span for role, span in mention.spans.items() if role in said])}
+    said_words = {t.i for t in doc if _covered(t, said_spans)}
     for child in predicate.children:
         if child.dep_ == "prt" or child.tag_ == "RP" or child.dep_ == "dative" and child.tag_ == "PRP":
             words.add(child.i)
