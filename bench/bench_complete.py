@@ -1,8 +1,9 @@
 """Benchmark: completion on the dev instructions (accuracy, questions) and its latency.
 
 Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm+frame_counts]
-       [--corpus all] [--mixture household=30|plain] [--no-context] [--scene-size 40]
-Uses the store, checkpoints and chosen mixture of $LMCR_DATA_DIR and the calibration `lmcr evaluate` wrote there.
+       [--corpus all] [--mixture household=30|plain] [--context-weight 1] [--no-context] [--scene-size 40]
+Uses the store, checkpoints, chosen mixture and context weight of $LMCR_DATA_DIR and the calibration `lmcr evaluate`
+wrote there.
 1. Accuracy: an instruction counts as right when the completed frame is the expected one, with or
    without a question; a question whose best guess is wrong is wrong even when it names the object.
    --scene-size N fills each scene with robot-vocabulary objects up to N: the same instructions among
@@ -53,6 +54,8 @@ def main() -> None:
     parser_.add_argument("--method", default=COMPLETION_METHOD)
     parser_.add_argument("--corpus", default="all")
     parser_.add_argument("--mixture", default=None, help="corpus weights (household=30, plain); default: the chosen one")
+    parser_.add_argument("--context-weight", type=float, default=None,
+                         help="weight of the context term; default: the chosen one")
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
     parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
     parser_.add_argument("--scene-size", type=int, default=0, help="fill each scene with other objects up to this")
@@ -60,11 +63,12 @@ def main() -> None:
     ws = Workspace.from_env()
     res = ws.resources(corpus=args.corpus)
     res = replace(res, mixture=Mixture.parse(args.mixture)) if args.mixture is not None else res
+    res = replace(res, context_weight=args.context_weight) if args.context_weight is not None else res
     scorer, config = ws.completion_scorer(args.method, res)
     config = replace(config, context=not args.no_context)
     parser = ws.parser()
     print(f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
-          f"{'on' if config.context else 'off'}); {config.source}")
+          f"{f'weight {res.context_weight:g}' if config.context else 'off'}); {config.source}")
     records = load_instructions(args.instructions)
     if args.scene_size:
         records = [filled_scene(r, args.scene_size) for r in records]

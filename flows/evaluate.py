@@ -60,15 +60,15 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 
 @task(name="choose-mixture")
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
-    """Choose the household weight of the pooled setting on the ratings (and the instructions: `lmcr
-    mixture`) and save it."""
+    """Choose the household weight of the pooled setting on the ratings (and on the instructions, with the
+    context term's weight: `lmcr mixture`) and save them."""
     from lmcr.evaluate.mixture import DevInstructions, choose_and_save
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
     dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None
-    chosen, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info,
-                                instructions=dev)
-    return chosen.label
+    chosen, context_weight, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir,
+                                                log=get_run_logger().info, instructions=dev)
+    return chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
 
 
 @flow(name="evaluate")
@@ -97,7 +97,7 @@ def evaluate_flow(
         ws = replace(ws, paper=Path(paper))
     res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
     if mixture and corpus == "all" and (ws.checkpoints / Setting("sentence", "household").name / "LATEST").exists():
-        get_run_logger().info("household weight: %s", mixture_task(ratings or str(ws.db), res, ws, instructions))
+        get_run_logger().info("chosen: %s", mixture_task(ratings or str(ws.db), res, ws, instructions))
         res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
         if not res.mixture.plain:  # the report shows what the mixture changed
             methods = [*methods, f"{COMPLETION_METHOD}@plain"]

@@ -369,11 +369,12 @@ def mixture(
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
     instructions: Path | None = typer.Option(None, help="Instructions JSONL ({instruction, objects, expected}) to "
-                                                        "choose on as well: the best mean of the two accuracies wins."),
+                                                        "choose on as well: the best mean of the two accuracies wins, "
+                                                        "and the context term's weight is chosen on them."),
 ) -> None:
-    """Choose how much a corpus counts in the pooled `all` setting, on rated frames (and instructions);
-    saves mixture.json (read by every command that scores, and part of the completion calibration's
-    fingerprint)."""
+    """Choose how much a corpus counts in the pooled `all` setting, on rated frames (and instructions, with
+    the weight of the context term); saves mixture.json (read by every command that scores, and part of the
+    completion calibration's fingerprint)."""
     from lmcr.evaluate.mixture import DevInstructions, choose_and_save
     from lmcr.evaluate.ratings import load_ratings
     from lmcr.lexicon import load_lexicon
@@ -387,11 +388,12 @@ def mixture(
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
     dev = DevInstructions.read(instructions, ws.parser) if instructions else None
-    chosen, path = choose_and_save(rated, ratings, ws.resources(checkpoint), method, ws.data_dir, corpus, weights,
-                                   EvalConfig(per_verb=per_verb), log=lambda m: console.print(m, highlight=False),
-                                   instructions=dev)
-    console.print(f"{corpus} weight {chosen.weight(corpus):g} saved to {path}; run `lmcr evaluate` to calibrate "
-                  "completion under it")
+    chosen, context_weight, path = choose_and_save(
+        rated, ratings, ws.resources(checkpoint), method, ws.data_dir, corpus, weights, EvalConfig(per_verb=per_verb),
+        log=lambda m: console.print(m, highlight=False), instructions=dev)
+    context = f", context weight {context_weight:g}" if context_weight else ""
+    console.print(f"{corpus} weight {chosen.weight(corpus):g}{context} saved to {path}; run `lmcr evaluate` to "
+                  "calibrate completion under it")
 
 
 def _split(names: str) -> list[str]:

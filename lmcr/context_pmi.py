@@ -1,21 +1,25 @@
-"""What the rest of an instruction says about a filler, learned from which words share a document:
-"season the apples for the pie" -> cinnamon, because recipes that mention pie mention cinnamon far more
-often than recipes at large, and salt barely more.
+"""What the rest of an instruction says about a filler, learned from which words share a sentence with it:
+"dump the pasta in to boil" -> the pot, because sentences that say boil name a pot far more often than
+sentences at large, and a bowl barely more.
 
-    context_pmi(frame, context) = WEIGHT * sum over the context's words w and the frame's fillers o of
-                                  log [(d(w, o) + 1) (D + 1) / ((d(w) + 1) (d(o) + 1))]
+    context_pmi(frame, context) = weight * sum over the context's words w and the frame's fillers o of
+                                  log [(n(w, o) + 1) (N + 1) / ((n(w) + 1) (n(o) + 1))]
 
-d(w): documents (a recipe, a narrated video, a household program) whose text has the word w; d(o): those
-that name the object o (its last word may take -s or -es); d(w, o): both; D: documents (in `all`, each
-corpus's documents count as often as the mixture weighs it). The context's words are its tokens that are
-not stop words (spaCy's list), held by at least MIN_DOCS documents, and not a word of the filler itself
-(a purpose that names the pasta says the pot is for it, not that the pasta is the pot). An instruction
-without context scores 0 for every candidate, as without the term, and so does every rated frame of
-Table I. The sentence LM reads the context too, but word by word after the frame: this term sees the
-whole document a purpose and an object share, and nothing in it is written by hand.
+n(w): sentences (recipe steps, titles, ingredient lines, narrations, program steps) with the word w;
+n(o): those that name the object o (its last word may take -s or -es); n(w, o): both; N: sentences (in
+`all`, each corpus's sentences count as often as the mixture weighs it). The context's words are its
+tokens that are not stop words (spaCy's list), in at least MIN_SENTENCES sentences, and not a word of the
+filler itself (a purpose that names the pasta says the pot is for it, not that the pasta is the pot). An
+instruction without context scores 0 for every candidate, as without the term, and so does every rated
+frame of Table I. The sentence LM reads the context too, but word by word after the frame: this term
+sees every sentence a purpose word and an object share, in any order, and nothing in it is written by
+hand. The unit is the sentence, not the document (a recipe, a narrated video): one sentence names a
+purpose with the thing it needs ("boil the pasta in a large pot"), a whole recipe names every tool it
+uses for every purpose (README, Completion: the figures of both).
 
-WEIGHT = 1 (log-probability units, as the experts it is added to) of 0.5, 1 and 2 tried on the dev
-instructions, which complete the same with each (README, Completion).
+The weight multiplies the term in log-probability units, as the experts it is added to: 1 (unscaled)
+unless `lmcr mixture` chose another of GRID on the dev instructions, together with the household weight
+(lmcr/evaluate/mixture.py); the choice is saved in mixture.json and read into `MethodResources`.
 """
 
 from __future__ import annotations
@@ -30,29 +34,32 @@ from lmcr.lm.linearize import tokens
 from lmcr.rarity import phrase_pattern
 from lmcr.store import named_query, read_connection
 
-WEIGHT = 1.0
-MIN_DOCS = 20  # a word in fewer documents says little and would only grow the table
+WEIGHT = 1.0  # the unscaled term: what completion uses when no weight was chosen
+GRID = (0.5, 1.0, 2.0)  # the weights `lmcr mixture` chooses among
+MIN_SENTENCES = 20  # a word in fewer sentences says little and would only grow the table
 
 
 class ContextCooccurrence:
-    """Document counts of words, object phrases and the two together; scores frames given a context."""
+    """Sentence counts of words, object phrases and the two together; scores frames given a context."""
 
-    def __init__(self, docs: float, word_docs: dict[str, float], object_docs: dict[str, float],
-                 pair_docs: dict[str, dict[str, float]]):
-        self.docs, self.word_docs, self.object_docs, self.pair_docs = docs, word_docs, object_docs, pair_docs
+    def __init__(self, sentences: float, word_sentences: dict[str, float], object_sentences: dict[str, float],
+                 pair_sentences: dict[str, dict[str, float]]):
+        self.sentences, self.word_sentences = sentences, word_sentences
+        self.object_sentences, self.pair_sentences = object_sentences, pair_sentences
 
     @classmethod
     def count(cls, db: Path, sql_dir: Path, objects: Iterable[str], corpora: dict[str, float],
-              min_docs: int = MIN_DOCS) -> ContextCooccurrence:
+              min_sentences: int = MIN_SENTENCES) -> ContextCooccurrence:
         """Count in the store's sentences, one query per corpus (`corpora`: corpus -> weight; 'all': 1)."""
-        docs, words, objs, pairs = 0.0, {}, {}, {}
+        sentences, words, objs, pairs = 0.0, {}, {}, {}
         con = read_connection(db)
         try:
             for corpus, weight in corpora.items():
-                params = {"phrases": phrase_pattern(o.lower() for o in objects), "corpus": corpus, "min_docs": min_docs}
+                params = {"phrases": phrase_pattern(o.lower() for o in objects), "corpus": corpus,
+                          "min_sentences": min_sentences}
                 for kind, obj, word, n in con.execute(named_query(sql_dir, "context_cooccurrence"), params).fetchall():
-                    if kind == "docs":
-                        docs += weight * n
+                    if kind == "sentences":
+                        sentences += weight * n
                     elif kind == "word":
                         words[word] = words.get(word, 0.0) + weight * n
                     elif kind == "object":
@@ -61,25 +68,25 @@ class ContextCooccurrence:
                         pairs.setdefault(obj, {})[word] = pairs.get(obj, {}).get(word, 0.0) + weight * n
         finally:
             con.close()
-        return cls(docs, words, objs, pairs)
+        return cls(sentences, words, objs, pairs)
 
     @classmethod
     def cached(cls, db: Path, sql_dir: Path, objects: Iterable[str], corpora: dict[str, float],
                cache: Path) -> ContextCooccurrence:
         """The counts from `cache` when it holds them for these objects (the caller names the file by the
-        corpus content and mixture), else counted (about 10 s on the full store) and saved there."""
+        corpus content and mixture), else counted (about 20 s on the full store) and saved there."""
         objects = sorted({o.lower() for o in objects})
 
         def counted() -> dict:
             found = cls.count(db, sql_dir, objects, corpora)
-            return {"objects": objects, "docs": found.docs, "words": found.word_docs,
-                    "object_docs": found.object_docs, "pairs": found.pair_docs}
+            return {"objects": objects, "sentences": found.sentences, "words": found.word_sentences,
+                    "object_sentences": found.object_sentences, "pairs": found.pair_sentences}
 
         def usable(saved) -> bool:
-            return saved["objects"] == objects and isinstance(saved["docs"], (int, float))
+            return saved["objects"] == objects and isinstance(saved["sentences"], (int, float))
 
         saved = cached_json(cache, usable, counted)
-        return cls(float(saved["docs"]), saved["words"], saved["object_docs"], saved["pairs"])
+        return cls(float(saved["sentences"]), saved["words"], saved["object_sentences"], saved["pairs"])
 
     def context_words(self, context: str) -> list[str]:
         """The context's counted words of three letters or more that are not stop words, each once, in order."""
@@ -87,21 +94,23 @@ class ContextCooccurrence:
             STOP_WORDS,  # imported here: building the term (`lmcr evaluate` does) needs no spaCy
         )
 
-        seen = dict.fromkeys(w for w in tokens(context) if len(w) > 2 and w.isalpha() and w not in STOP_WORDS and w in self.word_docs)
+        seen = dict.fromkeys(w for w in tokens(context)
+                             if len(w) > 2 and w.isalpha() and w not in STOP_WORDS and w in self.word_sentences)
         return list(seen)
 
     def pmi(self, word: str, obj: str) -> float:
-        """log of how much more often documents with `word` name `obj` than documents at large, smoothed."""
+        """log of how much more often sentences with `word` name `obj` than sentences at large, smoothed."""
         key = obj.lower()
-        together = self.pair_docs.get(key, {}).get(word, 0.0)
-        return math.log((together + 1) * (self.docs + 1) / ((self.word_docs[word] + 1) * (self.object_docs.get(key, 0.0) + 1)))
+        together = self.pair_sentences.get(key, {}).get(word, 0.0)
+        alone = (self.word_sentences[word] + 1) * (self.object_sentences.get(key, 0.0) + 1)
+        return math.log((together + 1) * (self.sentences + 1) / alone)
 
-    def score(self, frames: list[Frame], context: str = "") -> list[float]:
-        """WEIGHT * the summed PMI of the context's words with each frame's fillers (0 without context)."""
+    def score(self, frames: list[Frame], context: str = "", weight: float = WEIGHT) -> list[float]:
+        """`weight` * the summed PMI of the context's words with each frame's fillers (0 without context)."""
         words = self.context_words(context) if context else []
         if not words:
             return [0.0] * len(frames)
-        return [WEIGHT * sum(self.pmi(w, value) for _, value in frame.roles for w in words if not _names(w, value))
+        return [weight * sum(self.pmi(w, value) for _, value in frame.roles for w in words if not _names(w, value))
                 for frame in frames]
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Protocol
 
 from lmcr.config import SQL_DIR
+from lmcr.context_pmi import WEIGHT as CONTEXT_WEIGHT
 from lmcr.files import atomic_path, file_sha256
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, read_lines
@@ -48,6 +49,7 @@ class MethodResources:
     cache_dir: Path | None = None
     seed: int = 0
     mixture: Mixture = Mixture()  # per-corpus weights of the `all` setting (lmcr/mixture.py)
+    context_weight: float = CONTEXT_WEIGHT  # the context term's, chosen with the mixture (lmcr/context_pmi.py)
 
     @property
     def mixed(self) -> bool:
@@ -199,19 +201,20 @@ def _context_pmi(res: MethodResources) -> Scorer:
 
     _store(res, "context_pmi", "sentences")
     corpora = res.mixture.parts(res.corpus)
-    cache = _count_cache(res, "context", "sentence")
+    cache = _count_cache(res, "context-sentences", "sentence")
 
     @functools.cache
     def counts() -> ContextCooccurrence:  # counted (or read) at the first context: rated frames have none
         return ContextCooccurrence.cached(res.db, res.sql_dir, load_lexicon().objects, corpora, cache)
 
-    return lambda frames, context="": counts().score(frames, context) if context else [0.0] * len(frames)
+    weight = res.context_weight
+    return lambda frames, context="": counts().score(frames, context, weight) if context else [0.0] * len(frames)
 
 
 def _context_pmi_fingerprint(res: MethodResources) -> str:
-    from lmcr.context_pmi import MIN_DOCS, WEIGHT
+    from lmcr.context_pmi import MIN_SENTENCES
 
-    return f"{store_corpus_hash(res.db, 'sentence')}*{WEIGHT:g}/{MIN_DOCS}"
+    return f"{store_corpus_hash(res.db, 'sentence')}*{res.context_weight:g}/{MIN_SENTENCES}/sentences"
 
 
 def _cooccur(res: MethodResources) -> Scorer:

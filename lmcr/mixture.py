@@ -7,10 +7,13 @@ the all-corpora LM: P(text) = (1 - s) P_all(text) + s P_household(text), s = w N
 with N words in all and N_h in household. w = 1 for every corpus is the plain pooled setting.
 
 The weight is learned, not written by hand: `lmcr mixture` scores the dev ratings with each candidate of
-a short grid and keeps the best for the default completion method (Table I accuracy at lambda=1, k=6).
-It is saved as `mixture.json` in the data folder (with the candidates' accuracies and the ratings'
-hash), read by every command that builds scorers, and part of every scorer fingerprint built with it,
-so a completion calibration made under one mixture is never used under another.
+a short grid and keeps the best for the default completion method (Table I accuracy at lambda=1, k=6;
+with dev instructions, the mean of that and the share of instructions completed right). With
+instructions it chooses the weight of the context term (lmcr/context_pmi.py) on them at the same time:
+the rated frames have no context, so that weight changes the instructions alone. Both are saved as
+`mixture.json` in the data folder (with the candidates' accuracies and the dev files' hashes), read by
+every command that builds scorers, and part of every scorer fingerprint built with them, so a completion
+calibration made under one choice is never used under another.
 """
 
 from __future__ import annotations
@@ -42,7 +45,7 @@ class Mixture:
         for corpus, weight in weights.items():
             if corpus not in SOURCE_CORPORA:
                 raise MixtureError(f"mixture: unknown corpus {corpus!r} (one of {', '.join(SOURCE_CORPORA)})")
-            if not isinstance(weight, (int, float)) or isinstance(weight, bool) or not 0 < weight < float("inf"):
+            if not _positive(weight):
                 raise MixtureError(f"mixture: weight of {corpus} must be a positive number, not {weight!r}")
         return cls(tuple(sorted((c, float(w)) for c, w in weights.items() if w != 1)))
 
@@ -86,20 +89,47 @@ class Mixture:
         return {c: self.weight(c) * words.get(c, 0) / total for c, _ in self.weights if total}
 
 
+def _read(path: Path) -> dict:
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        if not isinstance(data, dict):
+            raise TypeError("not a JSON object")
+        return data
+    except (ValueError, TypeError) as exc:
+        raise MixtureError(f"{path}: not a mixture file ({exc}); run `lmcr mixture` again") from exc
+
+
 def load(data_dir: Path) -> Mixture:
     """The chosen mixture saved in `data_dir`, plain when none was chosen."""
     path = Path(data_dir) / FILE
     if not path.exists():
         return Mixture()
+    data = _read(path)
     try:
-        return Mixture.of(json.loads(path.read_text(encoding="utf-8"))["weights"])
+        return Mixture.of(data["weights"])
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise MixtureError(f"{path}: not a mixture file ({exc}); run `lmcr mixture` again") from exc
 
 
-def save(data_dir: Path, mixture: Mixture, provenance: dict) -> Path:
-    """Write `mixture.json` atomically: the weights and how they were chosen."""
+def load_context_weight(data_dir: Path) -> float | None:
+    """The weight of the context term (lmcr/context_pmi.py) chosen with the mixture on the dev instructions,
+    None when none was (no file, or a mixture chosen on rated frames alone)."""
     path = Path(data_dir) / FILE
+    weight = _read(path).get("context_weight") if path.exists() else None
+    if weight is not None and not _positive(weight):
+        raise MixtureError(f"{path}: context_weight must be a positive number, not {weight!r}; run `lmcr mixture` again")
+    return weight
+
+
+def save(data_dir: Path, mixture: Mixture, provenance: dict, context_weight: float | None = None) -> Path:
+    """Write `mixture.json` atomically: the weights (and the context term's, when chosen) and how they
+    were chosen."""
+    path = Path(data_dir) / FILE
+    chosen = {"weights": dict(mixture.weights), **({"context_weight": context_weight} if context_weight else {})}
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps({"weights": dict(mixture.weights), **provenance}, indent=2), encoding="utf-8")
+        tmp.write_text(json.dumps({**chosen, **provenance}, indent=2), encoding="utf-8")
     return path
+
+
+def _positive(weight) -> bool:
+    return isinstance(weight, (int, float)) and not isinstance(weight, bool) and 0 < weight < float("inf")

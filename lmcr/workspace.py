@@ -112,6 +112,14 @@ class Workspace:
         return load(self.data_dir)
 
     @property
+    def context_weight(self) -> float:
+        """The context term's weight chosen with the mixture, else the unscaled term's."""
+        from lmcr.context_pmi import WEIGHT
+        from lmcr.mixture import load_context_weight
+
+        return load_context_weight(self.data_dir) or WEIGHT
+
+    @property
     def baselines(self) -> Path:
         """Baseline caches (word2vec trained on the corpus)."""
         return self.data_dir / "baselines"
@@ -137,7 +145,7 @@ class Workspace:
                                db=self.db, sql_dir=self.sql_dir, vectors=Path(vectors) if vectors else self.vectors,
                                conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
                                spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed,
-                               mixture=self.mixture)
+                               mixture=self.mixture, context_weight=self.context_weight)
 
     def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:
         """The SRL parser with this workspace's learned compounds and role priors."""

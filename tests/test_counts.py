@@ -83,12 +83,34 @@ def test_mixture_file_round_trip_and_bad_file(tmp_path):
         load(tmp_path)
 
 
-def test_the_weight_with_the_best_mean_over_the_dev_sets_wins():
-    from lmcr.evaluate.mixture import best_weight
+def test_the_weights_with_the_best_mean_over_the_dev_sets_win():
+    from lmcr.evaluate.mixture import best_choice
 
-    # dev ratings alone: the best Table I; with instructions: the best mean of the two (what the full store gives)
-    assert best_weight({1: {"table1": 0.924}, 3: {"table1": 0.922}}) == 1
-    both = {1: {"table1": 0.924, "instructions": 0.933}, 3: {"table1": 0.922, "instructions": 0.950},
-            10: {"table1": 0.912, "instructions": 0.950}}
-    assert best_weight(both) == 3
-    assert best_weight({1: {"table1": 0.9}, 3: {"table1": 0.9}, 10: {"table1": 0.9}}) == 1  # a tie: the plain pool
+    # dev ratings alone: the best Table I, and no context weight (the rated frames have no context)
+    assert best_choice({1: {"table1": 0.924}, 3: {"table1": 0.922}}) == (1, None)
+    # with instructions: the best mean of the two, over the corpus and context weights together
+    both = {1: {"table1": 0.924, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.933}},
+            3: {"table1": 0.922, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.950}},
+            10: {"table1": 0.912, "instructions": {0.5: 0.950, 1: 0.950, 2: 0.950}}}
+    assert best_choice(both) == (3, 2)
+    # ties: the smaller corpus weight (the plain pool), then the unscaled context term, then the smaller
+    assert best_choice({1: {"table1": 0.9}, 3: {"table1": 0.9}, 10: {"table1": 0.9}}) == (1, None)
+    tied = {1: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}},
+            3: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}}}
+    assert best_choice(tied) == (1, 1)
+    assert best_choice({1: {"table1": 0.9, "instructions": {0.5: 0.95, 2: 0.95}}}) == (1, 0.5)
+
+
+def test_the_context_weight_round_trips_in_the_mixture_file(tmp_path):
+    from lmcr.mixture import load_context_weight
+
+    assert load_context_weight(tmp_path) is None  # nothing chosen: the unscaled term
+    save(tmp_path, Mixture.of({"household": 3}), {}, context_weight=2.0)
+    assert (load(tmp_path), load_context_weight(tmp_path)) == (Mixture.of({"household": 3}), 2.0)
+    save(tmp_path, Mixture.of({"household": 3}), {})  # chosen on rated frames alone: none
+    assert load_context_weight(tmp_path) is None
+    for bad in ('{"weights": {}, "context_weight": 0}', '{"weights": {}, "context_weight": "2"}',
+                '{"weights": {}, "context_weight": true}', '[1, 2]', '{"weights"'):
+        (tmp_path / "mixture.json").write_text(bad)
+        with pytest.raises(MixtureError, match="mixture.json: (context_weight must be|not a mixture file)"):
+            load_context_weight(tmp_path)

@@ -127,6 +127,8 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on both dev sets
     assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == COMPLETION_METHOD
     assert set(chosen["accuracy"]["1"]) == {"table1", "instructions"} and chosen["instructions_sha256"]
+    # with the context term's weight, chosen on the instructions at the same time
+    assert set(chosen["accuracy"]["1"]["instructions"]) == {"0.5", "1", "2"} and chosen["context_weight"] in (0.5, 1, 2)
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
     assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
     # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.
@@ -134,6 +136,7 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
                                                    "pour", "rub", "season", "sprinkle"}
     report = (tmp_path / "report" / "report.md").read_text(encoding="utf-8")
     assert "**Sample data.**" in report and "## Provenance" in report and "sample_ratings_mturk.csv" in report
+    assert f"weight of the context term in completion: {chosen['context_weight']:g}" in report
     assert "Checkpoint sentence-all: `v" in report and "paper " not in report.split("## Fig. 4A")[0]
     page = (tmp_path / "report" / "report.html").read_text(encoding="utf-8")
     assert '<div class="scroll"><table>' in page and "<blockquote>" in page and page.count("data:image/png") == 4

@@ -108,7 +108,9 @@ def provenance_markdown(provenance: dict) -> list[str]:
              f"on {provenance['machine']}."]
     lines += [f"- Ratings `{f['file']}` sha256 `{f['sha256'][:16]}`" for f in provenance["ratings"]]
     if "mixture" in provenance:
-        lines.append(f"- Corpus mixture of the bare method names: {provenance['mixture']} (`lmcr mixture`)")
+        lines.append(f"- Corpus mixture of the bare method names: {provenance['mixture']}; weight of the context term "
+                     f"in completion: {provenance.get('context_weight', 1):g} (`lmcr mixture`; the rated frames have "
+                     "no context)")
     lines += [f"- Checkpoint {c['setting']}: `{c['version']}`, manifest sha256 `{c['manifest_sha256'][:16]}`"
               for c in provenance["checkpoints"]]
     corpus = provenance["corpus"]

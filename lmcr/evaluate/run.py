@@ -135,6 +135,6 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     evaluated = [m for m in methods if m in scores], [s for s in settings if s in scores]
     origin = ({**provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res)),
-               "mixture": res.mixture.label} if ratings_source is not None else {})
+               "mixture": res.mixture.label, "context_weight": res.context_weight} if ratings_source is not None else {})
     write_report(results, *evaluated, out_dir, notes, origin, published)
     return results
