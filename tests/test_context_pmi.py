@@ -109,3 +109,15 @@ def test_a_chosen_context_weight_scales_the_term_and_names_its_calibration(store
     assert Workspace.from_env().resources().context_weight == WEIGHT
     save(tmp_path, Mixture.of({"household": 3}), {}, context_weight=0.5)
     assert Workspace.from_env().resources().context_weight == 0.5
+
+
+def test_a_sentence_is_keyed_by_its_source_too(tmp_path):
+    """Document ids are unique within a source: two sources' "doc 1, sentence 0" are two sentences."""
+    db, sql_dir = tmp_path / "lmcr.duckdb", Workspace.from_env().sql_dir
+    con = connect(db, sql_dir)
+    con.executemany("insert into sentences values ('recipes', ?, '1', 0, 'instruction', ?, 3, 'f', 0, null, null)",
+                    [("web:a", "boil the water"), ("web:b", "wash the pot")])
+    con.close()
+    counts = ContextCooccurrence.count(db, sql_dir, ["pot", "water"], {"all": 1.0}, min_sentences=1)
+    assert counts.sentences == 2 and "boil" not in counts.pair_sentences["pot"]
+    assert counts.pair_sentences["water"]["boil"] == 1

@@ -4,18 +4,19 @@
 -- pot"), where a whole recipe names every tool it uses for every purpose.
 -- $phrases: a regex alternation of escaped, lowercase object phrases (longest first; the last word may
 -- take -s or -es); $corpus: a corpus or 'all'; $min_sentences: words in fewer sentences are left out.
+-- A sentence is (corpus, source, doc_id, sent_id): a document id is unique within its source.
 -- Rows: (kind, object, word, n) with kind 'sentences' (n sentences), 'word', 'object' or 'pair'.
 with units as (
-    select corpus, doc_id, sent_id, lower(text) as t
+    select corpus, source, doc_id, sent_id, lower(text) as t
     from sentences
     where $corpus = 'all' or corpus = $corpus
 ),
 words as (
-    select corpus, doc_id, sent_id, unnest(list_distinct(regexp_extract_all(t, '[a-z]+(?:''[a-z]+)?'))) as word
+    select corpus, source, doc_id, sent_id, unnest(list_distinct(regexp_extract_all(t, '[a-z]+(?:''[a-z]+)?'))) as word
     from units
 ),
 objects as (
-    select corpus, doc_id, sent_id, unnest(list_distinct(regexp_extract_all(t, '\b(' || $phrases || ')(?:s|es)?\b', 1))) as object
+    select corpus, source, doc_id, sent_id, unnest(list_distinct(regexp_extract_all(t, '\b(' || $phrases || ')(?:s|es)?\b', 1))) as object
     from units
 ),
 word_sentences as (
@@ -28,6 +29,6 @@ union all
 select 'object', object, null, count(*) from objects group by object
 union all
 select 'pair', o.object, w.word, count(*)
-from objects o join words w using (corpus, doc_id, sent_id) semi join word_sentences using (word)
+from objects o join words w using (corpus, source, doc_id, sent_id) semi join word_sentences using (word)
 group by all
 order by all
