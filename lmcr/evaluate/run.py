@@ -37,8 +37,9 @@ DEVIATIONS = [
     "the closest stand-in for the API's relatedness offline.",
     "Corpus mixture: the household narrations (EPIC-KITCHENS, VirtualHome) are about 1% of the text; "
     "'@household=w' makes them count w times in the pooled setting (frame counts weighted, the LMs "
-    "interpolated with the household LM at its share of the weighted words), w chosen on rated frames by "
-    "`lmcr mixture`; a bare method name uses the chosen mixture (see provenance).",
+    "interpolated with the household LM at its share of the weighted words), w chosen on the rated frames "
+    "(and dev instructions, with the context term's weight) by `lmcr mixture`; a bare method name uses the "
+    "chosen mixture (see provenance).",
     "The paper: Chen, Tan, Kuntz, Bansal, Alterovitz, Enabling Robots to Understand Incomplete Natural "
     "Language Instructions Using Commonsense Reasoning, ICRA 2020. Its Table I is read from its LaTeX source "
     "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
@@ -49,7 +50,8 @@ DEVIATIONS = [
     "(similarity-based smoothing, lmcr/similar_verbs.py). 'a+b' sums two methods' log-probabilities "
     f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
     "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); context_pmi is the term "
-    "that weighs what an instruction's purpose says of each filler (lmcr/context_pmi.py), 0 on the rated "
+    "that weighs what an instruction's purpose says of each filler, learned from the sentences that name "
+    "both (lmcr/context_pmi.py), 0 on the rated "
     "frames, which have no context; "
     f"{COMPLETION_METHOD} is what `lmcr complete` uses by default.",
 ]
