@@ -21,7 +21,7 @@ from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.lexicon import is_object_name
 from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
-from lmcr.srl.context import antecedents, utterance_context
+from lmcr.srl.context import antecedents, served_in, utterance_context
 from lmcr.srl.frames import FrameMention
 from lmcr.srl.parser import FrameParser, read_instruction
 
@@ -84,6 +84,18 @@ def _referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str
     return referred
 
 
+def _served(parser: FrameParser, doc, frame: FrameMention, detected: list[str], taken: dict[str, str]) -> dict[str, str]:
+    """The open role a vessel is poured into, filled with the vessel the request serves in ("pour me a
+    glass of water": Destination glass) when a detected object names it and no role states it."""
+    vessel = served_in(doc, frame, parser.lex)
+    obj = vessel and _grounded(vessel, set(detected))
+    if not obj or obj in frame.roles.values() or obj in taken.values():
+        return {}
+    template = parser.lex.predicates[frame.predicate].sentence
+    into = [r for r, v in frame.roles.items() if v is None and r not in taken and f"into the {{{r}}}" in template]
+    return {into[0]: obj} if into else {}
+
+
 def _ground(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) \
         -> tuple[dict[str, str | None], dict[str, str]]:
     """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
@@ -118,8 +130,10 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     detected = list(dict.fromkeys(" ".join(o.split()).lower() for o in objects if o and o.strip()))
     pronouns = parser.lex.object_pronouns
     referred = _referents(parser, doc, frame, detected)
+    # "pour me a glass of water": the person asked for the glass as well as the water
+    served = _served(parser, doc, frame, detected, referred)
     # "pour it": who knows what, unless "it" points back to an object named before ("some wine")
-    roles = {r: referred.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
+    roles = {r: referred.get(r) or served.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
     roles, unresolved = _ground(roles, parser.lex.objects, detected)
@@ -136,7 +150,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     unfamiliar = [o for o in outside if o not in ignored]
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "referred": referred, "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
+                "referred": referred, "served": served, "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
                 "question": None, "context": context}
     pool = [o for o in detected if o not in stated and o not in ignored]
     if len(pool) < len(missing):
@@ -166,7 +180,7 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
         if unresolved:
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "referred": referred, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
+            "missing_roles": missing, "referred": referred, "served": served, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
             "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context}
 
 

@@ -45,7 +45,7 @@ def test_close_candidates_give_a_question_naming_them(parser):
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "referred": {}, "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
+                   "missing": None, "missing_roles": [], "referred": {}, "served": {}, "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
                    "question": None, "context": ""}
 
 
@@ -72,6 +72,18 @@ def test_a_pronoun_refers_back_to_a_detected_object_named_before_it(parser):
     assert unseen["referred"] == {} and unseen["missing_roles"] == ["Theme", "Destination"]  # no juice: the scene decides
     plain = complete(parser, scorer, "pour it into the cup", ["wine", "water", "cup"])
     assert plain["referred"] == {} and plain["frame"]["roles"]["Theme"] == "water"
+
+
+def test_the_vessel_a_request_serves_in_is_where_it_goes(parser):
+    out = complete(parser, scorer, "could you pour me a glass of water?", ["pot", "bowl", "glass", "water"])
+    assert out["served"] == {"Destination": "glass"} and out["missing"] is None
+    assert out["frame"]["roles"] == {"Theme": "water", "Destination": "glass"} and out["question"] is None
+    unseen = complete(parser, scorer, "pour me a glass of water", ["pot", "bowl", "cup"])  # no glass: the scene decides
+    assert unseen["served"] == {} and unseen["missing"] == "Destination"
+    measured = complete(parser, scorer, "pour me half a cup of milk", ["cup", "bowl", "pot"])  # a quantity
+    assert measured["served"] == {} and measured["missing"] == "Destination"
+    stated = complete(parser, scorer, "pour me a glass of water into the pot", ["pot", "glass"])
+    assert stated["served"] == {} and stated["frame"]["roles"]["Destination"] == "pot"
 
 
 def test_a_stated_object_that_is_detected_grounds_without_the_robot_vocabulary(parser):

@@ -4,7 +4,7 @@ request or the frame itself, and that context reaches only the scorers that read
 from __future__ import annotations
 
 from lmcr.lexicon import load_lexicon
-from lmcr.srl.context import antecedents, utterance_context
+from lmcr.srl.context import antecedents, served_in, utterance_context
 from lmcr.srl.frames import FrameMention
 from tests.srl_docs import make_doc
 
@@ -111,3 +111,18 @@ def test_an_antecedent_is_a_verbs_argument_before_a_prepositions_and_never_the_f
                    "heat/VB/conj/0 some/DT/det/9 oil/NN/dobj/7 in/IN/prep/7 it/PRP/pobj/10")
     heat = mention(doc, 7, {"Theme": 9, "Instrument": 11})
     assert antecedents(doc, heat, "Instrument", load_lexicon()) == ["pan", "sink"]  # not the oil: the frame's Theme
+
+
+def test_a_request_that_serves_someone_names_the_vessel_as_its_measure():
+    doc = make_doc("pour/VB/ROOT/0 me/PRP/dative/0 a/DT/det/3 glass/NN/dobj/0 of/IN/prep/3 water/NN/pobj/4")
+    assert served_in(doc, mention(doc, 0, {"Theme": 5, "Destination": None}), load_lexicon()) == "glass"
+    doc = make_doc("pour/VB/ROOT/0 me/PRP/dobj/0 the/DT/det/3 mugs/NNS/dobj/0/mug of/IN/prep/3 tea/NN/pobj/4")
+    assert served_in(doc, mention(doc, 0, {"Theme": 5, "Destination": None}), load_lexicon()) is None  # mugs: counted
+    for spec in ("pour/VB/ROOT/0 a/DT/det/2 cup/NN/dobj/0 of/IN/prep/2 milk/NN/pobj/3",  # nobody served
+                 "pour/VB/ROOT/0 me/PRP/dobj/0 half/PDT/predet/4 a/DT/det/4 cup/NN/dobj/0 of/IN/prep/4 milk/NN/pobj/5",
+                 "pour/VB/ROOT/0 me/PRP/dative/0 two/CD/nummod/3 cup/NN/dobj/0 of/IN/prep/3 tea/NN/pobj/4",
+                 "pour/VB/ROOT/0 me/PRP/dative/0 a/DT/det/3 lot/NN/dobj/0 of/IN/prep/3 tea/NN/pobj/4",  # no measure
+                 "pour/VB/ROOT/0 me/PRP/dative/0 some/DT/det/3 water/NN/dobj/0"):
+        doc = make_doc(spec)
+        theme = next(t.i for t in doc if t.dep_ == "pobj" or t.lower_ == "water")
+        assert served_in(doc, mention(doc, 0, {"Theme": theme, "Destination": None}), load_lexicon()) is None, spec

@@ -6,7 +6,9 @@ request around the predicate ("could you", "I need you to", "go ahead and", "ple
 context only when it holds a content word: "for me" or "a little" leave the instruction as it was.
 
 A pronoun role may point back to a thing named before it ("I'd love some wine, could you pour it?",
-"take the strawberries and dip them in the chocolate"): `antecedents` lists what it may refer to.
+"take the strawberries and dip them in the chocolate"): `antecedents` lists what it may refer to. A
+request that serves someone may name the vessel as the measure of what it serves ("pour me a glass of
+water"): `served_in` finds it.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from lmcr.lexicon import Lexicon
 from lmcr.srl.arguments import NOUN_TAGS, argument_value
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.frames import FrameMention
+from lmcr.srl.lemmas import lemma as lemma_of
 
 CONTENT_TAGS = ("NN", "VB", "JJ")  # nouns, verbs, adjectives (Penn tags: hand-built Docs have no POS)
 CLAUSE_BREAKS = frozenset({",", ";", ":", ".", "!", "?"})
@@ -122,3 +125,27 @@ def antecedents(doc: Doc, mention: FrameMention, role: str, lex: Lexicon, compou
         if value is not None:
             found.append((token.dep_ == "pobj", -token.i, value[0]))
     return list(dict.fromkeys(name for *_, name in sorted(found)))
+
+
+# Dependents of a measure noun that count or divide it ("two glasses", "half a cup"): then it is a quantity.
+COUNTING_DEPS = frozenset({"nummod", "predet", "quantmod"})
+
+
+def served_in(doc: Doc, mention: FrameMention, lex: Lexicon) -> str | None:
+    """The vessel a request serves its Theme in, named as its measure: "pour me a glass of water" ->
+    "glass"; None otherwise. English grammar, not knowledge of things: the verb has two objects, a
+    personal pronoun (the person served) and one uncounted measure noun with an of-phrase (the parser
+    gives its role to the of-phrase, "water"). A measure alone is a quantity ("pour a cup of milk into
+    the batter", "pour me half a cup of milk", "pour us two glasses of wine")."""
+    predicate = _predicate(doc, mention)
+    if predicate is None:
+        return None
+    objects = [c for c in predicate.children if c.dep_ in ("dative", "dobj")]
+    if len(objects) != 2 or objects[0].tag_ != "PRP":
+        return None
+    measure = objects[1]
+    counted = any(c.dep_ in COUNTING_DEPS for c in measure.children)
+    has_of = any(c.dep_ == "prep" and c.lower_ == "of" for c in measure.children)
+    if measure.tag_ != "NN" or counted or not has_of or lemma_of(measure) not in lex.measure_nouns:
+        return None
+    return lemma_of(measure)
