@@ -65,6 +65,7 @@ class Lexicon:
     quantity_nouns: frozenset[str]
     object_pronouns: frozenset[str]
     recipient_pronouns: frozenset[str]
+    courtesy_words: frozenset[str] = frozenset()  # "please": closes a request, never part of a name
     objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
 
 
@@ -85,4 +86,5 @@ def load_lexicon(path: str | None = None) -> Lexicon:
         predicates=predicates, measure_nouns=frozenset(data["measure_nouns"]),
         quantity_nouns=frozenset(data["quantity_nouns"]), object_pronouns=frozenset(data["object_pronouns"]),
         recipient_pronouns=frozenset(data["recipient_pronouns"]), objects=tuple(data.get("objects", ())),
+        courtesy_words=frozenset(data.get("courtesy_words", ())),
     )

@@ -102,6 +102,15 @@ def test_a_counted_measure_is_no_part_of_a_name(before, expected):
     assert frames(loaf) == [("pour", {"Theme": None, "Destination": "loaf pan"})]
 
 
+def test_a_closing_please_is_no_part_of_a_name():
+    """The small tagger reads a last 'please' as the noun a compound ends in ("coffee/compound please/pobj")."""
+    doc = "pour/VB/ROOT/0 me/PRP/dative/0 a/DT/det/3 mug/NN/dobj/0 of/IN/prep/3 coffee/NN/compound/6 please/NN/pobj/4"
+    assert frames(doc) == [("pour", {"Theme": "coffee", "Destination": None})]
+    doc = "blend/VB/ROOT/0 the/DT/det/3 soup/NN/compound/3 please/NN/dobj/0"
+    assert frames(doc) == [("blend", {"Theme": "soup", "Destination": None})]
+    assert frames("heat/VB/ROOT/0 the/DT/det/2 please/NN/dobj/0") == [("heat", {"Theme": None, "Instrument": None})]
+
+
 def test_passive_subject_is_the_theme():
     doc = ("the/DT/det/1 steak/NN/nsubjpass/4 should/MD/aux/4 be/VB/auxpass/4 seasoned/VBN/ROOT/4/season "
            "with/IN/prep/4 salt/NN/pobj/5")

@@ -83,6 +83,10 @@ def _singular(token: Token) -> str:
 def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = None) -> tuple[str, int, int] | None:
     """(value, start_char, end_char) of the argument headed by `token`, or None if it names nothing."""
     head = resolve_head(token, lex)
+    if head is not None and head.lower_ in lex.courtesy_words:
+        # "a mug of coffee please" read as a compound ending in please: the name ends before it
+        before = head.doc[head.i - 1] if head.i else None
+        head = before if before is not None and before.head.i == head.i and before.dep_ in ("compound", "amod") else None
     if head is None:
         return None
     if head.tag_ == "PRP" or head.lower_ in lex.object_pronouns:

@@ -134,14 +134,14 @@ COUNTING_DEPS = frozenset({"nummod", "predet", "quantmod"})
 def served_in(doc: Doc, mention: FrameMention, lex: Lexicon) -> str | None:
     """The vessel a request serves its Theme in, named as its measure: "pour me a glass of water" ->
     "glass"; None otherwise. English grammar, not knowledge of things: the verb has two objects, a
-    personal pronoun (the person served) and one uncounted measure noun with an of-phrase (the parser
+    recipient pronoun (the person served) and one uncounted measure noun with an of-phrase (the parser
     gives its role to the of-phrase, "water"). A measure alone is a quantity ("pour a cup of milk into
     the batter", "pour me half a cup of milk", "pour us two glasses of wine")."""
     predicate = _predicate(doc, mention)
     if predicate is None:
         return None
     objects = [c for c in predicate.children if c.dep_ in ("dative", "dobj")]
-    if len(objects) != 2 or objects[0].tag_ != "PRP":
+    if len(objects) != 2 or objects[0].lower_ not in lex.recipient_pronouns:
         return None
     measure = objects[1]
     counted = any(c.dep_ in COUNTING_DEPS for c in measure.children)
