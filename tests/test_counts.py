@@ -101,6 +101,27 @@ def test_the_weights_with_the_best_mean_over_the_dev_sets_win():
     assert best_choice({1: {"table1": 0.9, "instructions": {0.5: 0.95, 2: 0.95}}}) == (1, 0.5)
 
 
+def test_the_context_weights_share_one_scoring_of_each_candidate_set(monkeypatch, tmp_path):
+    """The grid scores the rest of the method and the unscaled term once per (frames, context)."""
+    from lmcr.evaluate import mixture as choosing
+    from lmcr.frame import Frame
+    from lmcr.methods import MethodResources
+
+    calls = []
+
+    def stand_in(method, res):
+        assert method == "context_pmi" and res.context_weight == 1 or method == "sentence_lm+rarity"
+        return lambda frames, context="": calls.append(method) or [0.5 if method == "context_pmi" else 1.0] * len(frames)
+
+    monkeypatch.setattr(choosing, "make_scorer", stand_in)
+    at = choosing._context_weighted("sentence_lm+rarity+context_pmi", MethodResources(checkpoints=tmp_path))
+    frames = [Frame.of("pour", {"Theme": "water", "Destination": d}) for d in ("cup", "pot")]
+    assert at(2.0)(frames, "for my tea") == [2.0, 2.0] and at(0.5)(frames, "for my tea") == [1.25, 1.25]
+    assert calls == ["sentence_lm+rarity", "context_pmi"]  # once each, for both weights
+    at(1.0)(frames[:1], "for my tea")
+    assert len(calls) == 4  # another candidate set is scored afresh
+
+
 def test_the_context_weight_round_trips_in_the_mixture_file(tmp_path):
     from lmcr.mixture import load_context_weight
 

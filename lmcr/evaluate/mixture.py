@@ -52,14 +52,15 @@ def choose_mixture(rated: list[RatedFrame], res: MethodResources, method: str, c
     context_grid = CONTEXT_GRID if instructions is not None and "context_pmi" in method.split("+") else ()
     for weight in sorted(grid):
         mixed = replace(res, corpus="all", mixture=Mixture.of({corpus: weight}))
-        scores = score_rated(rated, {method: make_scorer(method, mixed)})
+        scorer_at = _context_weighted(method, mixed)
+        scores = score_rated(rated, {method: scorer_at(res.context_weight)})
         accuracy[weight] = {"table1": evaluate(rated, scores, replace(config, lambdas=(), ks=())).table1[method]["all"]}
         line = f"{method} with {corpus} weighted {weight:g}: Table I accuracy {accuracy[weight]['table1']:.3f}"
         if instructions is not None:
             by_context = {}
             for context_weight in context_grid or (res.context_weight,):
                 # the rated frames have no context: this weight changes the instructions alone
-                scorer = make_scorer(method, replace(mixed, context_weight=context_weight))
+                scorer = scorer_at(context_weight)
                 # the best guess decides (a question counts when it proposes the right object): the
                 # completion thresholds, calibrated per mixture later, do not enter
                 done = instruction_accuracy(instructions.parser, scorer, CompletionConfig(), instructions.records)
@@ -70,6 +71,29 @@ def choose_mixture(rated: list[RatedFrame], res: MethodResources, method: str, c
         log(line)
     weight, context_weight = best_choice(accuracy)
     return Mixture.of({corpus: weight}), context_weight if context_grid else None, accuracy
+
+
+def _context_weighted(method: str, res: MethodResources) -> Callable[[float], Callable[..., list[float]]]:
+    """`method`'s scorer at any weight of its context term, from one scoring of each candidate set: the
+    term is linear in its weight, so the rest of the method and the unscaled term are scored once per
+    (frames, context) and kept for the next weight (a method without the term ignores the weight)."""
+    parts = method.split("+")
+    if "context_pmi" not in parts:
+        scorer = make_scorer(method, res)
+        return lambda weight: scorer
+    rest = make_scorer("+".join(p for p in parts if p != "context_pmi"), res)
+    term = make_scorer("context_pmi", replace(res, context_weight=1.0))
+    kept: dict[tuple, tuple[list[float], list[float]]] = {}
+
+    def scored(frames: list, context: str) -> tuple[list[float], list[float]]:
+        key = (tuple(frames), context)
+        if key not in kept:
+            kept[key] = (rest(frames, context), term(frames, context))
+        return kept[key]
+
+    def at(weight: float):
+        return lambda frames, context="": [a + weight * b for a, b in zip(*scored(frames, context))]
+    return at
 
 
 def best_choice(accuracy: dict[float, dict]) -> tuple[float, float | None]:
