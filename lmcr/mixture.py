@@ -99,26 +99,27 @@ def _read(path: Path) -> dict:
         raise MixtureError(f"{path}: not a mixture file ({exc}); run `lmcr mixture` again") from exc
 
 
-def load(data_dir: Path) -> Mixture:
-    """The chosen mixture saved in `data_dir`, plain when none was chosen."""
+def load_choice(data_dir: Path) -> tuple[Mixture, float | None]:
+    """The mixture chosen by `lmcr mixture` and saved in `data_dir`, and the weight of the context term
+    (lmcr/context_pmi.py) chosen with it on the dev instructions: (plain, None) without a file, None for
+    a mixture chosen on rated frames alone. One read for both."""
     path = Path(data_dir) / FILE
     if not path.exists():
-        return Mixture()
+        return Mixture(), None
     data = _read(path)
     try:
-        return Mixture.of(data["weights"])
+        mixture = Mixture.of(data["weights"])
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise MixtureError(f"{path}: not a mixture file ({exc}); run `lmcr mixture` again") from exc
-
-
-def load_context_weight(data_dir: Path) -> float | None:
-    """The weight of the context term (lmcr/context_pmi.py) chosen with the mixture on the dev instructions,
-    None when none was (no file, or a mixture chosen on rated frames alone)."""
-    path = Path(data_dir) / FILE
-    weight = _read(path).get("context_weight") if path.exists() else None
+    weight = data.get("context_weight")
     if weight is not None and not _positive(weight):
         raise MixtureError(f"{path}: context_weight must be a positive number, not {weight!r}; run `lmcr mixture` again")
-    return weight
+    return mixture, weight
+
+
+def load(data_dir: Path) -> Mixture:
+    """The chosen mixture saved in `data_dir`, plain when none was chosen."""
+    return load_choice(data_dir)[0]
 
 
 def save(data_dir: Path, mixture: Mixture, provenance: dict, context_weight: float | None = None) -> Path:

@@ -21,7 +21,6 @@ if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first 
 
     from lmcr.complete import CompletionConfig
     from lmcr.methods import MethodResources, Scorer
-    from lmcr.mixture import Mixture
     from lmcr.speech.recognize import Recognizer
     from lmcr.speech.whisper import WhisperRecognizer
     from lmcr.srl.parser import FrameParser
@@ -105,21 +104,6 @@ class Workspace:
         return self.data_dir / "speech" / "whisper-base"
 
     @property
-    def mixture(self) -> Mixture:
-        """The corpus mixture chosen by `lmcr mixture` (plain when none was chosen)."""
-        from lmcr.mixture import load
-
-        return load(self.data_dir)
-
-    @property
-    def context_weight(self) -> float:
-        """The context term's weight chosen with the mixture, else the unscaled term's."""
-        from lmcr.context_pmi import WEIGHT
-        from lmcr.mixture import load_context_weight
-
-        return load_context_weight(self.data_dir) or WEIGHT
-
-    @property
     def baselines(self) -> Path:
         """Baseline caches (word2vec trained on the corpus)."""
         return self.data_dir / "baselines"
@@ -139,13 +123,16 @@ class Workspace:
     def resources(self, checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
                   conceptnet: str | Path | None = None, seed: int = 0) -> MethodResources:
         """What the scorers are built from; explicit values win over the workspace's."""
+        from lmcr.context_pmi import WEIGHT
         from lmcr.methods import MethodResources
+        from lmcr.mixture import load_choice
 
+        mixture, context_weight = load_choice(self.data_dir)  # chosen together, saved in one file
         return MethodResources(checkpoints=Path(checkpoint) if checkpoint else self.checkpoints, corpus=corpus,
                                db=self.db, sql_dir=self.sql_dir, vectors=Path(vectors) if vectors else self.vectors,
                                conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
                                spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed,
-                               mixture=self.mixture, context_weight=self.context_weight)
+                               mixture=mixture, context_weight=context_weight or WEIGHT)
 
     def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:
         """The SRL parser with this workspace's learned compounds and role priors."""

@@ -123,15 +123,15 @@ def test_the_context_weights_share_one_scoring_of_each_candidate_set(monkeypatch
 
 
 def test_the_context_weight_round_trips_in_the_mixture_file(tmp_path):
-    from lmcr.mixture import load_context_weight
+    from lmcr.mixture import load_choice
 
-    assert load_context_weight(tmp_path) is None  # nothing chosen: the unscaled term
+    assert load_choice(tmp_path)[1] is None  # nothing chosen: the unscaled term
     save(tmp_path, Mixture.of({"household": 3}), {}, context_weight=2.0)
-    assert (load(tmp_path), load_context_weight(tmp_path)) == (Mixture.of({"household": 3}), 2.0)
+    assert (load(tmp_path), load_choice(tmp_path)[1]) == (Mixture.of({"household": 3}), 2.0)
     save(tmp_path, Mixture.of({"household": 3}), {})  # chosen on rated frames alone: none
-    assert load_context_weight(tmp_path) is None
+    assert load_choice(tmp_path)[1] is None
     for bad in ('{"weights": {}, "context_weight": 0}', '{"weights": {}, "context_weight": "2"}',
                 '{"weights": {}, "context_weight": true}', '[1, 2]', '{"weights"'):
         (tmp_path / "mixture.json").write_text(bad)
         with pytest.raises(MixtureError, match="mixture.json: (context_weight must be|not a mixture file)"):
-            load_context_weight(tmp_path)
+            load_choice(tmp_path)

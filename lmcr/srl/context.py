@@ -143,9 +143,7 @@ def served_in(doc: Doc, mention: FrameMention, lex: Lexicon) -> str | None:
     objects = [c for c in predicate.children if c.dep_ in ("dative", "dobj")]
     if len(objects) != 2 or objects[0].lower_ not in lex.recipient_pronouns:
         return None
-    measure = objects[1]
+    measure, name = objects[1], lemma_of(objects[1])
     counted = any(c.dep_ in COUNTING_DEPS for c in measure.children)
     has_of = any(c.dep_ == "prep" and c.lower_ == "of" for c in measure.children)
-    if measure.tag_ != "NN" or counted or not has_of or lemma_of(measure) not in lex.measure_nouns:
-        return None
-    return lemma_of(measure)
+    return name if measure.tag_ == "NN" and not counted and has_of and name in lex.measure_nouns else None
