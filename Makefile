@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 SAMPLE := data/sample
 
-.PHONY: setup demo test bench browser clean speech-audio speech-bench
+.PHONY: setup demo test docs bench browser clean speech-audio speech-bench
 
 setup: $(VENV)/.installed
 
@@ -13,7 +13,7 @@ $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
 	$(BIN)/pip install -q torch==2.13.0
-	$(BIN)/pip install -q -e ".[dev,vectors]"
+	$(BIN)/pip install -q -e ".[dev,vectors,docs]"
 	touch $@
 
 # The main job: the whole pipeline (ingest, frames, train, ratings, evaluation, checkpoints) on the sample.
@@ -24,7 +24,8 @@ demo: setup
 # The browser step may fail (no node, no npm registry): the headless preview test then skips.
 test: setup
 	-$(MAKE) browser
-	$(BIN)/ruff check lmcr flows tests bench
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
+	$(BIN)/ruff check lmcr flows tests bench docs
 	$(BIN)/python -m pytest -q --durations=10
 
 # Headless Chromium from the npm registry (@sparticuz/chromium bundles the binary) for the HIT preview check.
@@ -33,6 +34,11 @@ browser: annotation/browser/node_modules/.installed
 annotation/browser/node_modules/.installed: annotation/browser/package-lock.json
 	cd annotation/browser && npm ci --no-audit --no-fund --loglevel=error
 	touch $@
+
+# The documentation site (mkdocs.yml, docs/): the CLI reference, schema and results pages are generated.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
+	@echo "open build/site/index.html"
 
 bench: setup
 	$(BIN)/python bench/bench_ingest.py

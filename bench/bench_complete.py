@@ -2,6 +2,7 @@
 
 Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm+frame_counts]
        [--corpus all] [--mixture household=30|plain] [--context-weight 1] [--no-context] [--scene-size 40]
+       [--json PATH]
 Uses the store, checkpoints, chosen mixture and context weight of $LMCR_DATA_DIR and the calibration `lmcr evaluate`
 wrote there.
 1. Accuracy: an instruction counts as right when the completed frame is the expected one, with or
@@ -20,6 +21,8 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from record import add_json_option, write_results
+
 from lmcr.complete import complete
 from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
 from lmcr.lexicon import load_lexicon
@@ -28,7 +31,8 @@ from lmcr.mixture import Mixture
 from lmcr.workspace import Workspace
 
 
-def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs: int = 200) -> str:
+def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs: int = 200) -> dict:
+    """Median and p90 milliseconds of one completion of `instruction` among `n_objects` detected objects."""
     objects = [o for o in load_lexicon().objects if o != "water"][:n_objects]
     for _ in range(20):
         complete(parser, scorer, instruction, objects, config)
@@ -38,8 +42,8 @@ def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs:
         complete(parser, scorer, instruction, objects, config)
         times.append(time.perf_counter() - started)
     times.sort()
-    return (f"latency of {instruction!r} with {len(objects)} objects: median {1000 * statistics.median(times):.2f} ms, "
-            f"p90 {1000 * times[int(0.9 * runs)]:.2f} ms ({runs} runs)")
+    return {"objects": len(objects), "median ms": round(1000 * statistics.median(times), 2),
+            "p90 ms": round(1000 * times[int(0.9 * runs)], 2)}
 
 
 def filled_scene(record: dict, size: int) -> dict:
@@ -59,6 +63,7 @@ def main() -> None:
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
     parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
     parser_.add_argument("--scene-size", type=int, default=0, help="fill each scene with other objects up to this")
+    add_json_option(parser_, "bench_complete")
     args = parser_.parse_args()
     ws = Workspace.from_env()
     res = ws.resources(corpus=args.corpus)
@@ -67,15 +72,25 @@ def main() -> None:
     scorer, config = ws.completion_scorer(args.method, res)
     config = replace(config, context=not args.no_context)
     parser = ws.parser()
-    print(f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
-          f"{f'weight {res.context_weight:g}' if config.context else 'off'}); {config.source}")
+    setting = (f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
+               f"{f'weight {res.context_weight:g}' if config.context else 'off'})")
+    print(f"{setting}; {config.source}")
+    figures = {"method": setting, "instructions file": args.instructions.name, "scene size": args.scene_size or "as given"}
     records = load_instructions(args.instructions)
     if args.scene_size:
         records = [filled_scene(r, args.scene_size) for r in records]
         print(f"scenes filled to {args.scene_size} objects with the robot vocabulary")
-    print(instruction_accuracy(parser, scorer, config, records).summary())
+    accuracy = instruction_accuracy(parser, scorer, config, records)
+    print(accuracy.summary())
+    figures |= {"instructions right": f"{accuracy.right}/{accuracy.total}", "accuracy": round(accuracy.accuracy, 3),
+                "answered right without a question": accuracy.answered_right, "questions asked": accuracy.asked,
+                "questions whose best guess is right": accuracy.asked_right}
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
-        print(latency(parser, scorer, config, instruction, runs=args.runs))
+        took = latency(parser, scorer, config, instruction, runs=args.runs)
+        print(f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
+              f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)")
+        figures |= {f"latency {instruction!r}, {took['objects']} objects: {k}": v for k, v in took.items() if k != "objects"}
+    write_results(args.json, "bench_complete", __doc__.splitlines()[0], figures)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Benchmark: instructions end to end through batch `lmcr execute`: completed right and executed.
 
 Usage: python bench/bench_end_to_end.py --instructions instructions_dev.jsonl [--seed 0] [--work DIR]
-       [--method M] [--urdf PATH] [--distractors N]
+       [--method M] [--urdf PATH] [--distractors N] [--json PATH]
 Each instruction (`{id, instruction, objects, expected, missing}`) gets a seeded random scene of its
 objects (with `--distractors`, N more objects drawn at random from the lexicon: a crowded table, and
 candidates the instruction's author did not weigh); a stated object that is not among them is the one in
@@ -22,6 +22,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from record import add_json_option, write_results
 
 from lmcr.jsonl import read_jsonl
 from lmcr.lexicon import load_lexicon
@@ -64,6 +66,7 @@ def main() -> None:
     args_.add_argument("--method", help="completion method (default: lmcr execute's)")
     args_.add_argument("--urdf", help="the official Baxter URDF instead of the built-in one")
     args_.add_argument("--distractors", type=int, default=0, help="random other objects in each scene")
+    add_json_option(args_, "bench_end_to_end")
     args = args_.parse_args()
     records = [r for _, r in read_jsonl(args.instructions, FIELDS)]
     work = args.work or Path(tempfile.mkdtemp(prefix="lmcr-e2e-"))
@@ -99,6 +102,13 @@ def main() -> None:
         print(f"  {pred:9s} both {c['both']}/{c['n']} (right {c['right']}, succeeded {c['success']}, refused {c['refused']})")
     print("not both right and successful:" if misses else "every instruction right and successful")
     print("\n".join(misses))
+    figures = {"instructions": n, "seed": args.seed, "distractors per scene": args.distractors,
+               "completed right": f"{rows['right']}/{n}", "executed successfully": f"{rows['success']}/{n}",
+               "both": f"{rows['both']}/{n}", "both, share": round(rows["both"] / n, 3),
+               "executed plans that failed": rows["failed"], "refused before moving": rows["refused"],
+               "errors": rows["error"]}
+    figures |= {f"{pred}: both": f"{c['both']}/{c['n']}" for pred, c in sorted(per.items())}
+    write_results(args.json, "bench_end_to_end", __doc__.splitlines()[0], figures)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Benchmark: the Baxter executor on random table layouts, per predicate.
 
 Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill]
-       [--urdf PATH] [--holding]
+       [--urdf PATH] [--holding] [--json PATH]
 For each of the 11 predicates, an incomplete instruction on `--placements` random layouts: the two
 objects the frame needs plus `--distractors` random other objects (obstacles, and other candidates for
 the completion), placed at random with a seed. With `--holding` the stated object starts in the robot's
@@ -20,6 +20,8 @@ import os
 import random
 import statistics
 import time
+
+from record import add_json_option, write_results
 
 from lmcr.executor.execute import execute
 from lmcr.executor.scene import make_scene
@@ -102,6 +104,7 @@ def main() -> None:
     parser_.add_argument("--urdf", help="a Baxter URDF to use instead of the built-in one (LMCR_BAXTER_URDF)")
     parser_.add_argument("--holding", action="store_true",
                          help="the stated object starts in the hand (fill, season: put down first)")
+    add_json_option(parser_, "bench_executor")
     args = parser_.parse_args()
     if args.urdf:
         os.environ["LMCR_BAXTER_URDF"] = args.urdf
@@ -110,7 +113,7 @@ def main() -> None:
     nlp = ws.parser()
     objects = load_lexicon().objects
     times, slowest, reasons, refusals = [], [], collections.Counter(), collections.Counter()
-    totals = collections.Counter()
+    totals, per_predicate = collections.Counter(), {}
     for predicate in args.predicates.split(","):
         instruction, stated, expected, role = TASKS[predicate]
         row = collections.Counter()
@@ -134,6 +137,7 @@ def main() -> None:
                 held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
                 reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
         totals.update(row)
+        per_predicate[f"{predicate}: succeeded"] = f"{row['ok']}/{args.placements}"
         print(f"{predicate:9s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
               f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "
               f"would have chosen another object than {expected!r} {row['other_choice']} times", flush=True)
@@ -146,6 +150,15 @@ def main() -> None:
     print(f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
           f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); slowest: "
           + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(slowest)[::-1][:3]))
+    figures = {"robot": "official Baxter URDF" if args.urdf else "built-in Baxter", "seed": args.seed,
+               "placements per predicate": args.placements, "distractors": args.distractors,
+               "stated object in the hand": args.holding, "succeeded": f"{totals['ok']}/{n}",
+               "success rate": round(totals["ok"] / n, 3),
+               "of executed plans": f"{totals['ok']}/{totals['executed']}", "refused before moving": totals["refused"],
+               "planned afresh after the grasp": totals["replanned"],
+               "plan and execute, median s": round(statistics.median(times), 2),
+               "plan and execute, max s": round(max(times), 2), **per_predicate}
+    write_results(args.json, "bench_executor", __doc__.splitlines()[0], figures)
 
 
 if __name__ == "__main__":

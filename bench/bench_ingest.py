@@ -1,6 +1,6 @@
 """Benchmark: full ingest of the shared corpora into a fresh store, then an unchanged re-run.
 
-Usage: python bench/bench_ingest.py [--shared DIR] [--workers N]
+Usage: python bench/bench_ingest.py [--shared DIR] [--workers N] [--json PATH]
 Prints wall time, sentences/s and words/s for the cold run, and the wall time of the no-op re-run.
 """
 
@@ -11,6 +11,8 @@ import os
 import tempfile
 import time
 from pathlib import Path
+
+from record import add_json_option, write_results
 
 from lmcr.config import REPO_ROOT
 from lmcr.ingest import expand_inputs
@@ -23,7 +25,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared"))
     parser.add_argument("--workers", type=int, default=2)
+    add_json_option(parser, "bench_ingest")
     args = parser.parse_args()
+    figures = {}
     data = args.shared / "data"
     with tempfile.TemporaryDirectory() as tmp:
         paths = Workspace.from_env(data_dir=tmp)
@@ -38,10 +42,15 @@ def main() -> None:
         warm = time.perf_counter() - started
         for row in corpus_summary(con, paths.sql_dir):
             print(" ".join(f"{k}={v}" for k, v in row.items()))
+            figures |= {f"corpus {row['corpus']}: {k}": v for k, v in row.items() if k != "corpus"}
     sentences, words = sum(s.sentences for s in loaded), sum(s.words for s in loaded)
     print(f"cold ingest: {cold:.1f}s wall, {sentences / cold:,.0f} sentences/s, {words / cold:,.0f} words/s "
           f"({len(loaded)} sources, {args.workers} workers)")
     print(f"unchanged re-run: {warm:.2f}s wall ({cold / warm:.0f}x faster than cold)")
+    figures = {"sources": len(loaded), "workers": args.workers, "cold ingest s": round(cold, 1),
+               "sentences/s": round(sentences / cold), "words/s": round(words / cold),
+               "unchanged re-run s": round(warm, 2), **figures}
+    write_results(args.json, "bench_ingest", __doc__.splitlines()[0], figures)
 
 
 if __name__ == "__main__":

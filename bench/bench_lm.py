@@ -1,6 +1,7 @@
 """Benchmark: LMCR's LM training vs the PyTorch word_language_model example configuration, and scoring.
 
 Usage: python bench/bench_lm.py [--db STORE] [--tokens N] [--checkpoint DIR ...] [--ratings CSV] [--skip-training]
+       [--json PATH]
 1. Both trainers get the same recipe sentences (first N training tokens, same vocabulary, same
    held-out documents) on this machine: the reference for one epoch, ours epoch by epoch until its
    validation perplexity is at least as good (at most --max-epochs). The reference is the example's default
@@ -23,6 +24,7 @@ from pathlib import Path
 
 import duckdb
 import torch
+from record import add_json_option, write_results
 from scipy.stats import spearmanr
 from torch import nn
 
@@ -91,7 +93,8 @@ def example_val_ppl(model: ExampleLM, val: list[list[int]], vocab: int) -> float
     return math.exp(total / count)
 
 
-def scoring_speed(path: Path) -> str:
+def scoring_speed(path: Path) -> dict:
+    """Candidate frames per second of a checkpoint over every predicate x ordered object pair."""
     scorer = LMScorer(ckpt.load(path))
     lex = load_lexicon()
     frames = [(verb, dict(zip(spec.roles, pair))) for verb, spec in lex.predicates.items()
@@ -100,40 +103,30 @@ def scoring_speed(path: Path) -> str:
     started = time.perf_counter()
     scorer.score_frames(frames)
     wall = time.perf_counter() - started
-    return f"scoring {scorer.checkpoint.path.parent.name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s"
+    name = scorer.checkpoint.path.parent.name
+    print(f"scoring {name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s")
+    return {f"scoring {name}: frames": len(frames), f"scoring {name}: s": round(wall, 2),
+            f"scoring {name}: frames/s": round(len(frames) / wall)}
 
 
-def normalisation_check(path: Path, ratings_csv: Path) -> str:
+def normalisation_check(path: Path, ratings_csv: Path) -> dict:
     """Spearman correlation of each normalisation's scores with the mean crowd rating."""
     scorer = LMScorer(ckpt.load(path))
     rated = load_ratings(ratings_csv, Workspace.from_env().sql_dir)  # the store's validation and aggregation
     means = [r.mean for r in rated]
-    parts = []
+    name, rhos = scorer.checkpoint.path.parent.name, {}
     for norm in ("sum", "mean"):
-        rho = spearmanr(scorer.score_frames([r.frame for r in rated], norm=norm), means).statistic
-        parts.append(f"{norm}: rho={rho:.3f}")
-    return f"{scorer.checkpoint.path.parent.name} on {len(rated)} rated dev frames: " + ", ".join(parts)
+        rhos[norm] = spearmanr(scorer.score_frames([r.frame for r in rated], norm=norm), means).statistic
+    print(f"{name} on {len(rated)} rated dev frames: " + ", ".join(f"{k}: rho={v:.3f}" for k, v in rhos.items()))
+    return {f"{name}: Spearman rho with the mean rating, {k} ({len(rated)} frames)": round(v, 3) for k, v in rhos.items()}
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--db", type=Path, default=None)
-    parser.add_argument("--tokens", type=int, default=1_000_000)
-    parser.add_argument("--checkpoint", type=Path, action="append", default=[])
-    parser.add_argument("--ratings", type=Path, default=None, help="dev ratings (MTurk CSV) for the normalisation check")
-    parser.add_argument("--skip-training", action="store_true")
-    parser.add_argument("--max-epochs", type=int, default=3, help="epochs ours may take to reach the reference's ppl")
-    args = parser.parse_args()
-    for path in args.checkpoint:
-        print(scoring_speed(path))
-        if args.ratings:
-            print(normalisation_check(path, args.ratings))
-    if args.skip_training:
-        return
-    paths = Workspace.from_env(db=args.db)
+def training_speed(db: Path | None, tokens: int, max_epochs: int) -> dict:
+    """The reference trainer for one epoch, ours until it reaches the reference's perplexity."""
+    paths = Workspace.from_env(db=db)
     con = duckdb.connect(str(paths.db), read_only=True)
     text = training_text(con, "sentence", "recipes")
-    train, budget = [], args.tokens
+    train, budget = [], tokens
     for seq in text.train:
         if budget <= 0:
             break
@@ -160,12 +153,38 @@ def main() -> None:
 
     # Ours trains until it matches the reference's perplexity (or --max-epochs): the speed claim is
     # tokens/s at equal or better perplexity, and the time to get there is printed beside it.
-    history = train_lm(model, train_ids, val_ids, TrainConfig(max_epochs=args.max_epochs, target_ppl=ref_ppl, max_minutes=None), show)
+    history = train_lm(model, train_ids, val_ids, TrainConfig(max_epochs=max_epochs, target_ppl=ref_ppl, max_minutes=None), show)
     speed = sum(h["tokens_per_s"] * h["seconds"] for h in history) / seconds
     reached = history[-1]["val_ppl"] <= ref_ppl
     print(f"speed ratio {speed / ref_speed:.2f}x tokens/s; val ppl {history[-1]['val_ppl']:.1f} vs {ref_ppl:.1f} "
           f"{'reached' if reached else 'NOT reached'} after {len(history)} epoch(s), {seconds:.0f}s vs the "
           f"reference's {ref_seconds:.0f}s ({stream.numel():,} tokens, vocabulary {len(vocab):,})")
+    return {"training tokens": stream.numel(), "vocabulary": len(vocab),
+            "reference tokens/s": round(ref_speed), "reference val ppl after 1 epoch": round(ref_ppl, 1),
+            "lmcr tokens/s": round(speed), "lmcr val ppl": round(history[-1]["val_ppl"], 1),
+            "lmcr epochs": len(history), "speed ratio": round(speed / ref_speed, 2), "reference ppl reached": reached,
+            "lmcr precision": history[-1]["precision"]}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--db", type=Path, default=None)
+    parser.add_argument("--tokens", type=int, default=1_000_000)
+    parser.add_argument("--checkpoint", type=Path, action="append", default=[])
+    parser.add_argument("--ratings", type=Path, default=None, help="dev ratings (MTurk CSV) for the normalisation check")
+    parser.add_argument("--skip-training", action="store_true")
+    parser.add_argument("--max-epochs", type=int, default=3, help="epochs ours may take to reach the reference's ppl")
+    add_json_option(parser, "bench_lm")
+    args = parser.parse_args()
+    figures = {}
+    for path in args.checkpoint:
+        figures |= scoring_speed(path)
+        if args.ratings:
+            figures |= normalisation_check(path, args.ratings)
+    if not args.skip_training:
+        figures |= training_speed(args.db, args.tokens, args.max_epochs)
+    write_results(args.json, "bench_lm", __doc__.splitlines()[0], figures)
+
 
 if __name__ == "__main__":
     main()

@@ -12,12 +12,12 @@ from pathlib import Path
 
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
-from prefect.cache_policies import TASK_SOURCE, CacheKeyFnPolicy
+from prefect.cache_policies import NO_CACHE
 
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
-from lmcr.files import file_sha256
+from lmcr.files import cached_json, file_sha256
 from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
 from lmcr.methods import COMPLETION_METHOD, EVALUATED, MethodResources
@@ -26,10 +26,10 @@ from lmcr.store import read_connection
 from lmcr.workspace import Workspace
 
 
-def evaluation_key(context, parameters: dict) -> str:
+def evaluation_key(parameters: dict) -> str:
     """Cache key of an evaluation: the LM versions in use, the ratings (the store's rating files or the
-    CSV's content), the frame builds (frame_counts), the parameters, and whether the report is still
-    there (a deleted report is written again)."""
+    CSV's content), the frame builds (frame_counts), the parameters, this flow's source, and whether the
+    report is still there (a deleted report is written again)."""
     res: MethodResources = parameters["res"]
     versions = [str(ckpt.resolve(p.parent)) for p in sorted(Path(res.checkpoints).glob("*/LATEST"))]
     ratings = Path(parameters["ratings"])
@@ -43,19 +43,29 @@ def evaluation_key(context, parameters: dict) -> str:
         with read_connection(res.db) as con:
             frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()
     report_there = (Path(parameters["out"]) / "report.md").exists()
-    blob = json.dumps([versions, rating_files, frames, report_there, parameters], default=str, sort_keys=True)
+    blob = json.dumps([versions, rating_files, frames, report_there, file_sha256(Path(__file__)), parameters],
+                      default=str, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
-@task(name="evaluate", retries=0, persist_result=True,
-      cache_policy=TASK_SOURCE + CacheKeyFnPolicy(cache_key_fn=evaluation_key))
+@task(name="evaluate", retries=0, cache_policy=NO_CACHE)  # its own JSON cache, below
 def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
-                  per_verb: int, seed: int, ws: Workspace) -> dict:
-    """Table I and Fig. 4 on the ratings; completion of the LM methods calibrated into the workspace."""
-    rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-    results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
-                             ws.calibration, log=get_run_logger().info, ratings_source=Path(ratings), paper=ws.paper)
-    return results.to_json()
+                  per_verb: int, seed: int, ws: Workspace, optional: list[str] | None = None) -> dict:
+    """Table I and Fig. 4 on the ratings; completion of the LM methods calibrated into the workspace. The
+    result is cached as plain JSON in the workspace (`cache/evaluate-KEY.json`, read with `json` alone:
+    nothing in it can run code), so an unchanged re-run returns the same without evaluating."""
+    key = evaluation_key({"ratings": ratings, "out": out, "methods": methods, "settings": settings, "res": res,
+                          "per_verb": per_verb, "seed": seed, "optional": optional})
+
+    def evaluate() -> dict:
+        rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
+        results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
+                                 ws.calibration, log=get_run_logger().info, ratings_source=Path(ratings),
+                                 paper=ws.paper, optional=optional or ())
+        return json.loads(json.dumps(results.to_json()))  # as a cached run reads it back
+
+    usable = lambda saved: isinstance(saved, dict) and isinstance(saved.get("table1"), dict)  # noqa: E731
+    return cached_json(ws.data_dir / "cache" / f"evaluate-{key}.json", usable, evaluate)
 
 
 @task(name="choose-mixture")
@@ -75,8 +85,8 @@ def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions
 def evaluate_flow(
     ratings: str | None = None,
     out: str | None = None,
-    methods: list[str] = list(EVALUATED),  # noqa: B006 - Prefect parameters must be JSON
-    settings: list[str] = list(SETTINGS),  # noqa: B006
+    methods: list[str] | None = None,
+    settings: list[str] | None = None,
     conceptnet: str | None = None,
     vectors: str | None = None,
     per_verb: int = EvalConfig.per_verb,
@@ -91,7 +101,12 @@ def evaluate_flow(
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods. With `mixture`
     and a household sentence LM published, the household weight is chosen on the same ratings first
     (and on `instructions`, a JSONL of instructions in scenes, when given), so the default completion is
-    evaluated and calibrated under it."""
+    evaluated and calibrated under it. `methods` and `settings` default to every method (EVALUATED) and LM
+    setting; a default that cannot be built (a setting not trained) is skipped with a note, while one given
+    explicitly must build."""
+    optional = [*(EVALUATED if methods is None else ()), *(SETTINGS if settings is None else ())]
+    methods = list(EVALUATED) if methods is None else methods
+    settings = list(SETTINGS) if settings is None else settings
     ws = Workspace.from_env(data_dir=data_dir)
     if paper:
         ws = replace(ws, paper=Path(paper))
@@ -99,10 +114,10 @@ def evaluate_flow(
     if mixture and corpus == "all" and (ws.checkpoints / Setting("sentence", "household").name / "LATEST").exists():
         get_run_logger().info("chosen: %s", mixture_task(ratings or str(ws.db), res, ws, instructions))
         res = ws.resources(corpus=corpus, vectors=vectors, conceptnet=conceptnet, seed=seed)
-        if not res.mixture.plain:  # the report shows what the mixture changed
-            methods = [*methods, f"{COMPLETION_METHOD}@plain"]
+        if not res.mixture.plain:  # the report shows what the mixture changed (added here: may be skipped)
+            methods, optional = [*methods, f"{COMPLETION_METHOD}@plain"], [*optional, f"{COMPLETION_METHOD}@plain"]
     report = Path(out or ws.report)
-    results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws)
+    results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws, optional)
     create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",
                           table=[{"method": m, "overall": round(acc.get("all", float("nan")), 3)}
                                  for m, acc in results["table1"].items()])

@@ -25,6 +25,7 @@ from flows.annotate import annotate_flow
 from flows.evaluate import evaluate_flow
 from flows.frames import frames_flow
 from flows.ingest import ingest_flow
+from flows.server import ServerStartError, run_with_server
 from flows.speech import speech_flow
 from flows.train import train_flow
 from lmcr.config import REPO_ROOT
@@ -51,8 +52,10 @@ class PipelineParams(BaseModel):
     conceptnet: str | None = str(SAMPLE / "conceptnet" / "edges.txt")
     vectors: str | None = None
     paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
-    # sentence-household: the expert a chosen corpus mixture interpolates with sentence-all (lmcr/mixture.py)
-    settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all", "sentence-household"])
+    # the household LMs: the experts a chosen corpus mixture interpolates with each all-corpora LM
+    # (lmcr/mixture.py); the default methods (frame_lm among them) load them once a mixture is chosen
+    settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all", "sentence-household",
+                                                         "frame-household"])
     methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
     shard_size: int = Field(FrameCorpusConfig.shard_size, gt=0)
     embedding: int = Field(LMConfig.embedding, gt=0)
@@ -106,5 +109,20 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     return {"report": report, "checkpoints": checkpoints, "table1": evaluation["table1"], "executor_check": check}
 
 
+def main(argv: list[str]) -> int:
+    """`python -m flows.pipeline ['{"param": value, ...}']`: the pipeline against one local Prefect server
+    (or `$PREFECT_API_URL`'s); a server that cannot start is one line on stderr and exit status 1."""
+    params = PipelineParams(**json.loads(argv[0])) if argv else PipelineParams()
+    try:
+        run_with_server(pipeline_flow, params)
+    except ServerStartError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted: the run's Prefect server is stopped", file=sys.stderr)
+        return 130
+    return 0
+
+
 if __name__ == "__main__":
-    pipeline_flow(PipelineParams(**json.loads(sys.argv[1])) if len(sys.argv) > 1 else PipelineParams())
+    sys.exit(main(sys.argv[1:]))

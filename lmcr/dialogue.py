@@ -6,7 +6,9 @@ instruction against the objects on the table; when the completion asks ("Should 
 the bowl or the glass?") it waits for an answer and reads it: an object on the table ("the glass",
 "into the mug please"), "yes" (the first choice), "no, the other one" (the second of two choices).
 An answer naming something not on the table, or nothing it can use, gets a re-ask; after three such
-answers the robot says "I'll leave it." and waits for the next instruction.
+answers the robot says "I'll leave it." and waits for the next instruction. What the robot says about
+each outcome is `lmcr.reply.say`'s sentence ("I poured the water into the glass."), kept as the
+outcome's `reply`.
 """
 
 from __future__ import annotations
@@ -17,9 +19,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig, complete
-from lmcr.errors import LMCRError, one_line
+from lmcr.errors import LMCRError
 from lmcr.executor.execute import execute
 from lmcr.executor.scene import Scene
+from lmcr.reply import error_outcome
+from lmcr.reply import say as sentence
 from lmcr.srl.parser import FrameParser
 
 MAX_TRIES = 3
@@ -65,9 +69,15 @@ def _a(word: str) -> str:
 def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Callable, config: CompletionConfig,
              cache_dir: Path, say: Callable[[str], None]) -> list[dict]:
     """Run the conversation until the turns run out; each instruction's outcome is one dict (executed
-    result, left, or error)."""
+    result, left, or error) with what the robot said about it (`reply`)."""
     outcomes = []
     on_table = [o.label for o in scene.objects]
+
+    def done(outcome: dict) -> None:
+        outcome["reply"] = sentence(outcome, parser.lex)
+        say(f"robot: {outcome['reply']}")
+        outcomes.append(outcome)
+
     for instruction in turns:
         say(f"you: {instruction}")
         try:  # an instruction the robot cannot parse, complete or carry out is answered; the talk goes on
@@ -76,27 +86,19 @@ def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Ca
             if completion["question"]:
                 answer = _ask(completion, turns, on_table, parser.lex.objects, say)
                 if answer is None:
-                    say("robot: I'll leave it.")
-                    outcomes.append({"instruction": instruction, "left": True, "question": completion["question"]})
+                    done({"instruction": instruction, "left": True, "question": completion["question"]})
                     continue
             result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
-            if not result["feasible"] and result.get("suggestion"):  # "I can't reach the cup. Should I ...?"
+            if not result["feasible"] and result.get("suggestion"):  # "I can't reach the cup: should I ...?"
                 answer = _offer(result, turns, on_table, parser.lex.objects, say)
                 if answer is None:
-                    outcomes.append({"instruction": instruction, "left": True, **result})
+                    done({"instruction": instruction, **result, "left": True})
                     continue
                 result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
         except LMCRError as exc:
-            say(f"robot: {one_line(exc)}")
-            outcomes.append({"instruction": instruction, "error": one_line(exc)})
+            done({"instruction": instruction, **error_outcome(exc)})
             continue
-        frame = result["frame"]
-        if result["feasible"]:
-            say(f"robot: {frame['predicate']} {frame['roles']} with the {result['arm']} arm: "
-                f"{'done' if result['success'] else 'that did not work'}.")
-        else:
-            say(f"robot: I can't do that without a mishap: {result['reason']}.")
-        outcomes.append({"instruction": instruction, **({"answer": answer} if answer else {}), **result})
+        done({"instruction": instruction, **({"answer": answer} if answer else {}), **result})
     return outcomes
 
 
@@ -111,7 +113,6 @@ def _offer(result: dict, turns: Iterator[str], on_table: list[str], vocabulary: 
     say(f"you: {reply}")
     reading = read_answer(reply, [offered, result["chosen_object"]], on_table, vocabulary)
     if reading.choice != offered:
-        say("robot: I'll leave it.")
         return None
     return {role: offered}
 

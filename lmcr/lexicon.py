@@ -40,6 +40,7 @@ class PredicateSpec:
     particles: frozenset[str]
     alternating: bool
     sentence: str  # "pour {Theme} into the {Destination}": the sentence-LM linearisation
+    past: str | None = None  # the verb's simple past where it is irregular ("put"); else English's regular rule
 
     def prep_role(self, prep: str) -> str | None:
         """The role a prepositional phrase headed by `prep` fills, if any."""
@@ -78,7 +79,7 @@ def load_lexicon(path: str | None = None) -> Lexicon:
             name=name, roles=tuple(spec["roles"]), object_role=spec["object"], with_role=spec.get("with"),
             preps={role: tuple(p) for role, p in spec.get("preps", {}).items()},
             particles=frozenset(spec.get("particles", [])), alternating=bool(spec.get("alternating")),
-            sentence=spec["sentence"],
+            sentence=spec["sentence"], past=spec.get("past"),
         )
         for name, spec in data["predicates"].items()
     }

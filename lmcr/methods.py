@@ -116,6 +116,15 @@ def lm_experts(res: MethodResources) -> list[tuple[str, float]]:
     return [("all", 1.0 - sum(shares.values())), *shares.items()]
 
 
+def lm_settings(method: str, res: MethodResources) -> list[Setting]:
+    """The LM checkpoints the scorer of `method` ('a+b' sums) may load under `res`: each LM part's
+    linearisation in the setting's corpus, or, under a mixture, in `all` and in each weighted corpus (the
+    experts of `lm_experts`, counted before a corpus without words drops out)."""
+    corpora = ["all", *(c for c, _ in res.mixture.weights)] if res.mixed else [res.corpus]
+    return [Setting(LM_METHODS[part], corpus) for part in method.split("+") if part in LM_METHODS
+            for corpus in corpora]
+
+
 def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
     def build(res: MethodResources):
         from lmcr.lm.score import MixedLM

@@ -16,6 +16,12 @@ from lmcr.errors import LMCRError, one_line
 from lmcr.files import check_output_file
 
 MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
+# What a user's query runs under (`lmcr sql`, `lmcr query`): the store alone. No file outside it is read or
+# written (COPY, EXPORT DATABASE, read_csv, read_text, glob, ATTACH all refused), no extension is
+# installed or loaded, and the configuration is locked once set, so a query cannot SET any of it back.
+QUERY_STATEMENTS = ("SELECT", "EXPLAIN", "PRAGMA", "CALL")  # what a query may be: no ATTACH, COPY, LOAD, SET
+QUERY_CONFIG = {"enable_external_access": False, "allow_community_extensions": False,
+                "autoload_known_extensions": False, "autoinstall_known_extensions": False}
 
 
 class MigrationError(LMCRError, RuntimeError):
@@ -30,10 +36,10 @@ class StoreBusyError(LMCRError, RuntimeError):
     """Another process holds the store's write lock."""
 
 
-def _open(db: str | Path, read_only: bool) -> duckdb.DuckDBPyConnection:
+def _open(db: str | Path, read_only: bool, config: dict | None = None) -> duckdb.DuckDBPyConnection:
     """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
     try:
-        return duckdb.connect(str(db), read_only=read_only)
+        return duckdb.connect(str(db), read_only=read_only, config=config or {})
     except duckdb.ConnectionException:  # open in this process in the other mode: `read_connection` decides
         raise
     except duckdb.Error as exc:  # a held lock; not a DuckDB file, a newer storage version, ...
@@ -170,9 +176,23 @@ def query_params(sql: str) -> list[str]:
     return sorted(set(re.findall(r"\$([A-Za-z_][A-Za-z0-9_]*)", sql)))
 
 
+def query_connection(db: str | Path) -> duckdb.DuckDBPyConnection:
+    """A connection for a user's SQL: read-only, the store and nothing else (QUERY_CONFIG), locked.
+    The store open in this process under another configuration is a one-line ValueError."""
+    try:
+        con = _open(db, read_only=True, config=QUERY_CONFIG)
+    except duckdb.ConnectionException as exc:
+        raise ValueError(f"{db}: {one_line(exc)}") from exc
+    con.execute("set enable_progress_bar = false")  # a session setting: set before the lock
+    con.execute("set lock_configuration = true")
+    return con
+
+
 def run_query(db: str | Path, sql: str, params: dict[str, str] | None = None) -> tuple[list[str], list[tuple]]:
-    """(column names, rows) of one statement on a read-only connection: a query never writes.
-    Missing or unknown `$name` parameters and SQL errors raise ValueError with a one-line reason."""
+    """(column names, rows) of one statement on a `query_connection`: a query never writes, and reads
+    nothing but the store. Statements other than QUERY_STATEMENTS are refused before they run (the
+    connection's configuration refuses a file access in any case); they, missing or unknown `$name`
+    parameters and SQL errors raise ValueError with a one-line reason."""
     if not Path(db).is_file():
         raise ValueError(f"no store at {db}: run `lmcr ingest` (or `make demo`) first")
     params = dict(params or {})
@@ -181,8 +201,15 @@ def run_query(db: str | Path, sql: str, params: dict[str, str] | None = None) ->
     if missing or unknown:
         raise ValueError(f"query parameters: missing {missing or 'none'}, unknown {unknown or 'none'} "
                          f"(this query takes {wanted or 'none'}; give --param NAME=VALUE)")
-    con = _open(db, read_only=True)
+    con = query_connection(db)
     try:
+        kinds = [s.type.name for s in con.extract_statements(sql)]
+        if not kinds:
+            raise ValueError("no SQL statement given")
+        refused = [kind for kind in kinds if kind not in QUERY_STATEMENTS]
+        if refused:
+            raise ValueError(f"a query reads the store (read-only) and nothing else: {', '.join(QUERY_STATEMENTS)}, "
+                             f"not {refused[0]}")
         cursor = con.execute(sql, params or None)
         if cursor.description is None:
             return [], []

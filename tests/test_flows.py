@@ -1,4 +1,5 @@
-"""The ingest flow end to end under a throwaway Prefect API, with the process-pool task runner."""
+"""The flows end to end against one local Prefect server (the pipeline's own, `flows.server`), with the
+process-pool task runner."""
 
 from __future__ import annotations
 
@@ -6,16 +7,9 @@ import json
 
 import duckdb
 import pytest
-from prefect.testing.utilities import prefect_test_harness
 
 from flows.ingest import ingest_flow
 from lmcr.methods import COMPLETION_METHOD
-
-
-@pytest.fixture(scope="module")
-def prefect_api():
-    with prefect_test_harness():
-        yield
 
 
 def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):
@@ -123,7 +117,7 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     params = PipelineParams(data_dir=str(tmp_path), embedding=16, max_epochs=2, per_verb=5)
     first = pipeline_flow(params)
     assert (tmp_path / "report" / "report.html").exists()
-    assert set(first["checkpoints"]) == {"sentence-all", "frame-all", "sentence-household"}
+    assert set(first["checkpoints"]) == {"sentence-all", "frame-all", "sentence-household", "frame-household"}
     chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on both dev sets
     assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == COMPLETION_METHOD
     assert set(chosen["accuracy"]["1"]) == {"table1", "instructions"} and chosen["instructions_sha256"]

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
+import sys
 
 import pytest
 import torch
@@ -14,7 +17,7 @@ from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer
-from lmcr.lm.train import TrainConfig, pick_precision, train_lm
+from lmcr.lm.train import PrecisionError, TrainConfig, bf16_unsupported, pick_precision, train_lm
 from lmcr.lm.vocab import Vocab
 
 CORPUS = [
@@ -77,6 +80,11 @@ def test_tiny_corpus_overfits(overfit):
     assert history[-1]["val_ppl"] < 1.6 < history[0]["val_ppl"]
 
 
+NO_BF16 = bf16_unsupported(torch.device("cpu"))
+needs_bf16 = pytest.mark.skipif(NO_BF16 is not None, reason=f"bf16 path: {NO_BF16}")
+
+
+@needs_bf16
 def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
     """bf16 autocast (emulated where the CPU lacks it) reaches the fp32 run's overfit; fp32 stays fp32."""
     _, vocab, fp32 = overfit
@@ -88,10 +96,33 @@ def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
     assert history[-1]["val_ppl"] < 1.6 and {h["precision"] for h in history} == {"bf16"}
     assert all(p.dtype == torch.float32 for p in model.parameters())  # master weights stay fp32
     assert float(torch.tensor([1e-40]) * 1.0) > 0  # denormal flushing ended with the training steps
+
+
+def test_precision_choices(overfit):
+    """fp32 everywhere; auto is what the hardware does natively; bf16 where the CPU cannot is one line."""
+    _, _, fp32 = overfit
     assert {h["precision"] for h in fp32} == {pick_precision("auto", torch.device("cpu"))}
     assert pick_precision("fp32", torch.device("cpu")) == "fp32"
     with pytest.raises(ValueError, match="precision must be one of"):
         pick_precision("fp16", torch.device("cpu"))
+    if NO_BF16:
+        with pytest.raises(PrecisionError, match="precision bf16: this CPU has no bfloat16"):
+            pick_precision("bf16", torch.device("cpu"))
+    else:
+        assert pick_precision("bf16", torch.device("cpu")) == "bf16"
+
+
+def test_the_lm_tests_pass_on_a_cpu_without_bf16():
+    """oneDNN limited to AVX2 is a CPU without bf16 (a laptop, an older EPYC): bf16 is refused in one
+    line, its tests skip with the reason, and every fp32 path passes."""
+    env = os.environ | {"ONEDNN_MAX_CPU_ISA": "AVX2", "LMCR_INNER_AVX2_RUN": "1"}
+    if os.environ.get("LMCR_INNER_AVX2_RUN"):
+        pytest.skip("already the inner run")
+    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rs", __file__],
+                         env=env, capture_output=True, text=True, timeout=900)
+    assert run.returncode == 0, run.stdout[-3000:]
+    assert "bf16 path: this CPU has no bfloat16 support in oneDNN" in run.stdout
+    assert " failed" not in run.stdout and " error" not in run.stdout
 
 
 def test_time_budget_stops_between_epochs(overfit):
@@ -131,6 +162,7 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     assert cup > scissors
 
 
+@needs_bf16
 def test_bf16_scoring_is_within_rounding_of_fp32(overfit, tmp_path):
     """The LSTM and the decoder in bfloat16 (the default where the CPU has it, as in training) move a
     text's log-probability by rounding only; the softmax stays fp32, the checkpoint's model is unchanged."""
@@ -270,7 +302,7 @@ def test_decoder_blocks_give_the_scores_of_one_pass(overfit, tmp_path, monkeypat
     assert scorer.score(texts) == pytest.approx(whole, abs=1e-6)
 
 
-@pytest.mark.parametrize("dtype", [torch.float32, torch.bfloat16])
+@pytest.mark.parametrize("dtype", [torch.float32, pytest.param(torch.bfloat16, marks=needs_bf16)])
 def test_one_step_and_prepacked_products_equal_torchs_own(dtype):
     """The trie walk's one-step LSTM and the decoder's product, with weights laid out once, give what
     `nn.LSTM` and `F.linear` give: to float rounding in fp32, to bfloat16 rounding in bf16."""

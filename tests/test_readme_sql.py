@@ -1,5 +1,6 @@
-"""Every `lmcr sql` / `lmcr query` line of the README runs as written on a store built from the sample
-(ingested corpora, frames, ratings): the documented queries cannot rot silently."""
+"""Every `lmcr sql` / `lmcr query` line of the README and of the user's guide (docs/guide/) runs as written
+on a store built from the sample (ingested corpora, frames, ratings): the documented queries cannot rot
+silently."""
 
 from __future__ import annotations
 
@@ -19,13 +20,20 @@ from lmcr.ingest.run import ingest_sources
 pytestmark = pytest.mark.model
 
 
-def readme_commands() -> list[list[str]]:
-    lines = (REPO_ROOT / "README.md").read_text(encoding="utf-8").splitlines()
+def documented_commands(path) -> list[list[str]]:
+    lines = path.read_text(encoding="utf-8").splitlines()
     return [shlex.split(line)[1:] for line in lines if line.startswith(("lmcr sql ", "lmcr query "))]
 
 
-def test_the_readme_documents_queries():
-    assert len(readme_commands()) >= 6
+def readme_commands() -> list[list[str]]:
+    """The README's query lines, then the guide's, page by page."""
+    pages = [REPO_ROOT / "README.md", *sorted((REPO_ROOT / "docs" / "guide").glob("*.md"))]
+    return [args for page in pages for args in documented_commands(page)]
+
+
+def test_the_readme_and_the_guide_document_queries():
+    assert len(documented_commands(REPO_ROOT / "README.md")) >= 6
+    assert len(documented_commands(REPO_ROOT / "docs" / "guide" / "store.md")) >= 4
 
 
 def test_every_readme_query_runs(con, paths, sample_dir):

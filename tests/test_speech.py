@@ -178,6 +178,7 @@ def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
     assert done.returncode == 0, done.stderr + done.stdout
     outcome = json.loads(done.stdout.strip().splitlines()[-1])
     assert outcome["frame"]["roles"] == {"Theme": "water", "Destination": "cup"} and outcome["success"]
+    assert outcome["reply"] == "I poured the water into the cup." and "robot: I poured the water" in done.stderr
 
 
 def test_the_reading_that_names_the_table_wins():

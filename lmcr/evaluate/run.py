@@ -4,18 +4,18 @@ completion of the LM methods, and write the report."""
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import replace
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig, calibrate, calibration_file, save_config
+from lmcr.errors import LMCRError, one_line
 from lmcr.evaluate import provenance
 from lmcr.evaluate.paper import read_paper_table
 from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
-from lmcr.lm import checkpoint as ckpt
 from lmcr.methods import COMPLETION_METHOD, MethodResources, lm_experts, lm_version_dir, make_scorer
 from lmcr.mixture import Mixture
 from lmcr.rarity import WEIGHT
@@ -66,14 +66,23 @@ def named_method(name: str, res: MethodResources) -> tuple[str, MethodResources]
     return method, replace(named, mixture=Mixture.parse(mixture)) if at else named
 
 
-def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None]) -> tuple[dict, list[str]]:
-    """Scorers by name ('sentence_lm', 'sentence_lm/youcook2', 'cooccur', ...); unavailable ones noted."""
+class MethodUnavailable(LMCRError, ValueError):
+    """A method the user asked for that cannot be built (no checkpoint, a bad vector or edge file, ...)."""
+
+
+def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None],
+                  optional: Collection[str] = ()) -> tuple[dict, list[str]]:
+    """Scorers by name ('sentence_lm', 'sentence_lm/youcook2', 'cooccur', ...). A name in `optional` (a
+    default the user did not ask for) that cannot be built is skipped with a note; any other name that
+    cannot be built is a MethodUnavailable error: a requested method is never silently left out."""
     scorers, notes = {}, []
     for name in names:
         try:
             scorers[name] = make_scorer(*named_method(name, res))
-        except (ckpt.CheckpointError, ValueError, FileNotFoundError) as exc:
-            notes.append(f"{name} not evaluated: {exc}")
+        except (LMCRError, ValueError, OSError) as exc:  # LMCR's own errors, a missing or unreadable file
+            if name not in optional:
+                raise MethodUnavailable(f"method {name}: cannot be built: {one_line(exc)}") from exc
+            notes.append(f"{name} not evaluated: {one_line(exc)}")
             log(notes[-1])
     return scorers, notes
 
@@ -116,12 +125,13 @@ def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, P
 def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[str], settings: list[str],
                    config: EvalConfig, out_dir: Path, calibration_dir: Path | None = None,
                    log: Callable[[str], None] = print, ratings_source: Path | None = None,
-                   paper: Path | None = None) -> Results:
+                   paper: Path | None = None, optional: Collection[str] = ()) -> Results:
     """Score, sweep, calibrate and write the report; `ratings_source` (CSV or store) goes into its
-    provenance and `paper` (the paper's LaTeX source) gives its published Table I columns."""
+    provenance and `paper` (the paper's LaTeX source) gives its published Table I columns. Methods and
+    settings in `optional` (defaults, not asked for) may be skipped with a note; the others must build."""
     started = time.perf_counter()
     published = read_paper_table(paper) if paper else {}  # a bad file fails before the scoring
-    scorers, notes = build_scorers(list(dict.fromkeys(methods + settings)), res, log)
+    scorers, notes = build_scorers(list(dict.fromkeys(methods + settings)), res, log, optional)
     scores = {}
     for name, fn in scorers.items():
         t = time.perf_counter()

@@ -1,8 +1,8 @@
 """Detection from the simulated RGB-D camera: segmentation mask + depth -> labels and 3D positions.
 
 In the paper Mask R-CNN gave object masks and classes; here the renderer's segmentation mask gives the
-masks and the scene's body -> label map their classes (a perfect classifier), while positions are
-measured, not looked up: each mask's pixels are back-projected with the depth buffer and the camera
+masks and the scene's objects by body their classes and ids (a perfect classifier and tracker), while
+positions are measured, not looked up: each mask's pixels are back-projected with the depth buffer and the camera
 matrices, and an object's position is the centroid of its visible surface points.
 """
 
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from lmcr.executor.scene import TABLE_CENTRE, TABLE_TOP
+from lmcr.executor.scene import TABLE_CENTRE, TABLE_TOP, SceneObject
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,7 @@ class Detection:
     label: str
     position: tuple[float, float, float]  # centroid of the visible surface, world frame
     pixels: int
+    id: str = ""  # which of the objects with this label (lmcr.instances)
 
 
 def capture(camera: Camera = Camera(), shaded: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -66,14 +67,14 @@ def back_project(depth: np.ndarray, camera: Camera) -> np.ndarray:
     return (world[:, :3] / world[:, 3:]).reshape(camera.height, camera.width, 3)
 
 
-def detect(bodies: dict[int, str], camera: Camera = Camera(), min_pixels: int = 5) -> list[Detection]:
-    """Every scene object the camera sees, with its measured position."""
+def detect(bodies: dict[int, SceneObject], camera: Camera = Camera(), min_pixels: int = 5) -> list[Detection]:
+    """Every scene object the camera sees (`bodies`: the scene's objects by body), with its measured position."""
     _, depth, seg = capture(camera)
     points = back_project(depth, camera)
     found = []
-    for body, label in bodies.items():
+    for body, obj in bodies.items():
         mask = seg == body
         n = int(mask.sum())
         if n >= min_pixels:
-            found.append(Detection(label, tuple(float(v) for v in points[mask].mean(axis=0)), n))
+            found.append(Detection(obj.label, tuple(float(v) for v in points[mask].mean(axis=0)), n, obj.id))
     return found

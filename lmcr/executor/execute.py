@@ -1,8 +1,14 @@
 """One instruction in simulation: build the scene, detect the objects, complete the instruction with
-the detected labels, plan and execute the predicate's motion, and check the outcome."""
+the detected labels, plan and execute the predicate's motion, and check the outcome.
+
+The completion names labels; the executor picks the objects. When several objects have a label (three
+cups), their combinations for the task's two roles are planned nearest first (the least reach to the held
+object plus carry to the target) until one is feasible, and the result names the one acted on by id."""
 
 from __future__ import annotations
 
+import itertools
+import math
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -15,15 +21,22 @@ from lmcr.executor.detect import detect
 from lmcr.executor.plan import Infeasible, Plan, Planner
 from lmcr.executor.render import Recorder
 from lmcr.executor.run import run_plan
-from lmcr.executor.scene import Scene, build_world, free_spots, load_scene, scene_from_json
+from lmcr.executor.scene import X_LIMIT, Scene, SceneObject, build_world, free_spots, load_scene, scene_from_json
 from lmcr.executor.tasks import TASKS
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
+from lmcr.reply import say
 
 MAX_TRIED = 4  # candidates planned at most, in the language model's order, to find one the robot can do
+MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (nearest first)
+ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (table frame): both arms reach there
 
 
 class ExecutionError(LMCRError, ValueError):
-    """The completed frame names something the robot cannot act on here."""
+    """The completed frame names something the robot cannot act on here; `absent` is the label not on the table."""
+
+    def __init__(self, message: str, absent: str | None = None):
+        super().__init__(message)
+        self.absent = absent
 
 
 def _connect() -> None:
@@ -33,48 +46,59 @@ def _connect() -> None:
 
 def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
             recorder: Recorder | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
-    """The CLI contract's result: frame, chosen object, waypoint errors, per-verb checks, success, and
-    whether the plan was feasible. The robot moves only when the whole plan is feasible. When the
-    language model's choice is not but another candidate is, nothing moves and the result asks
-    (`question`, `suggestion`). A `recorder` takes a picture at the start, at every waypoint and at the
-    end. `answer` (role -> object) is what a person answered: it fills those roles instead.
-    `urdf`: the official Baxter description to use instead of ours."""
+    """The CLI contract's result: frame, chosen object (`chosen_object` its label, `chosen_id` which of the
+    objects with that label; `role_ids` the object of every role), waypoint errors, per-verb checks,
+    success, whether the plan was feasible, and what the robot says (`reply`). The robot moves only when
+    the whole plan is feasible. When the language model's choice is not but another candidate is, nothing
+    moves and the result asks (`question`, `suggestion`). A `recorder` takes a picture at the start, at
+    every waypoint and at the end. `answer` (role -> object) is what a person answered: it fills those
+    roles instead. `urdf`: the official Baxter description to use instead of ours."""
     started = time.perf_counter()
     _connect()
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
-    completion = complete(parser, scorer, instruction, [d.label for d in seen], config)
+    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table)
-    tried = []
-    for frame, candidate in _options(completion, answer)[:MAX_TRIED]:
-        tried.append((frame, candidate, _plan(planner, scene, frame)))
-        if isinstance(tried[-1][2], Plan):
+    options = _options(completion, answer)[:MAX_TRIED]
+    tried = []  # (frame, candidate, role -> object, plan or why not)
+    for frame, candidate in options:
+        for objects in _assignments(scene, frame, {d.id for d in seen})[:MAX_INSTANCES]:
+            tried.append((frame, candidate, objects, _plan(planner, scene, frame, objects)))
+            if isinstance(tried[-1][3], Plan):
+                break
+        if isinstance(tried[-1][3], Plan):
             break
     planned = time.perf_counter()
-    frame, candidate, result = tried[0]
-    out = {"frame": frame, "chosen_object": _chosen(candidate, answer), "feasible": isinstance(result, Plan),
+    # the language model's choice, as the first of its objects the robot can act on (else the nearest)
+    first = [t for t in tried if t[0] is options[0][0]]
+    frame, candidate, objects, result = next((t for t in first if isinstance(t[3], Plan)), first[0])
+    role = _chosen_role(completion, candidate, answer)
+    out = {"frame": frame, "chosen_object": _chosen(candidate, answer),
+           "chosen_id": objects[role].id if role in objects else None,
+           "role_ids": {r: o.id for r, o in objects.items()}, "feasible": isinstance(result, Plan),
            "success": False, "waypoints": [], "checks": {}, "missing": completion["missing"],
            "question": completion["question"], "holding": scene.holding.label if scene.holding else None,
            "ranking": _ranking(completion, tried),
-           "detections": [{"label": d.label, "position": [round(v, 3) for v in d.position]} for d in seen]}
+           "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]}
+                          for d in seen]}
     if isinstance(result, Infeasible):
-        out.update(_refusal(frame, result, tried, parser))
+        out.update(_refusal(out, result, tried))
     else:
         task = TASKS[frame["predicate"]]
-        roles = frame["roles"]
+        held, target = objects[task.held_role], objects[task.target_role]
         if recorder is not None:
-            recorder.target, recorder.held = roles[task.target_role], roles[task.held_role]
+            recorder.target, recorder.held = target.id, held.id
             for arm in result.moving_arms:
                 arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
-            recorder.shot(f"{frame['predicate']} {roles[task.held_role]} -> {roles[task.target_role]}: start")
-        held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
+            recorder.shot(f"{frame['predicate']} {held.id} -> {target.id}: start")
         out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)],
                             planner))
-        out["set_down_first"] = result.first.geometry.held.label if result.first else None
+        out["set_down_first"] = result.first.geometry.held.id if result.first else None
         if recorder is not None:  # what was poured or put down, once it has come to rest
             recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
         out["arm"] = result.arm.side
+    out["reply"] = say(out, parser.lex)
     done = time.perf_counter()
     out["seconds"] = {"perceive_and_complete": round(completed - started, 3), "plan": round(planned - completed, 3),
                       "execute": round(done - planned, 3), "plan_and_execute": round(done - completed, 3)}
@@ -93,13 +117,34 @@ def _options(completion: dict, answer: dict[str, str] | None) -> list[tuple[dict
             for c in completion["candidates"]]
 
 
-def _plan(planner: Planner, scene: Scene, frame: dict) -> Plan | Infeasible:
+def _assignments(scene: Scene, frame: dict, seen: set[str]) -> list[dict[str, SceneObject]]:
+    """The objects the frame's two roles may be done with (role -> object; one per role, never one object
+    for both), nearest first: the reach from the robot's edge to the held object (none when it is in the
+    hand) plus its carry to the target. An object is one the camera saw or the one in the hand."""
     task = TASKS[frame["predicate"]]
-    roles = frame["roles"]
-    try:
-        held, target = scene.find(roles[task.held_role]), scene.find(roles[task.target_role])
-    except KeyError as exc:
-        raise ExecutionError(f"cannot {frame['predicate']} here: {exc.args[0]}") from exc
+    choices = []
+    for role in (task.held_role, task.target_role):
+        label = frame["roles"][role]
+        found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
+        if not found:
+            there = ", ".join(o.id for o in scene.objects)
+            raise ExecutionError(f"cannot {frame['predicate']} here: no {label!r} on the table (there are: {there})",
+                                 absent=label)
+        choices.append(found)
+
+    def effort(pair: tuple[SceneObject, SceneObject]) -> float:
+        held, target = (ROBOT_EDGE if o is scene.holding else o.xy for o in pair)
+        return math.dist(ROBOT_EDGE, held) + math.dist(held, target)
+
+    pairs = sorted((pair for pair in itertools.product(*choices) if pair[0] is not pair[1]), key=effort)
+    if not pairs:  # "pour the cup into the cup" with one cup
+        raise ExecutionError(f"cannot {frame['predicate']} here: there is one {choices[0][0].label}, not two")
+    return [{task.held_role: held, task.target_role: target} for held, target in pairs]
+
+
+def _plan(planner: Planner, scene: Scene, frame: dict, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+    task = TASKS[frame["predicate"]]
+    held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
@@ -123,25 +168,36 @@ def _chosen(candidate: dict | None, answer: dict[str, str] | None) -> str | None
     return candidate["object"] if candidate else None
 
 
+def _chosen_role(completion: dict, candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+    """The role of the chosen object: the one answered, or the completion's missing one."""
+    if answer:
+        return next(iter(answer))
+    return completion["missing"] if candidate else None
+
+
 def _ranking(completion: dict, tried: list) -> list[dict]:
-    """The candidates by language-model probability x feasibility (1 planned feasible, 0 not, unknown
-    when not planned: those keep their probability and rank after the feasible ones)."""
-    feasible = {c["object"]: isinstance(r, Plan) for _, c, r in tried if c is not None}
+    """The candidates by language-model probability x feasibility (1 planned feasible with one of its
+    objects, 0 with none, unknown when not planned: those keep their probability and rank after the
+    feasible ones)."""
+    feasible: dict[str, bool] = {}
+    for _, c, _, r in tried:
+        if c is not None:
+            feasible[c["object"]] = feasible.get(c["object"], False) or isinstance(r, Plan)
     rows = [{"object": c["object"], "probability": c["probability"], "feasible": feasible.get(c["object"])}
             for c in completion["candidates"]]
     return sorted(rows, key=lambda r: -(r["probability"] * (r["feasible"] is not False)))
 
 
-def _refusal(frame: dict, result: Infeasible, tried: list, parser) -> dict:
-    """Why nothing moved, and the question to ask when another candidate is feasible."""
-    out = {"reason": result.reason}
-    alternative = next(((f, c) for f, c, r in tried[1:] if isinstance(r, Plan)), None)
-    if alternative is not None:
-        f, c = alternative
-        sentence = parser.lex.predicates[f["predicate"]].sentence.format(**f["roles"])
-        out["question"] = f"I can't reach the {tried[0][1]['object']}. Should I {sentence} instead?"
-        out["suggestion"] = c["objects"]
-    return out
+def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
+    """Why nothing moved (`out` the result so far), and the question to ask when another candidate is
+    feasible (`suggestion` its objects by label, `suggestion_ids` by id)."""
+    why = {"reason": result.reason, "out_of_reach": result.out_of_reach, "blocker": result.blocker or None}
+    alternative = next(((c, objects) for _, c, objects, r in tried if isinstance(r, Plan)), None)
+    if alternative is None:
+        return why
+    c, objects = alternative
+    offer = {"suggestion": c["objects"], "suggestion_ids": {role: objects[role].id for role in c["objects"]}}
+    return {**why, **offer, "question": say({**out, **why, **offer})}
 
 
 BATCH_FIELDS = {"id": (str, int), "instruction": str}

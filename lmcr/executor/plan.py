@@ -139,7 +139,7 @@ class Planner:
         where that works and park that arm, then do the task with either arm: what the hand holds is out
         of the way, or the held object is passed from one arm's reach to the other's. Both parts are
         planned before anything moves, the task in the world as the first part leaves it."""
-        best = Infeasible(f"found no free spot to put the {moved.label} down", -1)
+        best = Infeasible(f"found no free spot to put {_named(moved)} down", -1)
         for xy in spots:
             for side in SIDES:
                 first = self.plan(put_down(xy), moved, moved, holding, arms=(side,))
@@ -195,13 +195,13 @@ class Planner:
         picked = pick_steps(steps)
         in_hand = _simulated_grasp(arm, other, start, segments, g.held, variant)
         if in_hand is None:
-            return Infeasible(f"the {g.held.label} would slip from the {arm.side} hand's grasp", picked - 2), g
+            return Infeasible(f"{_named(g.held)} would slip from the {arm.side} hand's grasp", picked - 2), g
         if not shifted(g.in_hand(variant), in_hand):
             return segments, g
         found = replace(g, grasped=in_hand)
         rest = self._rest_in_hand(arm, task, variant, found, segments[picked - 1].path[-1])
         if isinstance(rest, Infeasible):
-            return replace(rest, reason=f"{rest.reason} (with the {g.held.label} as the fingers would push it)",
+            return replace(rest, reason=f"{rest.reason} (with {_named(g.held)} as the fingers would push it)",
                            progress=picked + rest.progress), g
         return segments[:picked] + rest, found
 
@@ -275,7 +275,7 @@ class Planner:
                     why, reach = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)", False
                     continue
                 if into and not _fits_through(arm, path, carried, target):
-                    why, reach, blocker = f"the {held.label} would not fit into the {target.label}", False, _named(target)
+                    why, reach, blocker = f"{_named(held)} would not fit into {_named(target)}", False, _named(target)
                     continue
                 found = (path, goal, position)
                 break
@@ -398,8 +398,8 @@ def _grasped(arm: Arm, q, held: SceneObject) -> tuple:
 
 
 def _named(obj: SceneObject) -> str:
-    """How a clash names an object."""
-    return f"the {obj.label}"
+    """How a clash names an object: by its id (the label when no other object has it)."""
+    return f"the {obj.name}"
 
 
 def _gripper_at(arm: Arm, q) -> np.ndarray:

@@ -66,8 +66,8 @@ class Recorder:
     """Pictures of one execution: `shot(caption)` at the start and at every waypoint."""
 
     scene: Scene
-    target: str | None = None  # label outlined as what the action is for
-    held: str | None = None
+    target: str | None = None  # id of the object outlined as what the action is for
+    held: str | None = None  # id of the object the hand takes
     camera: Camera = VIEW
     pictures: list[Image.Image] = field(default_factory=list)
     captions: list[str] = field(default_factory=list)
@@ -77,7 +77,7 @@ class Recorder:
         rgb = rgb.copy()
         objects = self.scene.present
         for obj in objects:
-            if obj.label == self.target and obj.body >= 0:
+            if obj.id == self.target and obj.body >= 0:
                 rgb[_outline(seg == obj.body, OUTLINE)] = TARGET_COLOUR
         image = Image.fromarray(rgb)
         draw = ImageDraw.Draw(image)
@@ -86,9 +86,9 @@ class Recorder:
                 continue
             low, high = p.getAABB(obj.body)
             top = ((low[0] + high[0]) / 2, (low[1] + high[1]) / 2, high[2])
-            colour = TARGET_COLOUR if obj.label == self.target else HELD_COLOUR if obj.label == self.held \
+            colour = TARGET_COLOUR if obj.id == self.target else HELD_COLOUR if obj.id == self.held \
                 else (235, 235, 235)
-            _label(draw, _project(top, self.camera), obj.label, colour)
+            _label(draw, _project(top, self.camera), obj.id, colour)
         self.pictures.append(image)
         self.captions.append(caption)
 

@@ -21,9 +21,10 @@ FINGERS_SET = 60  # simulation steps (1/4 s) for the fingers to take their shape
 
 def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject],
              planner: Planner | None = None) -> dict:
-    """Execute `plan` (its task); the result's `checks` hold the task's checks (and whether the `others`, the objects
-    not in the task, stayed where they were) and `success` whether all passed. With the `planner`, a
-    grasp that left the object in the hand otherwise than planned has the rest planned afresh."""
+    """Execute `plan` (its task); the result's `checks` hold the task's checks (and `knocked`: the ids of the
+    `others`, the objects not in the task, that did not stay where they were) and `success` whether all
+    passed. With the `planner`, a grasp that left the object in the hand otherwise than planned has the
+    rest planned afresh."""
     lead = plan.first or plan  # the arm that moves first starts at home, the other parked, both hands open
     for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
         a.set_config(q)
@@ -32,7 +33,7 @@ def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[Sc
     if plan.first is not None:  # an object set down out of the way or within reach; the checks start from there
         _act(plan.first, plan.first.geometry.held, Outcome(), planner=planner)
         settle(120)
-    before = {o.label: p.getBasePositionAndOrientation(o.body)[0] for o in others}
+    before = {o.id: p.getBasePositionAndOrientation(o.body)[0] for o in others}  # by id: two cups are two
     target_at = p.getBasePositionAndOrientation(target.body)[0]
     out = Outcome()
     grasped, released, knocked_during = _act(plan, held, out, others, before, planner)
@@ -87,8 +88,8 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
             released = True
         elif step.kind == "spill":
             out.particles += spill(held, plan.geometry.opening, step.particles)
-        for label in _moved(others, before or {}):
-            knocked_during.setdefault(label, step.name)
+        for ident in _moved(others, before or {}):
+            knocked_during.setdefault(ident, step.name)
         k += 1
         if k == picked and planner is not None:
             in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
@@ -99,9 +100,9 @@ def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] 
 
 
 def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
-    """The objects (not in the task) that are now more than MOVED from where they stood."""
-    return sorted(o.label for o in others
-                  if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.label])) > MOVED)
+    """The ids of the objects (not in the task) that are now more than MOVED from where they stood."""
+    return sorted(o.id for o in others
+                  if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.id])) > MOVED)
 
 
 def spill(held: SceneObject, opening: float, n: int) -> list[int]:

@@ -5,6 +5,13 @@ Table frame: origin at the table-top centre, +x away from the robot, +y to its l
 within |x| <= 0.3 and |y| <= 0.5. Containers (cups, bowls, pots, the sink, ...) are open boxes built
 from a floor and four walls; bottles and jugs hold liquids, shakers hold powders, food is a box,
 sphere or cylinder.
+
+Every object is an instance with an id: an object may give one (`{"label": "cup", "id": "red cup"}`),
+else it is assigned in scene order: "cup" for the first cup, "cup#2", "cup#3" for the next ones (see
+lmcr.instances). Ids differ; an id that is a label belongs to an object of that label; the held object's
+id is its label. Objects without `xy` are placed only when all of them could fit: their outlines, with
+the clearance between neighbours, must not need more than the table's area (checked before any is
+placed), and the placement gives up after PLACEMENT_CHECKS overlap checks.
 """
 
 from __future__ import annotations
@@ -17,6 +24,7 @@ from pathlib import Path
 import pybullet as p
 
 from lmcr.executor.baxter import PEDESTAL_HEIGHT, baxter_urdf
+from lmcr.instances import DuplicateIdError, assign_ids, id_problem
 from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
 from lmcr.lexicon import load_lexicon
 
@@ -29,6 +37,10 @@ HAND_OFF = (-1.6, 0.0)  # where a held object waits (behind the robot, on the fl
 LAYOUT_ATTEMPTS = 20  # seeded random layouts tried before the objects are packed tight
 PACKING_ATTEMPTS = 200  # seeded tight packings tried before a scene's objects are said not to fit
 PACKING_GAP = 0.022  # between packed neighbours: the 2 cm that counts as clear, and the 3-decimal rounding
+CLEAR = 0.02  # metres between two objects' outlines for them not to overlap
+# overlap checks (a spot against one placed object) at most, over all layouts of one scene: a crowded scene
+# that will not fit is given up on in seconds, not minutes
+PLACEMENT_CHECKS = 2_000_000
 
 # label -> (kind, size): container (width, depth, height, wall), bottle (radius, height),
 # food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
@@ -58,6 +70,12 @@ class SceneObject:
     label: str
     xy: tuple[float, float]
     body: int = -1
+    id: str = ""  # this object among those sharing its label (lmcr.instances); assigned by its Scene when empty
+
+    @property
+    def name(self) -> str:
+        """How plans and checks name the object: its id (its label before a Scene gave it one)."""
+        return self.id or self.label
 
     @property
     def kind(self) -> str:
@@ -75,19 +93,32 @@ class Scene:
     objects: list[SceneObject]  # on the table
     seed: int = 0
     holding: SceneObject | None = None  # in the robot's hand at the start (not on the table)
-    bodies: dict[int, str] = field(default_factory=dict)  # the table objects' bodies -> labels
+    bodies: dict[int, SceneObject] = field(default_factory=dict)  # the table objects by body
     table: int = -1
+
+    def __post_init__(self) -> None:
+        """Every object gets its id (lmcr.instances): the ones it was given are kept, and must differ."""
+        present = self.present
+        ids = assign_ids([o.label for o in present], [o.id or None for o in present])
+        for obj, ident in zip(present, ids):
+            obj.id = ident
 
     @property
     def present(self) -> list[SceneObject]:
         """Everything in the scene: the objects on the table and the one in the hand."""
         return [*self.objects, *([self.holding] if self.holding else [])]
 
-    def find(self, label: str) -> SceneObject:
-        for obj in self.present:
-            if obj.label == label:
-                return obj
-        raise KeyError(f"no {label!r} on the table (there are: {', '.join(o.label for o in self.objects)})")
+    def find(self, name: str) -> SceneObject:
+        """The object with id `name`, else the first one labelled `name`."""
+        present = self.present
+        found = next((o for o in present if o.id == name), None) or next((o for o in present if o.label == name), None)
+        if found is None:
+            raise KeyError(f"no {name!r} on the table (there are: {', '.join(o.id for o in self.objects)})")
+        return found
+
+    def instances(self, label: str) -> list[SceneObject]:
+        """Every object labelled `label`, the one in the hand first."""
+        return sorted((o for o in self.present if o.label == label), key=lambda o: o is not self.holding)
 
 
 def solid_shape(label: str) -> tuple:
@@ -140,7 +171,27 @@ def gap_between(a: str, axy, b: str, bxy) -> float:
 
 
 def _overlap(a: str, axy, b: str, bxy) -> bool:
-    return gap_between(a, axy, b, bxy) < 0.02
+    return gap_between(a, axy, b, bxy) < CLEAR
+
+
+def room_needed(label: str) -> float:
+    """The table area (m²) an object takes up with the half of CLEAR around it that no neighbour may use:
+    these grown outlines never overlap, so together they fit in the table grown by CLEAR / 2 each side."""
+    half_x, half_y, round_ = outline(label)
+    if round_:
+        return math.pi * (half_x + CLEAR / 2) ** 2
+    return (2 * half_x + CLEAR) * (2 * half_y + CLEAR)
+
+
+def _check_room(objects: list[SceneObject], where: str) -> None:
+    """Fail at once when the objects cannot fit on the table whatever their places (their grown outlines
+    need more area than there is): a scene of 10,000 cups is known not to fit without placing any."""
+    needed = sum(room_needed(o.label) for o in objects)
+    table = (2 * X_LIMIT + CLEAR) * (2 * Y_LIMIT + CLEAR)
+    if needed > table:
+        free = sum(1 for o in objects if o.xy is None)
+        raise InputError(f"{where}: {len(objects):,} objects ({free:,} without a position) need {needed:.2f} m² "
+                         f"of the table's {table:.2f} m²: they cannot all fit")
 
 
 def load_scene(path: Path) -> Scene:
@@ -160,13 +211,31 @@ def scene_from_json(data: object, where: str) -> Scene:
     for k, obj in enumerate(data["objects"]):
         if not isinstance(obj, dict):
             raise InputError(f"{where}: object {k} is not a JSON object")
-        items.append((obj.get("label"), obj.get("xy")))
+        items.append((obj.get("label"), obj.get("xy"), obj.get("id")))
     holding = data.get("holding")
     if holding is not None and (not isinstance(holding, str) or holding not in load_lexicon().objects):
         raise InputError(f"{where}: 'holding' must be a known object label, not {holding!r:.60}")
-    if holding in [label for label, _ in items]:
+    if holding in [item[0] for item in items]:
         raise InputError(f"{where}: the {holding} cannot be both in the hand ('holding') and on the table")
     return make_scene(items, seed, where, holding)
+
+
+def _check_ids(labels: list[str], given: list, vocabulary: set[str], holding: str | None, where: str) -> None:
+    """The ids given to objects are usable and differ (from each other and from the held object's, its
+    label); an id that is an object label is an object of that label (an id names one object)."""
+    for k, (label, ident) in enumerate(zip(labels, given)):
+        if ident is None:
+            continue
+        if problem := id_problem(ident):
+            raise InputError(f"{where}: object {k}: {problem}")
+        if ident in vocabulary and ident != label:
+            raise InputError(f"{where}: object {k} ({label}): id {ident!r} is another object's label")
+    try:
+        assign_ids(labels + ([holding] if holding else []), given + ([holding] if holding else []))
+    except DuplicateIdError as exc:
+        held = f" (the held {holding}'s)" if holding and exc.second == len(labels) else ""
+        raise InputError(f"{where}: duplicate object id {exc.ident!r}: objects {exc.first} and {exc.second}{held}") \
+            from None
 
 
 def _valid_xy(xy: object) -> bool:
@@ -174,15 +243,18 @@ def _valid_xy(xy: object) -> bool:
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in xy))
 
 
-def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str = "scene",
-               holding: str | None = None) -> Scene:
-    """Validated objects (known labels, finite on-table positions that do not overlap), the ones
-    without a position placed at random with `seed`; `holding` is the label of what the robot holds."""
+def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding: str | None = None) -> Scene:
+    """Validated objects (known labels, finite on-table positions that do not overlap, different ids),
+    the ones without a position placed at random with `seed`; `holding` is the label of what the robot
+    holds. An item is (label, xy or None) or (label, xy or None, id or None)."""
     vocabulary = set(load_lexicon().objects)
-    placed: list[SceneObject] = []
-    for k, (label, xy) in enumerate(items):
+    labels, given = [item[0] for item in items], [item[2] if len(item) > 2 else None for item in items]
+    for k, label in enumerate(labels):
         if not isinstance(label, str) or label not in vocabulary:
             raise InputError(f"{where}: object {k}: unknown label {label!r:.60}")
+    _check_ids(labels, given, vocabulary, holding, where)
+    placed: list[SceneObject] = []
+    for k, (label, xy, *_) in enumerate(items):
         if xy is not None:
             if not _valid_xy(xy):
                 raise InputError(f"{where}: object {k} ({label}): xy must be two finite numbers [x, y], not {xy!r:.60}")
@@ -190,38 +262,58 @@ def make_scene(items: list[tuple[str, list | None]], seed: int = 0, where: str =
                 raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
             for other in placed:
                 if other.xy is not None and _overlap(label, xy, other.label, other.xy):
-                    raise InputError(f"{where}: object {k} ({label}) overlaps the {other.label}")
-        placed.append(SceneObject(label, tuple(xy) if xy is not None else None))
+                    raise InputError(f"{where}: object {k} ({label}) overlaps the {other.id or other.label}")
+        placed.append(SceneObject(label, tuple(xy) if xy is not None else None, id=given[k] or ""))
     free = [o for o in placed if o.xy is None]
+    if free:
+        _check_room(placed, where)
     # uniform draws first (seeded "7", "7:1", ...: a scene that fits one is laid out as it always was),
     # then tight packings; an unlucky early spot can leave no room for a later object
     layouts = [(_random_spot, seed if k == 0 else f"{seed}:{k}") for k in range(LAYOUT_ATTEMPTS)]
     layouts += [(_packed_spot, f"{seed}:packed:{k}") for k in range(PACKING_ATTEMPTS)]
+    tries = _Tries(PLACEMENT_CHECKS)
     for k, (spot, layout_seed) in enumerate(layouts):
         try:
-            _place(placed, spot, random.Random(layout_seed), where)
+            _place(placed, spot, random.Random(layout_seed), where, tries)
             break
-        except InputError:
-            if k == len(layouts) - 1:
-                raise
+        except InputError as exc:
+            if k == len(layouts) - 1 or tries.left <= 0:
+                raise InputError(f"{exc} ({k + 1} layouts tried)") from None
             for obj in free:
                 obj.xy = None
     return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
 
 
-def _place(placed: list[SceneObject], spot, rng: random.Random, where: str) -> None:
+class _Tries:
+    """The overlap checks a scene's placement may still make (None: no limit)."""
+
+    def __init__(self, left: int | None = None):
+        self.left = left
+
+    def spend(self, checks: int, label: str, where: str) -> None:
+        if self.left is None:
+            return
+        self.left -= checks
+        if self.left <= 0:
+            raise InputError(f"{where}: no free spot for the {label} on the table")
+
+
+def _place(placed: list[SceneObject], spot, rng: random.Random, where: str, tries: _Tries) -> None:
     """Give the objects without a position one, big ones first (they need the room): `spot(label, others,
-    rng, where)` picks it clear of the objects placed so far."""
+    rng, where, tries)` picks it clear of the objects placed so far."""
     for obj in sorted(placed, key=lambda o: -footprint(o.label)):
         if obj.xy is None:
-            obj.xy = spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where)
+            obj.xy = spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
 
 
-def _packed_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
+def _packed_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str,
+                 tries: _Tries) -> tuple[float, float]:
     """A free spot where `label` touches the table's edges or its neighbours, drawn at random among them (a
     corner-point packing): scenes crowded with big things (an oven, a sink, a cutting board, ...) that
     uniform draws do not fit."""
-    spots = [xy for xy in _touching_spots(label, placed) if not any(_overlap(label, xy, o.label, o.xy) for o in placed)]
+    touching = _touching_spots(label, placed)
+    tries.spend(len(touching) * max(len(placed), 1), label, where)
+    spots = [xy for xy in touching if not any(_overlap(label, xy, o.label, o.xy) for o in placed)]
     if not spots:
         raise InputError(f"{where}: no free spot for the {label} on the table")
     return rng.choice(spots)
@@ -240,9 +332,11 @@ def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, 
     return [xy for xy in on_table if abs(xy[0]) <= X_LIMIT - half_x + 1e-9 and abs(xy[1]) <= Y_LIMIT - half_y + 1e-9]
 
 
-def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str) -> tuple[float, float]:
+def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str,
+                 tries: _Tries = _Tries()) -> tuple[float, float]:
     margin = footprint(label)
     for _ in range(500):
+        tries.spend(max(len(placed), 1), label, where)
         xy = (rng.uniform(-X_LIMIT + margin, X_LIMIT - margin), rng.uniform(-Y_LIMIT + margin, Y_LIMIT - margin))
         if not any(_overlap(label, xy, o.label, o.xy) for o in placed):
             return round(xy[0], 3), round(xy[1], 3)
@@ -323,7 +417,7 @@ def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     for obj in scene.objects:
         x, y = world_xy(obj.xy)
         obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
-        scene.bodies[obj.body] = obj.label
+        scene.bodies[obj.body] = obj
     if scene.holding is not None:
         x, y = world_xy(scene.holding.xy)
         make = _container if scene.holding.kind == "container" else _solid

@@ -226,20 +226,20 @@ def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     if holding:
         return []
     pos, orn = g.grip_pose(v)
-    label = g.held.label
+    name = g.held.name
     if v.side:
         back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
-        return [move(f"next to {label}", pos - back, orn), move(f"grip {label}", pos, orn, touches="held"),
-                Step("grasp", f"grasp {label}"), move(f"lift {label}", pos + [0, 0, 0.12], orn, touches="table")]
-    return [above(pos, f"above {label}", orn), move(f"grip {label}", pos, orn, touches="held"),
-            Step("grasp", f"grasp {label}"), above(pos, f"lift {label}", orn, touches="table")]
+        return [move(f"next to {name}", pos - back, orn), move(f"grip {name}", pos, orn, touches="held"),
+                Step("grasp", f"grasp {name}"), move(f"lift {name}", pos + [0, 0, 0.12], orn, touches="table")]
+    return [above(pos, f"above {name}", orn), move(f"grip {name}", pos, orn, touches="held"),
+            Step("grasp", f"grasp {name}"), above(pos, f"lift {name}", orn, touches="table")]
 
 
 def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
     """Carrying height with the held object's middle over the target's."""
     orn = v.at_target()
     offset = gripper_for(g.centre(v), orn, [0, 0, 0])
-    return above(g.target_top + offset, name or f"over {g.target.label}", orn)
+    return above(g.target_top + offset, name or f"over {g.target.name}", orn)
 
 
 def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -269,7 +269,7 @@ def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -
     # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
     bottom = max(t[2] - depth + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
-    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.label}", lower, orn,
+    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.name}", lower, orn,
                                                             touches="target"), Step("release", "let go")]
     if press:
         steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
@@ -316,7 +316,7 @@ def put_down(xy: tuple[float, float]) -> Task:
         orn = v.at_target()
         lower = gripper_for(g.bottom(v), orn, [*world_xy(xy), TABLE_TOP + PUT_DOWN_HEIGHT])
         return [*pick(g, v, holding), above(lower, "over a free spot", orn),
-                move(f"put the {g.held.label} down", lower, orn, touches="table"), Step("release", "let go"),
+                move(f"put the {g.held.name} down", lower, orn, touches="table"), Step("release", "let go"),
                 above(lower, "away from it", orn), Step("park", "out of the way")]
 
     return Task("", "", program, lambda held, target, out: {"ok": True})

@@ -7,6 +7,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from lmcr.errors import one_line
 from lmcr.files import hash_file
 from lmcr.ingest.epic_kitchens import narration_files, parse_epic_kitchens
 from lmcr.ingest.feeding_america import parse_feeding_america
@@ -48,7 +49,10 @@ class Source:
         files = self.files()
         for file in files:
             digest.update(file.relative_to(self.path).as_posix().encode() if self.path.is_dir() else b"")
-            hash_file(digest, file)
+            try:
+                hash_file(digest, file)
+            except OSError as exc:
+                raise unreadable(file, exc) from exc
         return digest.hexdigest()
 
 
@@ -59,9 +63,18 @@ class Source:
         return narration_files(self.path) if self.format == "epic_kitchens" else sorted(self.path.rglob("*.json"))
 
 
+def unreadable(path: Path, exc: OSError) -> IngestError:
+    """An input that the system cannot read (permission, an I/O error) as the error naming the file: a
+    read's OSError often carries no file name ("[Errno 5] Input/output error")."""
+    return IngestError(str(exc.filename or path), None, f"cannot read: {exc.strerror or one_line(exc)}")
+
+
 def _sniff(path: Path) -> str:
-    with open(path, "rb") as handle:
-        head = handle.read(8192).decode("latin-1")
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(8192).decode("latin-1")
+    except OSError as exc:
+        raise unreadable(path, exc) from exc
     if head.lstrip().startswith("[") and "Task:" in head:
         return "virtualhome"
     if '"database"' in head:
@@ -151,8 +164,11 @@ def _sniff_or_none(path: Path) -> str | None:
 
 
 def parse_source(source: Source) -> ParsedFile:
-    """Run the source's adapter."""
+    """Run the source's adapter; a file the system cannot read is an IngestError naming it."""
     parser = FORMATS[source.format]
-    if source.format == "mealmaster":
-        return parser(source.path, source.corpus, encoding=source.encoding)
-    return parser(source.path, source.corpus)
+    try:
+        if source.format == "mealmaster":
+            return parser(source.path, source.corpus, encoding=source.encoding)
+        return parser(source.path, source.corpus)
+    except OSError as exc:
+        raise unreadable(source.path, exc) from exc

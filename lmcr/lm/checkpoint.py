@@ -9,6 +9,7 @@ are needed to load and score.
 from __future__ import annotations
 
 import json
+import pickle
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,6 +61,25 @@ def verify(path: Path) -> dict:
     return verify_version(path, FILES)
 
 
+def read_weights(file: Path, device: str = "cpu") -> dict[str, torch.Tensor]:
+    """The state dict of a `model.pt`: names to tensors, unpickled weights-only, so that a pickle of
+    anything else is refused without running it (torch's own message advises the unsafe way round; it is
+    not relayed). Every failure is a CheckpointError naming the file."""
+    if file.is_file() and file.stat().st_size == 0:
+        raise CheckpointError(f"{file}: empty file (cut short when written?); retrain or restore the checkpoint")
+    try:
+        state = torch.load(file, map_location=device, weights_only=True)
+    except pickle.UnpicklingError:
+        raise CheckpointError(f"{file}: not a weights-only state dict; refusing to load it") from None
+    except (EOFError, KeyError, ValueError, RuntimeError, OSError) as exc:  # cut short, not a torch file
+        raise CheckpointError(f"{file}: not a torch weights file ({type(exc).__name__}: "
+                              f"{one_line(exc, 200) or 'no reason given'})") from exc
+    if not isinstance(state, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
+                                              for k, v in state.items()):
+        raise CheckpointError(f"{file}: not a state dict of named tensors; refusing to load it")
+    return state
+
+
 def load(path: Path, device: str = "cpu") -> Checkpoint:
     """Load a verified checkpoint (a version directory or a setting directory's LATEST)."""
     path = resolve(path)
@@ -68,14 +88,15 @@ def load(path: Path, device: str = "cpu") -> Checkpoint:
     def read(name: str) -> object:
         return json.loads((path / name).read_text(encoding="utf-8"))
 
+    weights = read_weights(path / "model.pt", device)
     try:
         model = RecurrentLM(LMConfig(**read("model.json")))
-        model.load_state_dict(torch.load(path / "model.pt", map_location=device, weights_only=True))
+        model.load_state_dict(weights)
         text = read("linearization.json")
         checkpoint = Checkpoint(path, model.eval(), Vocab.from_json(read("vocab.json")), text["linearization"],
                                 read("metrics.json"), read("provenance.json"), bool(text.get("articles", True)))
     except (ValueError, KeyError, TypeError, RuntimeError, EOFError, OSError) as exc:
-        raise CheckpointError(f"{path}: cannot load: {one_line(exc, 200)}") from exc
+        raise CheckpointError(f"{path}: cannot load: {one_line(exc, 200) or type(exc).__name__}") from exc
     if not path.parent.name.startswith(f"{checkpoint.linearization}-"):
         raise CheckpointError(f"{path}: holds a {checkpoint.linearization} model, not one of {path.parent.name}")
     return checkpoint

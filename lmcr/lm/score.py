@@ -73,8 +73,8 @@ def _prepacked(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Callab
         packed = torch.ops.mkldnn._reorder_linear_weight(weight, None) if usable else None
     except (AttributeError, RuntimeError):  # a build without these oneDNN ops
         packed = None
-    if packed is None:
-        return lambda x: F.linear(x, weight, bias)
+    if packed is None:  # inputs in the weight's precision, as the packed product takes them
+        return lambda x: F.linear(x.to(weight.dtype), weight, None if bias is None else bias.to(weight.dtype))
     return lambda x: torch.ops.mkldnn._linear_pointwise(x, packed, bias, "none", [], "")
 
 

@@ -10,6 +10,7 @@ from contextlib import contextmanager
 
 import torch
 
+from lmcr.errors import LMCRError
 from lmcr.lm.config import TrainConfig
 from lmcr.lm.data import bucket_batches
 from lmcr.lm.model import RecurrentLM
@@ -29,11 +30,33 @@ def native_bf16(device: torch.device) -> bool:
     return any(getattr(torch.cpu, probe, lambda: False)() for probe in probes)
 
 
+class PrecisionError(LMCRError, ValueError):
+    """A precision this machine cannot compute in, or no precision at all."""
+
+
+def bf16_unsupported(device: torch.device) -> str | None:
+    """Why `device` cannot run the LM in bfloat16, or None when it can. On a CPU, PyTorch's LSTM and
+    products in bf16 go through oneDNN, which computes bf16 natively (AMX, AVX512-BF16, Arm BF16) or
+    emulates it with AVX-512; on a CPU with neither (AVX2 only: many laptops, older AMD EPYC) it has no
+    bf16 LSTM primitive at all."""
+    if device.type == "cuda":
+        return None if torch.cuda.is_bf16_supported() else "this CUDA device has no bfloat16"
+    if device.type != "cpu":
+        return None
+    if torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported():
+        return None
+    return "this CPU has no bfloat16 support in oneDNN (it needs AVX-512, AMX or Arm BF16)"
+
+
 def pick_precision(requested: str, device: torch.device) -> str:
+    """The precision to compute in: "auto" is bf16 where the hardware multiplies it natively, else fp32;
+    "bf16" where the device cannot is refused in one line, never a failure deep in a kernel."""
     if requested not in PRECISIONS:
-        raise ValueError(f"precision must be one of {PRECISIONS}, not {requested!r}")
+        raise PrecisionError(f"precision must be one of {PRECISIONS}, not {requested!r}")
     if requested == "auto":
         return "bf16" if native_bf16(device) else "fp32"
+    if requested == "bf16" and (reason := bf16_unsupported(device)):
+        raise PrecisionError(f"precision bf16: {reason}; use --precision fp32 (or auto)")
     return requested
 
 

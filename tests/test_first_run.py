@@ -1,0 +1,124 @@
+"""The first run: the demo's pipeline passes on a machine whose cores are kept busy, through one Prefect
+server of its own, and no process of it is left behind, whether it ends, is interrupted or killed."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+
+from flows.server import ServerStartError, local_server, startup_timeout
+from lmcr.config import REPO_ROOT
+
+MARKER = "LMCR_TEST_RUN_MARKER"
+SMALL = {"embedding": 16, "max_epochs": 1, "per_verb": 5}
+
+
+def processes_with(marker: str) -> list[int]:
+    """Live processes whose environment carries `marker` (the run's own and everything it spawned)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit() or int(entry.name) == os.getpid():
+            continue
+        try:
+            environ = (entry / "environ").read_bytes()
+            state = (entry / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if f"{MARKER}={marker}".encode() in environ.split(b"\0") and state != "Z":
+            found.append(int(entry.name))
+    return found
+
+
+def wait_until_gone(marker: str, seconds: float = 20.0) -> list[int]:
+    deadline = time.monotonic() + seconds
+    while (left := processes_with(marker)) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    return left
+
+
+def run_env(tmp_path: Path, marker: str) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if k != "PREFECT_API_URL"}
+    return env | {"PREFECT_HOME": str(tmp_path / "prefect-home"), "PREFECT_SERVER_ANALYTICS_ENABLED": "false",
+                  MARKER: marker}
+
+
+def pipeline(tmp_path: Path, env: dict[str, str], **popen) -> subprocess.Popen:
+    params = json.dumps(SMALL | {"data_dir": str(tmp_path / "data")})
+    return subprocess.Popen([sys.executable, "-m", "flows.pipeline", params], cwd=REPO_ROOT, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **popen)
+
+
+pytestmark = pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs Linux /proc")
+
+
+def test_demo_pipeline_on_busy_cores_uses_one_server_and_leaves_nothing(tmp_path):
+    marker = uuid.uuid4().hex
+    env = run_env(tmp_path, marker)
+    busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"], env=env) for _ in range(os.cpu_count() or 2)]
+    try:
+        run = pipeline(tmp_path, env)
+        output, _ = run.communicate(timeout=1800)
+    finally:
+        for loop in busy:
+            loop.kill()
+            loop.wait()
+    assert run.returncode == 0, output[-3000:]
+    assert output.count("Prefect server for this run") == 1
+    assert "Starting temporary server" not in output  # no task process started a server of its own
+    assert "Error logging to API" not in output  # logs were sent before the server stopped
+    assert (tmp_path / "data" / "report" / "report.html").exists()
+    assert wait_until_gone(marker) == []
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
+def test_an_interrupted_or_killed_run_leaves_no_server(tmp_path, how):
+    marker = uuid.uuid4().hex
+    run = pipeline(tmp_path, run_env(tmp_path, marker))
+    try:
+        for line in run.stdout:
+            if "Prefect server for this run" in line:
+                break
+        else:
+            pytest.fail("the run never reported its server")
+        assert len(processes_with(marker)) >= 2  # the run and its server
+        run.send_signal(how)
+        run.wait(timeout=60)
+    finally:
+        if run.poll() is None:
+            run.kill()
+            run.wait()
+    assert wait_until_gone(marker) == []
+
+
+def test_a_server_that_cannot_start_is_one_line(tmp_path):
+    env = run_env(tmp_path, uuid.uuid4().hex) | {"LMCR_PREFECT_STARTUP_TIMEOUT_S": "0.01"}
+    run = pipeline(tmp_path, env)
+    output, _ = run.communicate(timeout=120)
+    assert run.returncode == 1
+    assert output.strip().splitlines() == [
+        "error: the Prefect server did not answer within 0 s (set LMCR_PREFECT_STARTUP_TIMEOUT_S to wait longer, "
+        "or PREFECT_API_URL to use a running one)"]
+    assert wait_until_gone(env[MARKER]) == []
+
+
+def test_startup_timeout_reads_the_environment(monkeypatch):
+    monkeypatch.setenv("LMCR_PREFECT_STARTUP_TIMEOUT_S", "90")
+    assert startup_timeout() == 90
+    for bad in ("soon", "0", "-5"):
+        monkeypatch.setenv("LMCR_PREFECT_STARTUP_TIMEOUT_S", bad)
+        with pytest.raises(ServerStartError, match="LMCR_PREFECT_STARTUP_TIMEOUT_S"):
+            startup_timeout()
+
+
+def test_a_set_api_url_is_used_and_no_server_started(monkeypatch):
+    monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")
+    with local_server() as url:
+        assert url == "http://127.0.0.1:1/api"
