@@ -26,8 +26,8 @@ from record import add_json_option, write_results
 from lmcr.complete import complete
 from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD
-from lmcr.mixture import Mixture
+from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
 
 

@@ -23,11 +23,11 @@ import time
 
 from record import add_json_option, write_results
 
-from lmcr.executor.execute import execute
-from lmcr.executor.scene import make_scene
 from lmcr.jsonl import InputError
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD
+from lmcr.robot.execute import execute
+from lmcr.robot.scene import make_scene
+from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
 
 # predicate -> (incomplete instruction, the object it needs that is stated, the one to be filled in, its role)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from record import add_json_option, write_results
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import corpus_summary, ingest_sources
 from lmcr.store import connect

@@ -19,7 +19,7 @@ from pathlib import Path
 import duckdb
 from record import add_json_option, write_results
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction

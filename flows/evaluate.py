@@ -20,7 +20,8 @@ from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.files import cached_json, file_sha256
 from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
-from lmcr.methods import COMPLETION_METHOD, EVALUATED, MethodResources
+from lmcr.scorers.registry import COMPLETION_METHOD, EVALUATED
+from lmcr.scorers.resources import MethodResources
 from lmcr.setting import Setting
 from lmcr.store import read_connection
 from lmcr.workspace import Workspace
@@ -72,7 +73,7 @@ def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
     """Choose the household weight of the pooled setting on the ratings (and on the instructions, with the
     context term's weight: `lmcr mixture`) and save them."""
-    from lmcr.evaluate.mixture import DevInstructions, choose_and_save
+    from lmcr.evaluate.choose_mixture import DevInstructions, choose_and_save
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
     dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None

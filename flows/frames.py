@@ -10,9 +10,9 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner, TaskRunner
 
-from lmcr.frames.build import build_frame_corpus
-from lmcr.frames.config import FrameCorpusConfig
-from lmcr.frames.shards import Shard, ShardJob, ShardResult, parse_shard
+from lmcr.frame_corpus.build import build_frame_corpus
+from lmcr.frame_corpus.config import FrameCorpusConfig
+from lmcr.frame_corpus.shards import Shard, ShardJob, ShardResult, parse_shard
 from lmcr.store import check_contracts, named_query, query_dicts
 from lmcr.workspace import Workspace
 

@@ -28,11 +28,11 @@ from flows.ingest import ingest_flow
 from flows.server import ServerStartError, run_with_server
 from flows.speech import speech_flow
 from flows.train import train_flow
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.evaluate.protocol import EvalConfig
-from lmcr.frames.config import FrameCorpusConfig
-from lmcr.lm.config import LMConfig, TrainConfig
-from lmcr.methods import COMPLETION_METHOD, EVALUATED
+from lmcr.frame_corpus.config import FrameCorpusConfig
+from lmcr.lm.hyperparams import LMConfig, TrainConfig
+from lmcr.scorers.registry import COMPLETION_METHOD, EVALUATED
 from lmcr.setting import Setting
 from lmcr.workspace import Workspace
 
@@ -53,7 +53,7 @@ class PipelineParams(BaseModel):
     vectors: str | None = None
     paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
     # the household LMs: the experts a chosen corpus mixture interpolates with each all-corpora LM
-    # (lmcr/mixture.py); the default methods (frame_lm among them) load them once a mixture is chosen
+    # (lmcr/scorers/mixture.py); the default methods (frame_lm among them) load them once a mixture is chosen
     settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all", "sentence-household",
                                                          "frame-household"])
     methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
@@ -72,8 +72,8 @@ class PipelineParams(BaseModel):
 def executor_check_task(instruction: str, scene: str, data_dir: str | None) -> dict:
     """The default completion (published sentence LM times the frame counts) completes an instruction and
     the simulated Baxter carries it out."""
-    from lmcr.executor.execute import execute
-    from lmcr.executor.scene import load_scene
+    from lmcr.robot.execute import execute
+    from lmcr.robot.scene import load_scene
 
     ws = Workspace.from_env(data_dir=data_dir)
     scorer, config = ws.completion_scorer(COMPLETION_METHOD)

@@ -13,7 +13,7 @@ from flows.annotate import ingest_task
 from flows.ingest import ingest_flow
 from lmcr.evaluate.ratings import rated_frames
 from lmcr.lexicon import load_lexicon
-from lmcr.lm.config import LMConfig, TrainConfig
+from lmcr.lm.hyperparams import LMConfig, TrainConfig
 from lmcr.lm.run import train_setting
 from lmcr.retrain import RetrainConfig, decide, inputs_sha256, last_inputs, record
 from lmcr.setting import Setting

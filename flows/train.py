@@ -8,7 +8,7 @@ from __future__ import annotations
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 
-from lmcr.lm.config import LMConfig, TrainConfig
+from lmcr.lm.hyperparams import LMConfig, TrainConfig
 from lmcr.lm.run import train_setting
 from lmcr.setting import ALL_SETTINGS, Setting
 from lmcr.workspace import Workspace

@@ -21,9 +21,9 @@ from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
-from lmcr.methods import Scorer, make_scorer, scorer_fingerprint
+from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.context import antecedents, served_in, utterance_context
-from lmcr.srl.frames import FrameMention
+from lmcr.srl.mentions import FrameMention
 from lmcr.srl.parser import FrameParser, read_instruction
 
 
@@ -235,7 +235,7 @@ def save_config(config: CompletionConfig, path: Path, fingerprint: str | None) -
 
 def load_config(path: Path, fingerprint: str | None) -> CompletionConfig | None:
     """The saved calibration when it was made for this fingerprint (the scorer's checkpoints and
-    corpus, see `methods.scorer_fingerprint`), else None."""
+    corpus, see `scorers.registry.scorer_fingerprint`), else None."""
     if not Path(path).exists():
         return None
     data = json.loads(Path(path).read_text(encoding="utf-8"))

@@ -128,9 +128,10 @@ def _name(kind: type | tuple[type, ...]) -> str:
 
 
 def write_jsonl_atomic(path: Path, records: Iterable[dict]) -> int:
-    """Write records to a temporary file beside `path`, then rename: never a partial output."""
+    """Write records to a temporary file beside `path`, then rename: never a partial output. Each line
+    reaches the temporary file as soon as its record comes (line-buffered), so a long batch shows progress."""
     count = 0
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as out:
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", buffering=1) as out:
         for record in records:
             out.write(json.dumps(record, ensure_ascii=False) + "\n")
             count += 1

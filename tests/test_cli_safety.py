@@ -15,8 +15,8 @@ import torch
 from typer.testing import CliRunner
 
 from lmcr import cli
+from lmcr.checkout import SQL_DIR
 from lmcr.cli import app
-from lmcr.config import SQL_DIR
 from lmcr.files import OUTPUT_MARKER, OutputError, atomic_dir, atomic_path, file_sha256
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.model import LMConfig, RecurrentLM
@@ -410,13 +410,15 @@ def option_default(command, name: str):
 def test_the_defaults_need_only_what_the_pipeline_trains(tmp_path):
     from flows.pipeline import PipelineParams
     from lmcr.evaluate.run import named_method
-    from lmcr.methods import EVALUATED, MethodResources, lm_settings
-    from lmcr.mixture import GRID, Mixture
+    from lmcr.scorers.lm_checkpoints import lm_settings
+    from lmcr.scorers.mixture import GRID, Mixture
+    from lmcr.scorers.registry import EVALUATED
+    from lmcr.scorers.resources import MethodResources
 
     trained = {s for s in PipelineParams().settings}
-    defaults = {"score": option_default(cli.score, "methods").split(","),
-                "complete": [option_default(cli.complete, "method")],
-                "execute": [option_default(cli.execute, "method")],
+    defaults = {"score": option_default(cli.models.score, "methods").split(","),
+                "complete": [option_default(cli.models.complete, "method")],
+                "execute": [option_default(cli.robot.execute, "method")],
                 "evaluate": list(EVALUATED)}  # `lmcr evaluate` and the pipeline's evaluate flow
     # the pipeline may choose any weight of the household corpus (mixture.json), or none
     for mixture in [Mixture(), *(Mixture.of({"household": w}) for w in GRID)]:

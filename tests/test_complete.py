@@ -145,13 +145,14 @@ def test_calibration_temperature_and_conformal_threshold(tmp_path):
 
 def test_a_scorer_is_one_registry_entry(monkeypatch):
     """A new method is one SCORERS entry: `make_scorer`, sums and calibration fingerprints follow."""
-    from lmcr import methods
     from lmcr.frame import Frame
+    from lmcr.scorers import registry as methods
+    from lmcr.scorers.resources import MethodResources
 
     spec = methods.ScorerSpec(lambda res: (lambda frames: [float(len(f.predicate)) for f in frames]),
                               lambda res: "len-v1")
     monkeypatch.setitem(methods.SCORERS, "verb_length", spec)
-    res = methods.MethodResources(checkpoints=__import__("pathlib").Path("/nonexistent"))
+    res = MethodResources(checkpoints=__import__("pathlib").Path("/nonexistent"))
     frames = [Frame.of("pour", {"Theme": "water"}), Frame.of("season", {"Theme": "rice"})]
     assert methods.make_scorer("verb_length", res)(frames) == [4.0, 6.0]
     assert methods.make_scorer("verb_length+verb_length", res)(frames) == [8.0, 12.0]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.context import antecedents, served_in, utterance_context
-from lmcr.srl.frames import FrameMention
+from lmcr.srl.mentions import FrameMention
 from tests.srl_docs import make_doc
 
 
@@ -72,7 +72,8 @@ def test_a_role_the_robot_cannot_ground_is_said_words_read_as_context():
 
 
 def test_only_text_reading_scorers_see_the_context(monkeypatch):
-    from lmcr import methods
+    from lmcr.scorers import registry as methods
+    from lmcr.scorers.resources import MethodResources
 
     seen = {}
 
@@ -86,7 +87,7 @@ def test_only_text_reading_scorers_see_the_context(monkeypatch):
 
     monkeypatch.setitem(methods.SCORERS, "reader", fake("reader", True))
     monkeypatch.setitem(methods.SCORERS, "counter", fake("counter", False))
-    scorer = methods.make_scorer("reader+counter", methods.MethodResources(checkpoints=__import__("pathlib").Path(".")))
+    scorer = methods.make_scorer("reader+counter", MethodResources(checkpoints=__import__("pathlib").Path(".")))
     assert scorer([("pour", {"Theme": "milk", "Destination": "mug"})], "for my tea") == [0.0]
     assert seen == {"reader": "for my tea", "counter": None}
 

@@ -7,9 +7,10 @@ import math
 
 import pytest
 
-from lmcr.context_pmi import MIN_SENTENCES, WEIGHT, ContextCooccurrence
 from lmcr.frame import Frame
-from lmcr.methods import MethodResources, make_scorer, scorer_fingerprint
+from lmcr.scorers.context_pmi import MIN_SENTENCES, WEIGHT, ContextCooccurrence
+from lmcr.scorers.registry import make_scorer, scorer_fingerprint
+from lmcr.scorers.resources import MethodResources
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 
@@ -94,7 +95,7 @@ def test_context_pmi_is_a_context_reading_term_with_a_cache(store, tmp_path):
 def test_a_chosen_context_weight_scales_the_term_and_names_its_calibration(store, tmp_path, monkeypatch):
     from dataclasses import replace
 
-    from lmcr.mixture import Mixture, save
+    from lmcr.scorers.mixture import Mixture, save
 
     counts = ContextCooccurrence.count(*store, OBJECTS, {"all": 1.0}, min_sentences=1)
     frames = [Frame.of("season", {"Theme": "apple", "Instrument": spice}) for spice in ("salt", "cinnamon")]

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from lmcr.counts import FrameCountScorer
-from lmcr.mixture import Mixture, MixtureError, load, save
+from lmcr.scorers.frame_counts import FrameCountScorer
+from lmcr.scorers.mixture import Mixture, MixtureError, load, save
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 
@@ -84,7 +84,7 @@ def test_mixture_file_round_trip_and_bad_file(tmp_path):
 
 
 def test_the_weights_with_the_best_mean_over_the_dev_sets_win():
-    from lmcr.evaluate.mixture import best_choice
+    from lmcr.evaluate.choose_mixture import best_choice
 
     # dev ratings alone: the best Table I, and no context weight (the rated frames have no context)
     assert best_choice({1: {"table1": 0.924}, 3: {"table1": 0.922}}) == (1, None)
@@ -103,9 +103,9 @@ def test_the_weights_with_the_best_mean_over_the_dev_sets_win():
 
 def test_the_context_weights_share_one_scoring_of_each_candidate_set(monkeypatch, tmp_path):
     """The grid scores the rest of the method and the unscaled term once per (frames, context)."""
-    from lmcr.evaluate import mixture as choosing
+    from lmcr.evaluate import choose_mixture as choosing
     from lmcr.frame import Frame
-    from lmcr.methods import MethodResources
+    from lmcr.scorers.resources import MethodResources
 
     calls = []
 
@@ -123,7 +123,7 @@ def test_the_context_weights_share_one_scoring_of_each_candidate_set(monkeypatch
 
 
 def test_the_context_weight_round_trips_in_the_mixture_file(tmp_path):
-    from lmcr.mixture import load_choice
+    from lmcr.scorers.mixture import load_choice
 
     assert load_choice(tmp_path)[1] is None  # nothing chosen: the unscaled term
     save(tmp_path, Mixture.of({"household": 3}), {}, context_weight=2.0)

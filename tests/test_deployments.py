@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 
 PREFECT = str(Path(sys.executable).with_name("prefect"))
 

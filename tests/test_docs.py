@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 
 
 def load_module(path, name):

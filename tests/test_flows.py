@@ -9,7 +9,7 @@ import duckdb
 import pytest
 
 from flows.ingest import ingest_flow
-from lmcr.methods import COMPLETION_METHOD
+from lmcr.scorers.registry import COMPLETION_METHOD
 
 
 def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):

@@ -213,28 +213,30 @@ def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, 
 
 
 def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monkeypatch):
-    from lmcr import methods
-    from lmcr.mixture import Mixture
+    from lmcr.scorers import lm_checkpoints
+    from lmcr.scorers.mixture import Mixture
+    from lmcr.scorers.registry import make_scorer, scorer_fingerprint
+    from lmcr.scorers.resources import MethodResources
 
     model, vocab, _ = overfit
     torch.manual_seed(3)
     untrained = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
     ckpt.publish(tmp_path, "sentence-all", model, vocab, "sentence", {}, {})
     ckpt.publish(tmp_path, "sentence-household", untrained, vocab, "sentence", {}, {})
-    monkeypatch.setattr(methods, "corpus_words", lambda res: {"recipes": 99, "household": 1})
+    monkeypatch.setattr(lm_checkpoints, "corpus_words", lambda res: {"recipes": 99, "household": 1})
     frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors")]
-    plain = methods.MethodResources(checkpoints=tmp_path)
-    mixed = methods.MethodResources(checkpoints=tmp_path, mixture=Mixture.of({"household": 9}))
+    plain = MethodResources(checkpoints=tmp_path)
+    mixed = MethodResources(checkpoints=tmp_path, mixture=Mixture.of({"household": 9}))
     share = 9 / (99 + 9)  # household weighted 9 is 9 of 108 weighted words
-    all_lm = methods.make_scorer("sentence_lm", plain)
+    all_lm = make_scorer("sentence_lm", plain)
     p_all = [math.exp(x) for x in all_lm(frames)]
     p_house = [math.exp(x) for x in LMScorer(ckpt.load(tmp_path / "sentence-household")).score_frames(frames)]
     purpose = [a - b for a, b in zip(all_lm(frames, "for tea"), all_lm(frames))]  # log P_all(context | frame)
     expected = [math.log((1 - share) * a + share * h) + g for a, h, g in zip(p_all, p_house, purpose)]
-    assert methods.make_scorer("sentence_lm", mixed)(frames, "for tea") == pytest.approx(expected, rel=1e-5)
-    assert methods.lm_experts(mixed) == [("all", pytest.approx(1 - share)), ("household", pytest.approx(share))]
-    assert methods.scorer_fingerprint("sentence_lm", mixed).endswith("@household=9")
-    assert "@" not in methods.scorer_fingerprint("sentence_lm", plain)
+    assert make_scorer("sentence_lm", mixed)(frames, "for tea") == pytest.approx(expected, rel=1e-5)
+    assert lm_checkpoints.lm_experts(mixed) == [("all", pytest.approx(1 - share)), ("household", pytest.approx(share))]
+    assert scorer_fingerprint("sentence_lm", mixed).endswith("@household=9")
+    assert "@" not in scorer_fingerprint("sentence_lm", plain)
 
 
 @pytest.mark.parametrize("texts", [

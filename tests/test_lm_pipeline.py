@@ -9,8 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from lmcr.cli import app
-from lmcr.frames.build import build_frame_corpus, process_pool
-from lmcr.frames.config import FrameCorpusConfig
+from lmcr.frame_corpus.build import build_frame_corpus, process_pool
+from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.lm import checkpoint as ckpt
@@ -25,7 +25,7 @@ runner = CliRunner()
 
 @pytest.fixture(scope="module")
 def sample_store(tmp_path_factory):
-    from lmcr.config import REPO_ROOT
+    from lmcr.checkout import REPO_ROOT
     from lmcr.store import connect
     from lmcr.workspace import Workspace
 

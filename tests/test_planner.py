@@ -7,7 +7,7 @@ import pytest
 
 pytest.importorskip("ompl")
 
-from lmcr.executor.planner import RESOLUTION, joint_path, segment_clash  # noqa: E402
+from lmcr.robot.joint_paths import RESOLUTION, joint_path, segment_clash  # noqa: E402
 
 LIMITS = np.array([[-2.0, 2.0]] * 7)
 

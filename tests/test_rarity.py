@@ -8,9 +8,10 @@ import math
 import pytest
 
 from lmcr.frame import Frame
-from lmcr.methods import MethodResources, corpus_words, make_scorer, scorer_fingerprint
-from lmcr.mixture import Mixture
-from lmcr.rarity import WEIGHT, PhraseCounts, phrase_pattern
+from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.rarity import WEIGHT, PhraseCounts, phrase_pattern
+from lmcr.scorers.registry import make_scorer, scorer_fingerprint
+from lmcr.scorers.resources import MethodResources, corpus_words
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 

@@ -10,10 +10,10 @@ import pytest
 from typer.testing import CliRunner
 
 from lmcr.annotate.results import ingest_ratings
+from lmcr.checkout import REPO_ROOT
 from lmcr.cli import app
-from lmcr.config import REPO_ROOT
-from lmcr.frames.build import build_frame_corpus, process_pool
-from lmcr.frames.config import FrameCorpusConfig
+from lmcr.frame_corpus.build import build_frame_corpus, process_pool
+from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 

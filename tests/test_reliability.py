@@ -17,8 +17,8 @@ import pytest
 import torch
 from typer.testing import CliRunner
 
+from lmcr.checkout import REPO_ROOT
 from lmcr.cli import app
-from lmcr.config import REPO_ROOT
 from lmcr.files import OUTPUT_MARKER, OutputError, atomic_dir, atomic_path
 from lmcr.ingest import IngestError, expand_inputs
 from lmcr.ingest.run import ingest_sources
@@ -431,20 +431,20 @@ def test_ratings_that_are_neither_csv_nor_a_store_are_one_line_and_untouched(tmp
 
 def test_every_lmcr_error_is_one_lmcr_error():
     """One base the command line knows, each error still the built-in kind its callers catch."""
-    import lmcr.baselines.vectors
     import lmcr.complete
     import lmcr.evaluate.paper
-    import lmcr.executor.execute
     import lmcr.files
     import lmcr.ingest.records
     import lmcr.jsonl
     import lmcr.lm.checkpoint
+    import lmcr.robot.execute
+    import lmcr.scorers.baselines.vectors
     import lmcr.srl.parser
     import lmcr.store
     import lmcr.versions
     from lmcr.errors import LMCRError
 
-    modules = [lmcr.baselines.vectors, lmcr.complete, lmcr.evaluate.paper, lmcr.executor.execute, lmcr.files,
+    modules = [lmcr.scorers.baselines.vectors, lmcr.complete, lmcr.evaluate.paper, lmcr.robot.execute, lmcr.files,
                lmcr.ingest.records, lmcr.jsonl, lmcr.lm.checkpoint, lmcr.srl.parser, lmcr.store, lmcr.versions]
     errors = {obj for m in modules for obj in vars(m).values()
               if isinstance(obj, type) and issubclass(obj, Exception) and obj.__module__ == m.__name__}

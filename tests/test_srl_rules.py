@@ -8,7 +8,7 @@ import pytest
 
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
-from lmcr.srl.frames import extract_frames
+from lmcr.srl.mentions import extract_frames
 from lmcr.srl.parser import find_split, needs_reparse
 from lmcr.srl.priors import RolePriors
 from tests.srl_docs import make_doc

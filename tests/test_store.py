@@ -7,7 +7,7 @@ import shutil
 import duckdb
 import pytest
 
-from lmcr.config import REPO_ROOT
+from lmcr.checkout import REPO_ROOT
 from lmcr.store import ContractViolation, MigrationError, check_contracts, connect, list_migrations, migrate
 
 

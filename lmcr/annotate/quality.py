@@ -19,8 +19,7 @@ import numpy as np
 import pandas as pd
 
 from lmcr.files import atomic_path
-
-FRAME_KEY = ["verb", "role1", "arg1", "role2", "arg2"]
+from lmcr.frame import FRAME_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -43,7 +42,7 @@ def krippendorff_alpha(df: pd.DataFrame) -> float:
     """Interval alpha over the worker x frame reliability matrix (NaN where a worker did not rate)."""
     if df.empty:
         return float("nan")
-    table = df.pivot_table(index="worker_id", columns=FRAME_KEY, values="rating", aggfunc="mean")
+    table = df.pivot_table(index="worker_id", columns=list(FRAME_COLUMNS), values="rating", aggfunc="mean")
     if table.shape[0] < 2 or df["rating"].nunique() < 2:
         return float("nan")  # alpha is undefined with one rater or one value
     return float(krippendorff.alpha(reliability_data=table.to_numpy(dtype=float), level_of_measurement="interval"))
@@ -60,7 +59,7 @@ def alpha_by_verb(con: duckdb.DuckDBPyConnection) -> dict[str, float]:
 
 def _loo(df: pd.DataFrame) -> pd.DataFrame:
     """Per rating, the mean of the other workers' ratings of the same frame."""
-    grouped = df.groupby(FRAME_KEY)["rating"]
+    grouped = df.groupby(list(FRAME_COLUMNS))["rating"]
     total, count = grouped.transform("sum"), grouped.transform("count")
     return df.assign(others=(total - df["rating"]) / (count - 1)).query("others == others")  # drop lone ratings
 
@@ -68,7 +67,7 @@ def _loo(df: pd.DataFrame) -> pd.DataFrame:
 def _mace_spam(df: pd.DataFrame, seed: int = 0) -> dict[str, float]:
     from crowdkit.aggregation import MACE
 
-    data = pd.DataFrame({"task": df[FRAME_KEY].astype(str).agg("|".join, axis=1), "worker": df["worker_id"],
+    data = pd.DataFrame({"task": df[list(FRAME_COLUMNS)].astype(str).agg("|".join, axis=1), "worker": df["worker_id"],
                          "label": df["rating"]}).sort_values("worker", kind="stable")
     with warnings.catch_warnings():  # crowd-kit uses pandas' deprecated inplace= on every iteration
         warnings.simplefilter("ignore")
@@ -83,7 +82,7 @@ def dawid_skene(con: duckdb.DuckDBPyConnection) -> pd.DataFrame:
 
     df = ratings_frame(con)
     df = df[~df["frame_id"].isin(_gold(con).keys())]
-    task = df[FRAME_KEY].astype(str).agg("|".join, axis=1)
+    task = df[list(FRAME_COLUMNS)].astype(str).agg("|".join, axis=1)
     with warnings.catch_warnings():  # crowd-kit's deprecated pandas inplace= calls
         warnings.simplefilter("ignore")
         ds = DawidSkene(n_iter=100).fit_predict(pd.DataFrame({"task": task, "worker": df["worker_id"], "label": df["rating"]}))

@@ -21,11 +21,11 @@ from pathlib import Path
 import duckdb
 
 from lmcr.files import file_sha256
+from lmcr.frame import FRAME_COLUMNS
 from lmcr.jsonl import InputError, read_lines
 from lmcr.store import insert_rows, transaction
 
 META = ("HITId", "AssignmentId", "WorkerId", "AssignmentStatus")
-ITEM_FIELDS = ("verb", "role1", "arg1", "role2", "arg2")
 OPTIONAL_FIELDS = ("frame_id", "sentence")
 RATINGS = frozenset("12345")  # exactly these ASCII digits: str.isdigit() also accepts "٣" and "²"
 
@@ -84,14 +84,14 @@ def _slots(columns: list[str], path: Path) -> tuple[str, list[str]]:
 def _item(row: dict, suffix: str) -> tuple[dict | None, str | None]:
     """(item, None) for a valid slot, (item, reason) for a defective one, (None, None) for an empty slot."""
     get = lambda name: (row.get(name) or "").strip()  # noqa: E731
-    fields = {f: get(f"Input.{f}{suffix}") for f in ITEM_FIELDS + OPTIONAL_FIELDS}
+    fields = {f: get(f"Input.{f}{suffix}") for f in FRAME_COLUMNS + OPTIONAL_FIELDS}
     answer = get(f"Answer.rating{suffix}")
     if not any(fields.values()) and not answer:
         return None, None
     item = {**{f: fields[f] or None for f in OPTIONAL_FIELDS},
-            **{f: fields[f].lower() if f.startswith("arg") or f == "verb" else fields[f] for f in ITEM_FIELDS},
+            **{f: fields[f].lower() if f.startswith("arg") or f == "verb" else fields[f] for f in FRAME_COLUMNS},
             "item": int(suffix[1:]) if suffix else 1, "answer": answer}
-    empty = [f"Input.{f}{suffix}" for f in ITEM_FIELDS if not fields[f]]
+    empty = [f"Input.{f}{suffix}" for f in FRAME_COLUMNS if not fields[f]]
     if empty:
         return item, f"missing required input {', '.join(empty)}"
     if answer not in RATINGS:

@@ -27,12 +27,12 @@ import numpy as np
 
 from lmcr.annotate.hits import HitSettings
 from lmcr.files import atomic_dir, check_output_dir
-from lmcr.frame import Frame
+from lmcr.frame import FRAME_COLUMNS, Frame
 from lmcr.lexicon import load_lexicon
 from lmcr.lm.linearize import sentence_text
 
 MODES = ("protocol", "corpus", "disagreement")
-FIELDS = ("frame_id", "verb", "role1", "arg1", "role2", "arg2", "sentence")
+FIELDS = ("frame_id", *FRAME_COLUMNS, "sentence")
 TEMPLATE_DIR = Path(__file__).resolve().parents[2] / "annotation"
 
 

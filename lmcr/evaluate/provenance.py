@@ -10,7 +10,7 @@ import platform
 from pathlib import Path
 
 from lmcr import __version__
-from lmcr.config import REPO_ROOT, git_commit
+from lmcr.checkout import REPO_ROOT, git_commit
 from lmcr.files import file_sha256
 from lmcr.store import read_connection
 

@@ -16,11 +16,13 @@ from lmcr.evaluate.protocol import EvalConfig, Results, evaluate, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.report import write_report
 from lmcr.evaluate.scenarios import build_scenarios
-from lmcr.methods import COMPLETION_METHOD, MethodResources, lm_experts, lm_version_dir, make_scorer
-from lmcr.mixture import Mixture
-from lmcr.rarity import WEIGHT
+from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir
+from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.rarity import WEIGHT
+from lmcr.scorers.registry import COMPLETION_METHOD, make_scorer
+from lmcr.scorers.resources import MethodResources
+from lmcr.scorers.similar_verbs import NEIGHBOURS
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
-from lmcr.similar_verbs import NEIGHBOURS
 
 SETTINGS = tuple(s.label for s in ALL_SETTINGS)
 DEVIATIONS = [
@@ -45,13 +47,13 @@ DEVIATIONS = [
     "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
     "not a like-for-like comparison.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
-    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/counts.py). similar_verbs is not in the paper either: the same "
+    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/scorers/frame_counts.py). similar_verbs is not in the paper either: the same "
     f"two conditionals from the pair counts of the {NEIGHBOURS} verbs whose fillers are most like the predicate's "
-    "(similarity-based smoothing, lmcr/similar_verbs.py). 'a+b' sums two methods' log-probabilities "
+    "(similarity-based smoothing, lmcr/scorers/similar_verbs.py). 'a+b' sums two methods' log-probabilities "
     f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
-    "(lmcr/rarity.py: the score less how common the words are anyway, a PMI); context_pmi is the term "
+    "(lmcr/scorers/rarity.py: the score less how common the words are anyway, a PMI); context_pmi is the term "
     "that weighs what an instruction's purpose says of each filler, learned from the sentences that name "
-    "both (lmcr/context_pmi.py), 0 on the rated "
+    "both (lmcr/scorers/context_pmi.py), 0 on the rated "
     "frames, which have no context; "
     f"{COMPLETION_METHOD} is what `lmcr complete` uses by default.",
 ]

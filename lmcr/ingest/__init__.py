@@ -7,8 +7,8 @@ single writer, replacing that source's earlier rows in one transaction.
 
 from __future__ import annotations
 
-from lmcr.ingest.detect import FORMATS, Source, detect_format, expand_corpora, expand_inputs, parse_source
 from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.ingest.sources import FORMATS, Source, detect_format, expand_corpora, expand_inputs, parse_source
 from lmcr.ingest.stage import StagedFile, already_loaded, load_staged, stage
 
 __all__ = [

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import duckdb
 
-from lmcr.ingest.detect import Source, parse_source
+from lmcr.ingest.sources import Source, parse_source
 from lmcr.ingest.stage import StagedFile, already_loaded, load_staged, stage
 from lmcr.store import check_contracts, named_query, query_dicts
 

@@ -10,8 +10,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from lmcr.files import atomic_path
-from lmcr.ingest.detect import Source
 from lmcr.ingest.records import IngestError, ParsedFile
+from lmcr.ingest.sources import Source
 from lmcr.store import insert_rows, transaction
 
 DOCUMENT_SCHEMA = pa.schema([

@@ -10,7 +10,7 @@ import torch
 from torch import nn
 from torch.nn import functional as F
 
-from lmcr.lm.config import LMConfig
+from lmcr.lm.hyperparams import LMConfig
 
 
 class RecurrentLM(nn.Module):

@@ -11,10 +11,10 @@ from pathlib import Path
 import duckdb
 
 import lmcr
-from lmcr.config import git_commit
+from lmcr.checkout import git_commit
 from lmcr.lm import checkpoint as ckpt
-from lmcr.lm.config import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
+from lmcr.lm.hyperparams import MIN_FREQ, LMConfig, TrainConfig
 from lmcr.lm.model import RecurrentLM
 from lmcr.lm.train import train_lm
 from lmcr.lm.vocab import Vocab

@@ -333,7 +333,7 @@ def add_context(scores: list[float], gains_of: Callable[[list[int]], list[float]
 
 
 class MixedLM:
-    """Corpus LMs interpolated, P(frame) = sum_i w_i P_i(frame) (the weights from `lmcr/mixture.py`),
+    """Corpus LMs interpolated, P(frame) = sum_i w_i P_i(frame) (the weights from `lmcr/scorers/mixture.py`),
     with the context read by the first, the LM of every corpus: log P(frame) + log P_1(context | frame).
 
     Only the first reads it because only its corpus teaches purposes: 5% of the recipe sentences have a

@@ -11,8 +11,8 @@ from contextlib import contextmanager
 import torch
 
 from lmcr.errors import LMCRError
-from lmcr.lm.config import TrainConfig
 from lmcr.lm.data import bucket_batches
+from lmcr.lm.hyperparams import TrainConfig
 from lmcr.lm.model import RecurrentLM
 
 PRECISIONS = ("auto", "bf16", "fp32")

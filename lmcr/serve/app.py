@@ -25,8 +25,8 @@ from starlette.exceptions import HTTPException
 
 from lmcr.errors import LMCRError, one_line
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD
-from lmcr.reply import error_outcome, say
+from lmcr.robot.reply import error_outcome, say
+from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.serve.robot import MAX_AUDIO_BYTES, MAX_OBJECTS, Pending, RequestError, ServedRobot, read_reply
 from lmcr.workspace import Workspace
 

@@ -19,8 +19,8 @@ from pathlib import Path
 from lmcr.errors import LMCRError, one_line
 from lmcr.jsonl import check_text
 from lmcr.lexicon import load_lexicon
-from lmcr.methods import COMPLETION_METHOD
-from lmcr.reply import LEAVE_IT, say
+from lmcr.robot.reply import LEAVE_IT, say
+from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
 
 MAX_OBJECTS = 10  # a person picks a handful; the 1.2 m x 0.7 m table holds about this many
@@ -79,7 +79,7 @@ def check_labels(objects: list[str]) -> list[str]:
 
 def make_layout(labels: list[str], seed: int):
     """The scene: the labelled objects placed at random (seeded) where they fit on the table."""
-    from lmcr.executor.scene import make_scene
+    from lmcr.robot.scene import make_scene
 
     return make_scene([(label, None) for label in labels], seed, "scene")
 
@@ -87,7 +87,10 @@ def make_layout(labels: list[str], seed: int):
 def read_reply(reply: str, pending: Pending) -> dict:
     """A person's answer to `pending`: {"answer": {role: object}} to act on, {"pending", "said"} to ask
     again, or {"left": True, "said"} when the robot gives up (a refused offer, MAX_TRIES unusable answers)."""
-    from lmcr.dialogue import MAX_TRIES, read_answer  # here: it imports the parser (seconds), the page need not wait
+    from lmcr.robot.dialogue import (  # here: it imports the parser (seconds), the page need not wait
+        MAX_TRIES,
+        read_answer,
+    )
 
     reading = read_answer(reply, pending.choices, pending.allowed, load_lexicon().objects)
     if pending.kind == "offer":  # only the offered object is taken, as in `lmcr robot`
@@ -151,8 +154,8 @@ class ServedRobot:
         """Execute the instruction in simulation (with a person's `answer`, role -> object, when given) and
         record it: the result, the animation's id, what the robot says, and its offer when the choice was
         out of reach but another object is not."""
-        from lmcr.executor.execute import execute
-        from lmcr.executor.render import Recorder
+        from lmcr.robot.execute import execute
+        from lmcr.robot.render import Recorder
         from lmcr.srl.parser import read_instruction
 
         text, labels = check_instruction(instruction), check_labels(objects)

@@ -9,6 +9,7 @@ different predicate or object word in the same place, the robot asks instead of 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 from lmcr.jsonl import InputError, read_jsonl
@@ -58,14 +59,13 @@ def read_listen_input(path: Path) -> list[tuple[int, dict]]:
     return list(read_jsonl(path, required=LISTEN_FIELDS))
 
 
-def listen_batch(records: list[tuple[int, dict]], base: Path, recognizer: Recognizer, parser: FrameParser) -> list[dict]:
-    """Each record {id, audio} (audio relative to `base` or absolute) heard and parsed; a line whose
-    audio cannot be decoded gets an `error` and the batch goes on."""
-    results = []
+def listen_batch(records: list[tuple[int, dict]], base: Path, recognizer: Recognizer, parser: FrameParser
+                 ) -> Iterator[dict]:
+    """Each record {id, audio} (audio relative to `base` or absolute) heard and parsed, in order, as soon as
+    each is done; a line whose audio cannot be decoded gets an `error` and the batch goes on."""
     for line, rec in records:
         audio = Path(rec["audio"]) if Path(rec["audio"]).is_absolute() else base / rec["audio"]
         try:
-            results.append({"id": rec["id"], "audio": rec["audio"], **listen(recognizer, parser, audio)})
+            yield {"id": rec["id"], "audio": rec["audio"], **listen(recognizer, parser, audio)}
         except (AudioError, InputError) as exc:
-            results.append({"id": rec["id"], "audio": rec["audio"], "error": f"line {line}: {exc}"})
-    return results
+            yield {"id": rec["id"], "audio": rec["audio"], "error": f"line {line}: {exc}"}

@@ -18,8 +18,8 @@ from spacy.tokens import Doc, Token
 from lmcr.lexicon import Lexicon
 from lmcr.srl.arguments import NOUN_TAGS, argument_value
 from lmcr.srl.compounds import Compounds
-from lmcr.srl.frames import FrameMention
 from lmcr.srl.lemmas import lemma as lemma_of
+from lmcr.srl.mentions import FrameMention
 
 CONTENT_TAGS = ("NN", "VB", "JJ")  # nouns, verbs, adjectives (Penn tags: hand-built Docs have no POS)
 CLAUSE_BREAKS = frozenset({",", ";", ":", ".", "!", "?"})

@@ -25,11 +25,11 @@ from lmcr.files import read_resource
 from lmcr.jsonl import check_text
 from lmcr.lexicon import Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
-from lmcr.srl.frames import FrameMention, extract_frames
 from lmcr.srl.lemmas import LazyLemmas
+from lmcr.srl.mentions import FrameMention, extract_frames
 from lmcr.srl.priors import RolePriors
 from lmcr.srl.repair import rejoin_split_compounds
-from lmcr.workspace import spacy_model_from_env
+from lmcr.srl.spacy_model import spacy_model_from_env
 
 # Tried in order; "You should" forces a verb reading where "Please" leaves a bare "season" a noun.
 PREFIXES = ("Please ", "You should ")

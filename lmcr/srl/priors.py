@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from lmcr.files import atomic_path, read_resource
-from lmcr.srl.frames import FrameMention
+from lmcr.srl.mentions import FrameMention
 
 SMOOTHING = 1.0
 

@@ -1,5 +1,5 @@
 -- sentences (recipe steps, titles and ingredient lines, narrations, program steps) that hold each word,
--- that name each object phrase, and that do both: what the context term (lmcr/context_pmi.py) learns
+-- that name each object phrase, and that do both: what the context term (lmcr/scorers/context_pmi.py) learns
 -- from. A sentence is its unit: a purpose and the object it needs are named in one ("boil the pasta in a
 -- pot"), where a whole recipe names every tool it uses for every purpose.
 -- $phrases: a regex alternation of escaped, lowercase object phrases (longest first; the last word may

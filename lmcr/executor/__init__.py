@@ -1,1 +1,0 @@
-"""The robot end: a simulated Baxter (pybullet) that detects, completes, plans and executes."""

@@ -1,0 +1,91 @@
+"""Loading parsed shards into the store: one transaction that replaces the frame tables, learns role
+priors from the unambiguous frames, resolves the ambiguous ones and records the build."""
+
+from __future__ import annotations
+
+import duckdb
+
+from lmcr.frame_corpus.shards import ShardResult
+from lmcr.lexicon import load_lexicon
+from lmcr.srl.mentions import FrameMention
+from lmcr.srl.priors import RolePriors
+from lmcr.store import insert_rows, transaction
+
+_PRIOR_COUNTS = """
+select f.predicate, r.value, r.role, count(*)
+from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no)
+where f.known and list_contains(?, f.predicate) and f.ambiguous_role is null
+  and not exists (select 1 from frame_roles m
+                  where m.corpus = f.corpus and m.doc_id = f.doc_id and m.sent_id = f.sent_id
+                    and m.frame_no = f.frame_no and m.value is null)
+group by all
+"""
+
+
+def learn_priors(con: duckdb.DuckDBPyConnection) -> RolePriors:
+    """Role preferences from fully specified, syntactically unambiguous alternating-verb frames."""
+    alternating = [name for name, spec in load_lexicon().predicates.items() if spec.alternating]
+    priors = RolePriors()
+    for verb, value, role, n in con.execute(_PRIOR_COUNTS, [alternating]).fetchall():
+        priors.by_verb[(verb, value, role)] += n
+        priors.pooled[(value, role)] += n
+    return priors
+
+
+def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int:
+    """Move lone objects of alternating verbs to the role the priors prefer; return how many moved."""
+    rows = con.execute(
+        "select f.corpus, f.doc_id, f.sent_id, f.frame_no, f.predicate, f.ambiguous_role, r.role, r.value "
+        "from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
+        "where f.known and f.ambiguous_role is not null order by all"
+    ).fetchall()
+    frames: dict[tuple, FrameMention] = {}
+    for corpus, doc_id, sent_id, frame_no, predicate, ambiguous, role, value in rows:
+        frame = frames.setdefault((corpus, doc_id, sent_id, frame_no), FrameMention(predicate, {}, True, 0, 0, {}, ambiguous))
+        frame.roles[role] = value
+    lex = load_lexicon()
+    flipped = []
+    for key, frame in frames.items():
+        roles = lex.predicates[frame.predicate].roles
+        frame.roles = {r: frame.roles.get(r) for r in roles}
+        if priors.resolve(frame).roles != frame.roles:
+            flipped.append((*key, frame.ambiguous_object, next(r for r in roles if r != frame.ambiguous_object)))
+    if flipped:
+        con.execute("create or replace temp table _flipped (corpus varchar, doc_id varchar, sent_id integer, "
+                    "frame_no integer, default_role varchar, other_role varchar)")
+        con.executemany("insert into _flipped values (?, ?, ?, ?, ?, ?)", flipped)
+        # Both role rows swap names: the value moves to the other role, the null to the default one.
+        con.execute(
+            "update frame_roles set role = case when frame_roles.role = x.default_role then x.other_role "
+            "else x.default_role end from _flipped x where frame_roles.corpus = x.corpus "
+            "and frame_roles.doc_id = x.doc_id and frame_roles.sent_id = x.sent_id and frame_roles.frame_no = x.frame_no"
+        )
+        con.execute("update frames set resolved_by_prior = true from _flipped x where frames.corpus = x.corpus "
+                    "and frames.doc_id = x.doc_id and frames.sent_id = x.sent_id and frames.frame_no = x.frame_no")
+        con.execute("drop table _flipped")
+    return len(flipped)
+
+
+def load_frames(con: duckdb.DuckDBPyConnection, results: list[ShardResult], build: dict) -> RolePriors:
+    """Replace the frame tables with the parsed shards, resolve ambiguous objects, record the build:
+    one transaction, so a failure leaves the previous corpus in place."""
+    with transaction(con):
+        con.execute("delete from frame_roles")
+        con.execute("delete from frames")
+        if results:
+            con.execute("insert into frames select * from read_parquet(?)", [[r.frames_path for r in results]])
+            con.execute("insert into frame_roles select * from read_parquet(?)", [[r.roles_path for r in results]])
+        priors = learn_priors(con)
+        resolve_ambiguous(con, priors)
+        known = con.execute("select count(*) filter (where known), count(*) from frames").fetchone()
+        con.execute("delete from frame_builds where fingerprint = ?", [build["fingerprint"]])
+        insert_rows(con, "frame_builds", [{
+            **{k: build[k] for k in ("fingerprint", "sentences", "words", "reparsed", "wall_s", "words_per_s")},
+            "kinds": ",".join(build["kinds"]), "shards": len(results), "frames": known[1], "known_frames": known[0],
+            "reparse_kept": build["kept"]}])
+    return priors
+
+
+def last_build(con: duckdb.DuckDBPyConnection) -> str | None:
+    row = con.execute("select fingerprint from frame_builds order by built_at desc limit 1").fetchone()
+    return row[0] if row else None

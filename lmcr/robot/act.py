@@ -1,0 +1,122 @@
+"""Acting out a feasible plan in the simulation: follow each planned path with the joint motors, grasp,
+pour or let go where the program says, then run the task's checks on what happened."""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as p
+
+from lmcr.robot.arm import relative_pose, settle
+from lmcr.robot.plan import Plan, Planner, pick_steps, shifted
+from lmcr.robot.scene import SceneObject
+from lmcr.robot.tasks import Outcome
+
+TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
+MOVED = 0.02  # metres: an object not in the task that moved further was knocked
+# a poured drop or grain, 6 mm across: twice that, they piled up like marbles and rolled off round food
+# (cinnamon shaken over an apple: 0.21-0.38 stayed on it, 0.75-0.96 at this size)
+GRAIN_RADIUS = 0.003
+FINGERS_SET = 60  # simulation steps (1/4 s) for the fingers to take their shape before the arm moves
+
+
+def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject],
+             planner: Planner | None = None) -> dict:
+    """Execute `plan` (its task); the result's `checks` hold the task's checks (and `knocked`: the ids of the
+    `others`, the objects not in the task, that did not stay where they were) and `success` whether all
+    passed. With the `planner`, a grasp that left the object in the hand otherwise than planned has the
+    rest planned afresh."""
+    lead = plan.first or plan  # the arm that moves first starts at home, the other parked, both hands open
+    for a, q in ((lead.other, lead.other.parked), (lead.arm, lead.arm.home)):
+        a.set_config(q)
+        a.hold(q)
+        a.open_fingers()
+    if plan.first is not None:  # an object set down out of the way or within reach; the checks start from there
+        _act(plan.first, plan.first.geometry.held, Outcome(), planner=planner)
+        settle(120)
+    before = {o.id: p.getBasePositionAndOrientation(o.body)[0] for o in others}  # by id: two cups are two
+    target_at = p.getBasePositionAndOrientation(target.body)[0]
+    out = Outcome()
+    grasped, released, knocked_during = _act(plan, held, out, others, before, planner)
+    if out.particles or released:
+        settle(480)  # let what was poured or let go come to rest
+    checks = plan.task.check(held, target, out) if grasped else {"ok": False}
+    log = [w for a in plan.moving_arms for w in a.log]  # both parts' waypoints, in order
+    within = all(w["error_m"] <= TOLERANCE for w in log)
+    moved = _moved(others, before)
+    # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
+    # but the reason to name when they do
+    pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
+    return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": log,
+            "target_moved_m": round(pushed, 3), "replanned_after_grasp": out.replanned,
+            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
+                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
+            **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
+
+
+def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] = (),
+         before: dict[str, tuple] | None = None, planner: Planner | None = None) -> tuple[bool, bool, dict[str, str]]:
+    """Follow the plan's segments: move, grasp, let go and pour where it says. Returns whether the grasp
+    held, whether the object was let go, and for each of the `others` found moved (from `before`) the
+    step during which it was first seen moved. Once the object is picked up, when it sits in the hand
+    otherwise than planned, the rest is planned afresh (kept as planned when no new plan is found)."""
+    arm = plan.arm
+    if plan.carried is not None:  # handed over: the fingers are closed on it from the start
+        arm.shape_fingers(arm.finger_targets(plan.half_width), now=True)
+        plan.carried.place(arm)
+        arm.attach(held.body)
+    else:  # the hand takes the shape it was planned to approach in before it moves
+        arm.shape_fingers(plan.fingers)
+        if not arm.fingers_at(plan.fingers):
+            settle(FINGERS_SET)
+    grasped, released = True, False
+    knocked_during: dict[str, str] = {}
+    segments, picked = list(plan.segments), pick_steps([s.step for s in plan.segments])
+    k = 0
+    while k < len(segments):
+        step = segments[k].step
+        if step.moves:
+            arm.follow(segments[k].path)
+            arm.record(step.name, segments[k].goal)
+            if step.probe:
+                out.probes[step.probe] = (p.getBasePositionAndOrientation(held.body)[0], p.getAABB(held.body))
+        elif step.kind == "grasp":
+            grasped = arm.grasp(held.body, plan.half_width)
+            if not grasped:
+                break  # nothing in the hand: the rest of the program would act out nothing
+        elif step.kind == "release":
+            arm.release(plan.fingers)
+            released = True
+        elif step.kind == "spill":
+            out.particles += spill(held, plan.geometry.opening, step.particles)
+        for ident in _moved(others, before or {}):
+            knocked_during.setdefault(ident, step.name)
+        k += 1
+        if k == picked and planner is not None:
+            in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+            again = planner.replan_in_hand(plan, in_hand) if shifted(plan.geometry.in_hand(plan.variant), in_hand) else None
+            if again is not None:
+                plan, segments[k:], out.replanned = again, again.segments, True
+    return grasped, released, knocked_during
+
+
+def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
+    """The ids of the objects (not in the task) that are now more than MOVED from where they stood."""
+    return sorted(o.id for o in others
+                  if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.id])) > MOVED)
+
+
+def spill(held: SceneObject, opening: float, n: int) -> list[int]:
+    """A stream of particles (liquid or powder) leaving the held container's opening (`opening` above
+    its origin), one at a time: particles created on top of each other would push each other apart."""
+    shape = p.createCollisionShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS)
+    visual = p.createVisualShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS, rgbaColor=[0.2, 0.4, 0.9, 1])
+    rng = np.random.default_rng(n)
+    bodies = []
+    for _ in range(n):
+        pos, orn = p.getBasePositionAndOrientation(held.body)
+        mouth = np.asarray(p.multiplyTransforms(pos, orn, [0, 0, opening], [0, 0, 0, 1])[0])
+        body = p.createMultiBody(0.002, shape, visual, list(mouth + rng.normal(0, 0.002, 3)))
+        p.changeDynamics(body, -1, lateralFriction=1.0, rollingFriction=0.02, spinningFriction=0.02)  # grains stay put
+        bodies.append(body)
+        settle(12)
+    return bodies

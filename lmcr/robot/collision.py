@@ -1,0 +1,75 @@
+"""Collision checks of arm configurations for planning: the arm, and whatever it carries, against the
+table, the objects and the rest of the robot, with pybullet's closest-point queries on joints set
+kinematically (nothing is simulated)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pybullet as p
+
+from lmcr.robot.arm import Arm
+
+CLEARANCE = 0.01  # metres kept from obstacles (the joints track a path only to a few millimetres)
+CONTACT_CLEARANCE = 0.003  # ... but from the table while grasping, lifting or lowering into the target
+
+
+@dataclass(frozen=True)
+class Carried:
+    """An object in the hand: its pose relative to the gripper."""
+
+    body: int
+    rel_pos: tuple
+    rel_orn: tuple
+
+    def place(self, arm: Arm) -> None:
+        ee_pos, ee_orn = arm.ee_pose()
+        pos, orn = p.multiplyTransforms(ee_pos.tolist(), ee_orn, self.rel_pos, self.rel_orn)
+        p.resetBasePositionAndOrientation(self.body, pos, orn)
+
+
+class Clearance:
+    """`clash(q, ...)`: the first thing the arm at joints `q` (with what it carries) comes too close to."""
+
+    def __init__(self, arm: Arm, obstacles: dict[int, str]):
+        self.arm = arm
+        self.obstacles = obstacles  # body -> name ("the table", "the cup")
+        self.self_pairs = self._self_pairs()
+
+    def _self_pairs(self) -> list[tuple[int, int]]:
+        """Links of this arm beyond the elbow against the torso, the pedestal and the other arm, less the
+        pairs that touch in the home pose (the simple link shapes overlap at some joints)."""
+        robot, arm = self.arm.robot, self.arm
+        distal = [link for link in range(arm.joints[3], p.getNumJoints(robot))
+                  if p.getJointInfo(robot, link)[12].decode().startswith(arm.side)]
+        ours = set(range(arm.joints[0], distal[-1] + 1))
+        others = [link for link in range(-1, p.getNumJoints(robot)) if link not in ours
+                  and not (link >= 0 and p.getJointInfo(robot, link)[12].decode() == f"{arm.side}_arm_mount")]
+        saved = arm.config()
+        arm.set_config(arm.home)
+        pairs = [(a, b) for a in distal for b in others
+                 if not p.getClosestPoints(robot, robot, 0.0, linkIndexA=a, linkIndexB=b)]
+        arm.set_config(saved)
+        return pairs
+
+    def clash(self, q, carried: Carried | None = None, ignore: frozenset[int] = frozenset(),
+              margin: float = CLEARANCE, tight: frozenset[int] = frozenset()) -> str | None:
+        """What the arm at `q` is within `margin` of (None: clear). `ignore`: bodies allowed to touch
+        (the object about to be grasped, the target the motion goes into); `tight`: bodies it may come
+        within CONTACT_CLEARANCE of (the table under a grasp)."""
+        arm = self.arm
+        arm.set_config(q)
+        if carried is not None:
+            carried.place(arm)
+        for body, name in self.obstacles.items():
+            if body in ignore or (carried is not None and body == carried.body):
+                continue
+            gap = CONTACT_CLEARANCE if body in tight else margin
+            if p.getClosestPoints(arm.robot, body, gap):
+                return name
+            if carried is not None and p.getClosestPoints(carried.body, body, gap):
+                return name
+        for a, b in self.self_pairs:
+            if p.getClosestPoints(arm.robot, arm.robot, 0.0, linkIndexA=a, linkIndexB=b):
+                return "the robot's own body"
+        return None

@@ -1,0 +1,229 @@
+"""One instruction in simulation: build the scene, detect the objects, complete the instruction with
+the detected labels, plan and execute the predicate's motion, and check the outcome.
+
+The completion names labels; the executor picks the objects. When several objects have a label (three
+cups), their combinations for the task's two roles are planned nearest first (the least reach to the held
+object plus carry to the target) until one is feasible, and the result names the one acted on by id."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pybullet as p
+
+from lmcr.complete import CompletionConfig, complete
+from lmcr.errors import LMCRError, one_line
+from lmcr.jsonl import InputError, check_text, read_jsonl_lines
+from lmcr.robot.act import run_plan
+from lmcr.robot.detect import detect
+from lmcr.robot.plan import Infeasible, Plan, Planner
+from lmcr.robot.render import Recorder
+from lmcr.robot.reply import say
+from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
+from lmcr.robot.tasks import TASKS
+from lmcr.robot.world import build_world
+
+MAX_TRIED = 4  # candidates planned at most, in the language model's order, to find one the robot can do
+MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (nearest first)
+ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (table frame): both arms reach there
+
+
+class ExecutionError(LMCRError, ValueError):
+    """The completed frame names something the robot cannot act on here; `absent` is the label not on the table."""
+
+    def __init__(self, message: str, absent: str | None = None):
+        super().__init__(message)
+        self.absent = absent
+
+
+def _connect() -> None:
+    if not p.isConnected():
+        p.connect(p.DIRECT)
+
+
+def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
+            recorder: Recorder | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
+    """The CLI contract's result: frame, chosen object (`chosen_object` its label, `chosen_id` which of the
+    objects with that label; `role_ids` the object of every role), waypoint errors, per-verb checks,
+    success, whether the plan was feasible, and what the robot says (`reply`). The robot moves only when
+    the whole plan is feasible. When the language model's choice is not but another candidate is, nothing
+    moves and the result asks (`question`, `suggestion`). A `recorder` takes a picture at the start, at
+    every waypoint and at the end. `answer` (role -> object) is what a person answered: it fills those
+    roles instead. `urdf`: the official Baxter description to use instead of ours."""
+    started = time.perf_counter()
+    _connect()
+    robot = build_world(scene, cache_dir, urdf)
+    seen = detect(scene.bodies)
+    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
+    completed = time.perf_counter()
+    planner = Planner(robot, scene, scene.table)
+    options = _options(completion, answer)[:MAX_TRIED]
+    tried = []  # (frame, candidate, role -> object, plan or why not)
+    for frame, candidate in options:
+        for objects in _assignments(scene, frame, {d.id for d in seen})[:MAX_INSTANCES]:
+            tried.append((frame, candidate, objects, _plan(planner, scene, frame, objects)))
+            if isinstance(tried[-1][3], Plan):
+                break
+        if isinstance(tried[-1][3], Plan):
+            break
+    planned = time.perf_counter()
+    # the language model's choice, as the first of its objects the robot can act on (else the nearest)
+    first = [t for t in tried if t[0] is options[0][0]]
+    frame, candidate, objects, result = next((t for t in first if isinstance(t[3], Plan)), first[0])
+    role = _chosen_role(completion, candidate, answer)
+    out = {"frame": frame, "chosen_object": _chosen(candidate, answer),
+           "chosen_id": objects[role].id if role in objects else None,
+           "role_ids": {r: o.id for r, o in objects.items()}, "feasible": isinstance(result, Plan),
+           "success": False, "waypoints": [], "checks": {}, "missing": completion["missing"],
+           "question": completion["question"], "holding": scene.holding.label if scene.holding else None,
+           "ranking": _ranking(completion, tried),
+           "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]}
+                          for d in seen]}
+    if isinstance(result, Infeasible):
+        out.update(_refusal(out, result, tried))
+    else:
+        task = TASKS[frame["predicate"]]
+        held, target = objects[task.held_role], objects[task.target_role]
+        if recorder is not None:
+            recorder.target, recorder.held = target.id, held.id
+            for arm in result.moving_arms:
+                arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
+            recorder.shot(f"{frame['predicate']} {held.id} -> {target.id}: start")
+        out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)],
+                            planner))
+        out["set_down_first"] = result.first.geometry.held.id if result.first else None
+        if recorder is not None:  # what was poured or put down, once it has come to rest
+            recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
+        out["arm"] = result.arm.side
+    out["reply"] = say(out, parser.lex)
+    done = time.perf_counter()
+    out["seconds"] = {"perceive_and_complete": round(completed - started, 3), "plan": round(planned - completed, 3),
+                      "execute": round(done - planned, 3), "plan_and_execute": round(done - completed, 3)}
+    return out
+
+
+def _options(completion: dict, answer: dict[str, str] | None) -> list[tuple[dict, dict | None]]:
+    """The frames worth planning, best first: the answered one, else one per candidate in the language
+    model's order (just the completed frame when nothing was missing)."""
+    frame = completion["frame"]
+    if answer:
+        return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **answer}}, None)]
+    if not completion["candidates"]:
+        return [(frame, None)]
+    return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **c["objects"]}}, c)
+            for c in completion["candidates"]]
+
+
+def _assignments(scene: Scene, frame: dict, seen: set[str]) -> list[dict[str, SceneObject]]:
+    """The objects the frame's two roles may be done with (role -> object; one per role, never one object
+    for both), nearest first: the reach from the robot's edge to the held object (none when it is in the
+    hand) plus its carry to the target. An object is one the camera saw or the one in the hand."""
+    task = TASKS[frame["predicate"]]
+    choices = []
+    for role in (task.held_role, task.target_role):
+        label = frame["roles"][role]
+        found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
+        if not found:
+            there = ", ".join(o.id for o in scene.objects)
+            raise ExecutionError(f"cannot {frame['predicate']} here: no {label!r} on the table (there are: {there})",
+                                 absent=label)
+        choices.append(found)
+
+    def effort(pair: tuple[SceneObject, SceneObject]) -> float:
+        held, target = (ROBOT_EDGE if o is scene.holding else o.xy for o in pair)
+        return math.dist(ROBOT_EDGE, held) + math.dist(held, target)
+
+    pairs = sorted((pair for pair in itertools.product(*choices) if pair[0] is not pair[1]), key=effort)
+    if not pairs:  # "pour the cup into the cup" with one cup
+        raise ExecutionError(f"cannot {frame['predicate']} here: there is one {choices[0][0].label}, not two")
+    return [{task.held_role: held, task.target_role: target} for held, target in pairs]
+
+
+def _plan(planner: Planner, scene: Scene, frame: dict, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+    task = TASKS[frame["predicate"]]
+    held, target = objects[task.held_role], objects[task.target_role]
+    holding = scene.holding is not None and held is scene.holding
+    if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
+        return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
+    direct = planner.plan(task, held, target, holding)
+    if isinstance(direct, Plan):
+        return direct
+    # set down elsewhere first: the held object when no arm reaches all the task as it stands (from the
+    # table it may be picked up by either arm, in any grasp), else, with the hand free, the object on
+    # the table a pose would put the arm against
+    blocking = None if holding else planner.on_table(direct.blocker)
+    moved = held if direct.out_of_reach else blocking
+    if moved is None:
+        return direct
+    rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
+    return rearranged if isinstance(rearranged, Plan) else direct
+
+
+def _chosen(candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+    if answer:
+        return next(iter(answer.values()))
+    return candidate["object"] if candidate else None
+
+
+def _chosen_role(completion: dict, candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+    """The role of the chosen object: the one answered, or the completion's missing one."""
+    if answer:
+        return next(iter(answer))
+    return completion["missing"] if candidate else None
+
+
+def _ranking(completion: dict, tried: list) -> list[dict]:
+    """The candidates by language-model probability x feasibility (1 planned feasible with one of its
+    objects, 0 with none, unknown when not planned: those keep their probability and rank after the
+    feasible ones)."""
+    feasible: dict[str, bool] = {}
+    for _, c, _, r in tried:
+        if c is not None:
+            feasible[c["object"]] = feasible.get(c["object"], False) or isinstance(r, Plan)
+    rows = [{"object": c["object"], "probability": c["probability"], "feasible": feasible.get(c["object"])}
+            for c in completion["candidates"]]
+    return sorted(rows, key=lambda r: -(r["probability"] * (r["feasible"] is not False)))
+
+
+def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
+    """Why nothing moved (`out` the result so far), and the question to ask when another candidate is
+    feasible (`suggestion` its objects by label, `suggestion_ids` by id)."""
+    why = {"reason": result.reason, "out_of_reach": result.out_of_reach, "blocker": result.blocker or None}
+    alternative = next(((c, objects) for _, c, objects, r in tried if isinstance(r, Plan)), None)
+    if alternative is None:
+        return why
+    c, objects = alternative
+    offer = {"suggestion": c["objects"], "suggestion_ids": {role: objects[role].id for role in c["objects"]}}
+    return {**why, **offer, "question": say({**out, **why, **offer})}
+
+
+BATCH_FIELDS = {"id": (str, int), "instruction": str}
+
+
+def execute_batch(path: Path, run: Callable[[str, Scene], dict]) -> Iterator[dict]:
+    """The batch form of the CLI contract: one output line per input line, in order. Each line gives an
+    instruction and a `scene` object or a `scene_file` (relative to the input's folder); `run` executes
+    one. A bad line (not JSON, a bad scene, an instruction that cannot be completed or acted on) gets
+    `{"id", "error"}` and the rest go on; only an unreadable input file raises."""
+    for line_no, record, error in read_jsonl_lines(path, BATCH_FIELDS):
+        ident = record.get("id") if isinstance(record, dict) else None
+        try:
+            if error is not None:
+                raise error
+            scene = _batch_scene(record, Path(path).parent, f"{path}:{line_no}")
+            yield {"id": ident, **run(check_text(record["instruction"], f"{path}:{line_no}"), scene)}
+        # every LMCR error is a ValueError/RuntimeError; the simulator raises its own type
+        except (ValueError, KeyError, RuntimeError, p.error) as exc:
+            yield {"id": ident, "line": line_no, "error": one_line(exc)}
+
+
+def _batch_scene(record: dict, base: Path, where: str) -> Scene:
+    if "scene" in record:
+        return scene_from_json(record["scene"], f"{where}: scene")
+    if isinstance(record.get("scene_file"), str):
+        return load_scene(base / record["scene_file"])
+    raise InputError(f"{where}: needs a 'scene' object or a 'scene_file' path")

@@ -1,0 +1,400 @@
+"""One motion program per predicate: the steps (gripper poses, grasp, release, pouring) that act out a
+completed frame, computed from the objects' geometry, and the checks that say whether it worked.
+
+A program is built for one way of doing the task (`Variant`: the gripper's turn about the vertical when
+it grasps, the direction it tilts to pour); the planner tries variants until one is feasible. Poses are
+exact, not corrected while moving: the held object's pose in the hand is known from the grasp, so the
+gripper pose that puts a bottle's mouth over the cup's centre is computed, not searched for.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pybullet as p
+
+from lmcr.robot.arm import DOWN, relative_pose
+from lmcr.robot.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, outline, world_xy
+
+CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
+TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
+POUR_HEIGHT = 0.10  # the opening this far above the target's rim: low enough to aim, high enough for the hand
+DUMP_HEIGHTS = (0.03, 0.07, 0.11)  # the dumped object's middle this far above the target's rim, tried in turn
+SHAKE_HEIGHT = 0.18  # a shaker's opening above the target: flat targets (pizza, steak) leave the hand no room lower
+SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
+SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
+PITCHES = (0.0, 0.5)
+TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
+GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
+GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
+PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
+
+
+@dataclass(frozen=True)
+class Step:
+    """A gripper pose to reach (`kind` "move", first reachable of `positions`), or an action."""
+
+    kind: str  # move | home, park (to the arm's start, out of the way) | grasp | release | spill
+    name: str = ""
+    positions: tuple = ()
+    orientation: tuple = DOWN
+    # what this motion may touch, "held" | "target", or "table" (a lift from it); it may also pass close
+    # over the table, the rest is kept clear
+    touches: str = ""
+    probe: str = ""  # a name to record the held object's pose under once the pose is reached
+    particles: int = 0
+    # the held object goes into the target through its opening: though the motion may touch the target
+    # (what is in it), the object must pass the walls clear
+    into: bool = False
+
+    @property
+    def moves(self) -> bool:
+        """Whether the arm moves in this step (to a gripper pose, or to its start or parked configuration)."""
+        return self.kind in ("move", "home", "park")
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One way to do the task (radians): the gripper's yaw when grasping, how far it leans away from the
+    robot (reaching the far side of the table needs the hand pitched forward) and the way it tilts."""
+
+    yaw: float = 0.0  # a side grasp's heading: the horizontal direction the gripper points in
+    pitch: float = 0.0
+    tilt_sign: int = 1  # which way it turns to pour
+    side: bool = False  # grasped from the side (bottles and shakers, to pour), not by the top
+    turn: float = 0.0  # how far the hand turns about the vertical between the grasp and the target
+    shift: tuple = (0.0, 0.0)  # a top grasp this far (x, y metres) from the top's middle, along a long object
+    narrow: bool = False  # a top grasp approached with the fingers closed to the object's width
+
+    def half_across(self, label: str) -> float:
+        """Half the object's width between the fingers: a round one's radius, or a box's extent along
+        the line a top grasp's fingers close on (across a long object's narrow side)."""
+        half_x, half_y, round_ = outline(label)
+        if self.side or round_:
+            return footprint(label)
+        return abs(math.sin(self.yaw)) * half_x + abs(math.cos(self.yaw)) * half_y
+
+    def approach_width(self, label: str) -> float | None:
+        """The half-width the fingers are set for on the way to the grasp (None: fully open). A top
+        grasp's fingertips stop above the object, so a `narrow` one comes with the fingers closed to its
+        width and passes close to its neighbours; open fingers forgive an object that stands a few
+        millimetres off where it was planned (one just set down), so they are tried first."""
+        return self.half_across(label) if self.narrow and not self.side else None
+
+    def at_target(self) -> tuple:
+        """The gripper orientation over the target: the grasp's, turned about the vertical (the held
+        object stays upright)."""
+        return _turned(self.upright(), self.turn)
+
+    def upright(self) -> tuple:
+        """The gripper orientation that grasps, and carries the grasped object upright."""
+        if self.side:  # gripper axis horizontal along the heading, fingers either side of the object
+            return p.getQuaternionFromEuler((0, math.pi / 2, self.yaw))
+        lean = p.getQuaternionFromAxisAngle((0, 1, 0), -self.pitch)  # gripper axis towards +x (away)
+        return p.multiplyTransforms([0, 0, 0], lean, [0, 0, 0], _turned(DOWN, self.yaw))[1]
+
+
+@dataclass
+class Geometry:
+    """The task's objects as they stand when planning starts (measured once: planning moves the held
+    object about): the held one's pose (in the hand when it is already held) and the target's top
+    centre and outline."""
+
+    held: SceneObject
+    target: SceneObject
+    held_pos: tuple = ()
+    held_orn: tuple = ()
+    held_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    target_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    target_box: tuple = ()
+    grasped: tuple | None = None  # the held object's pose in the hand as found after the grasp, if not as planned
+
+    @classmethod
+    def measure(cls, held: SceneObject, target: SceneObject) -> Geometry:
+        pos, orn = p.getBasePositionAndOrientation(held.body)
+        lo, hi = p.getAABB(target.body)
+        tpos, _ = p.getBasePositionAndOrientation(target.body)
+        return cls(held, target, pos, orn, np.array([pos[0], pos[1], p.getAABB(held.body)[1][2]]),
+                   np.array([tpos[0], tpos[1], hi[2]]), (lo, hi))
+
+    def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
+        """The gripper pose that grasps the held object by its top, or from the side around its body
+        (high enough for the hand to clear the table)."""
+        if variant.side:
+            return self.held_top - [0, 0, height(self.held.label) - side_grip_height(self.held.label)], variant.upright()
+        return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
+
+    def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
+        """The held object's pose relative to the gripper after the grasp (as found, once it is known)."""
+        if self.grasped is not None:
+            return self.grasped
+        return relative_pose(*self.grip_pose(variant), self.held_pos, self.held_orn)
+
+    def point_in_hand(self, variant: Variant, local) -> np.ndarray:
+        """A point given in the held object's frame, in the gripper's frame."""
+        rel_pos, rel_orn = self.in_hand(variant)
+        return np.asarray(p.multiplyTransforms(rel_pos, rel_orn, local, [0, 0, 0, 1])[0])
+
+    @property
+    def opening(self) -> float:
+        """How far the held object's opening (just above its top) is above its origin, in its own frame."""
+        return self.held_top[2] - self.held_pos[2] + 0.012
+
+    def mouth(self, variant: Variant) -> np.ndarray:
+        """The held object's opening in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.opening])
+
+    def bottom(self, variant: Variant) -> np.ndarray:
+        """The middle of the held object's underside in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) - self.held_pos[2]])
+
+    def centre(self, variant: Variant) -> np.ndarray:
+        """The held object's middle in the gripper's frame."""
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
+
+
+def side_grip_height(label: str) -> float:
+    """How far above the table a side grasp holds the object: SIDE_GRIP of its height, at least SIDE_GRIP_MIN."""
+    return max(SIDE_GRIP * height(label), SIDE_GRIP_MIN)
+
+
+def _turned(orientation, yaw: float) -> tuple:
+    """`orientation` turned by `yaw` about the vertical."""
+    return p.multiplyTransforms([0, 0, 0], p.getQuaternionFromEuler((0, 0, yaw)), [0, 0, 0], orientation)[1]
+
+
+def tilted(variant: Variant) -> tuple:
+    """The gripper orientation with the grasped object turned TILT: a side grasp rolls the wrist about
+    the gripper's axis; a top grasp turns about the line between the fingers (about any other axis a
+    finger would end up under the opening, in the way of what pours)."""
+    upright = variant.at_target()
+    axis = np.asarray(p.getMatrixFromQuaternion(upright)).reshape(3, 3)[:, 2 if variant.side else 1]
+    turn = p.getQuaternionFromAxisAngle(axis.tolist(), variant.tilt_sign * TILT)
+    return p.multiplyTransforms([0, 0, 0], turn, [0, 0, 0], upright)[1]
+
+
+def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
+    """The gripper position that puts a point of the hand (gripper frame) at `goal` in orientation `orientation`."""
+    offset = p.multiplyTransforms([0, 0, 0], orientation, point_in_hand.tolist(), [0, 0, 0, 1])[0]
+    return np.asarray(goal) - offset
+
+
+def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False) -> list[Variant]:
+    """The grasps that suit the held object's shape (fingers across a long object; a round one also from
+    the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
+    forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
+    object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
+    robot towards the object."""
+    half_x, half_y, round_ = outline(held.label)
+    yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
+    if round_:  # a square box held across its corners would not fit between fingers set for its sides
+        yaws += [math.pi / 4, -math.pi / 4]
+    if not round_ and abs(2 * half_x - 2 * half_y) > 0.02:
+        long_x = half_x > half_y
+        yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
+        # a long object may also be held nearer either end, the hand then further from a neighbour
+        reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
+        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
+    signs = (1, -1) if turns else (1,)
+    top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
+           for turn in TURNS for sign in signs]
+    narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
+    if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
+        return top + narrow  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
+    x, y = world_xy(held.xy)
+    heading = math.atan2(y, x)
+    side = [Variant(heading + a, 0.0, sign, side=True, turn=turn) for a in (0.0, 0.5, -0.5) for turn in TURNS
+            for sign in signs]
+    return side + top + narrow
+
+
+def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:
+    return Step("move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation,
+                touches)
+
+
+def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "", into: bool = False) -> Step:
+    return Step("move", name, (np.asarray(position, dtype=float),), orientation, touches, probe, into=into)
+
+
+def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Approach from above and grasp the top, or from the side around the body; lift (nothing to do
+    when the object is already in the hand)."""
+    if holding:
+        return []
+    pos, orn = g.grip_pose(v)
+    name = g.held.name
+    if v.side:
+        back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
+        return [move(f"next to {name}", pos - back, orn), move(f"grip {name}", pos, orn, touches="held"),
+                Step("grasp", f"grasp {name}"), move(f"lift {name}", pos + [0, 0, 0.12], orn, touches="table")]
+    return [above(pos, f"above {name}", orn), move(f"grip {name}", pos, orn, touches="held"),
+            Step("grasp", f"grasp {name}"), above(pos, f"lift {name}", orn, touches="table")]
+
+
+def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
+    """Carrying height with the held object's middle over the target's."""
+    orn = v.at_target()
+    offset = gripper_for(g.centre(v), orn, [0, 0, 0])
+    return above(g.target_top + offset, name or f"over {g.target.name}", orn)
+
+
+def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the opening above the target's centre, tilted; let the liquid run; turn back upright."""
+    tilt = tilted(v)
+    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, POUR_HEIGHT])
+    return [*pick(g, v, holding), over_target(g, v), move("tilt to pour", spout, tilt),
+            Step("spill", "pour", particles=30), over_target(g, v)]
+
+
+def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the shaker's opening above the target, tilted, and shake three times."""
+    tilt = tilted(v)
+    spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, SHAKE_HEIGHT])
+    steps = [*pick(g, v, holding), over_target(g, v), move("tilt", spout, tilt)]
+    for k in range(3):
+        steps += [move(f"shake {k + 1} down", spout - [0, 0, 0.02], tilt), Step("spill", "shake", particles=8),
+                  move(f"shake {k + 1} up", spout, tilt)]
+    return [*steps, over_target(g, v)]
+
+
+def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -> list[Step]:
+    """Lower the held object into or onto the target and let go (heat, fry; blend also presses)."""
+    depth = CONTAINERS.get(g.target.label, (0, 0, 0))[2]
+    orn, t = v.at_target(), g.target_top
+    drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
+    # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
+    bottom = max(t[2] - depth + 0.015, t[2] + 0.01 - drop)
+    lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
+    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.name}", lower, orn,
+                                                            touches="target"), Step("release", "let go")]
+    if press:
+        steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
+    return [*steps, above(t, "retreat", orn)]
+
+
+def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Carry the object over the target, turn the hand over and let go."""
+    tilt = tilted(v)
+    # lowest first (what falls stays where it lands); higher ones when the hand, turned, would meet the rim
+    turned = tuple(gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.label) / 2])
+                   for h in DUMP_HEIGHTS)
+    return [*pick(g, v, holding), over_target(g, v), Step("move", "turn over", turned, tilt), Step("release", "let go"),
+            over_target(g, v)]
+
+
+def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Lower the held object below the target's rim, then lift it back out. Into a container (a bowl of
+    batter) it must pass the walls; food that is not served in one (flour, a shaker here) it presses into."""
+    orn, t = v.at_target(), g.target_top
+    dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
+    out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
+    into = g.target.label in CONTAINERS
+    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=into),
+            move("lift out", out, orn, touches="target", probe="lifted")]
+
+
+def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the object just above the target's surface and stroke across it four times."""
+    orn, t = v.at_target(), g.target_top
+    lo, hi = g.target_box
+    reach = max(0.02, (hi[0] - lo[0]) / 2 - 0.03)
+    # the held object's underside skims the surface, 1 cm above it
+    strokes = [move(f"stroke {k + 1}", gripper_for(g.bottom(v), orn, t + [reach if k % 2 else -reach, 0, 0.01]),
+                    orn, touches="target", probe=f"stroke {k + 1}") for k in range(4)]
+    return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
+
+
+def put_down(xy: tuple[float, float]) -> Task:
+    """Pick the object up (unless it is in the hand), set it down upright at the free table spot `xy`
+    and park the arm: the object is in the way of a task in the hand or out of one arm's reach, and the
+    task then starts afresh from there."""
+    def program(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+        orn = v.at_target()
+        lower = gripper_for(g.bottom(v), orn, [*world_xy(xy), TABLE_TOP + PUT_DOWN_HEIGHT])
+        return [*pick(g, v, holding), above(lower, "over a free spot", orn),
+                move(f"put the {g.held.name} down", lower, orn, touches="table"), Step("release", "let go"),
+                above(lower, "away from it", orn), Step("park", "out of the way")]
+
+    return Task("", "", program, lambda held, target, out: {"ok": True})
+
+
+@dataclass
+class Outcome:
+    """What happened while the program ran: particles poured, the held object's poses at probes, whether
+    the rest was planned afresh after the pick-up."""
+
+    particles: list[int] = field(default_factory=list)
+    probes: dict[str, tuple] = field(default_factory=dict)  # name -> (position, AABB)
+    replanned: bool = False
+
+
+def inside(target: SceneObject, point, above: float = 0.05) -> bool:
+    """Whether a point lies within the target's outline, above the table and at most `above` over its
+    rim (0.01: held in it, as a liquid must be; more: resting on top of it)."""
+    lo, hi = p.getAABB(target.body)
+    return lo[0] <= point[0] <= hi[0] and lo[1] <= point[1] <= hi[1] and TABLE_TOP - 0.01 <= point[2] <= hi[2] + above
+
+
+def share_inside(target: SceneObject, bodies: list[int], above: float) -> float:
+    hits = sum(inside(target, p.getBasePositionAndOrientation(b)[0], above) for b in bodies)
+    return round(hits / max(len(bodies), 1), 3)
+
+
+def check_pour(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    share = share_inside(target, out.particles, above=0.01)  # a liquid must stay inside, below the rim
+    return {"liquid_in_target": share, "ok": share >= 0.6}
+
+
+def check_sprinkle(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    share = share_inside(target, out.particles, above=0.05)
+    return {"powder_on_target": share, "ok": share >= 0.6}
+
+
+def check_in_target(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    ok = inside(target, p.getBasePositionAndOrientation(held.body)[0])
+    return {"in_target": ok, "ok": ok}
+
+
+def check_dip(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    rim = p.getAABB(target.body)[1][2]
+    pos, box = out.probes["dip"]
+    dipped = box[0][2] < rim and inside(target, pos)
+    lifted = out.probes["lifted"][1][0][2] > rim
+    return {"dipped_below_rim": bool(dipped), "lifted_out": bool(lifted), "ok": bool(dipped and lifted)}
+
+
+def check_stroke(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    lo, hi = p.getAABB(target.body)
+    on = all(lo[0] - 0.02 <= pos[0] <= hi[0] + 0.02 and lo[1] - 0.02 <= pos[1] <= hi[1] + 0.02
+             for name, (pos, _) in out.probes.items() if name.startswith("stroke"))
+    return {"over_target": bool(on), "ok": bool(on)}
+
+
+@dataclass(frozen=True)
+class Task:
+    held_role: str  # the role whose object the gripper holds
+    target_role: str  # the role whose object it acts on
+    program: Callable[[Geometry, Variant, bool], list[Step]]
+    check: Callable[[SceneObject, SceneObject, Outcome], dict]
+    pours: bool = False  # the held object's contents run out of its opening
+    turns: bool = False  # the held object is turned over (pouring or dumping): either way will do
+
+
+TASKS = {
+    "pour": Task("Theme", "Destination", program_pour, check_pour, pours=True, turns=True),
+    "fill": Task("Theme", "Destination", program_pour, check_pour, pours=True, turns=True),
+    "sprinkle": Task("Theme", "Destination", program_sprinkle, check_sprinkle, pours=True, turns=True),
+    "season": Task("Instrument", "Theme", program_sprinkle, check_sprinkle, pours=True, turns=True),
+    "heat": Task("Theme", "Instrument", program_place, check_in_target),
+    "fry": Task("Theme", "Instrument", program_place, check_in_target),
+    "blend": Task("Theme", "Destination", lambda g, v, h: program_place(g, v, h, press=True), check_in_target),
+    "dump": Task("Theme", "Destination", program_dump, check_in_target, turns=True),
+    "dip": Task("Theme", "Destination", program_dip, check_dip),
+    "brush": Task("Theme", "Destination", program_stroke, check_stroke),
+    "rub": Task("Theme", "Destination", program_stroke, check_stroke),
+}
+

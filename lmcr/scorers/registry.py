@@ -1,0 +1,231 @@
+"""The scorer registry: each method's name, how its scorer is built from the resources, and what a
+completion calibration of it is valid for. A scorer takes complete frames and returns one float each
+(higher = more plausible); 'a+b' sums two methods' scores."""
+
+from __future__ import annotations
+
+import functools
+import random
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+from lmcr.files import file_sha256
+from lmcr.lexicon import load_lexicon
+from lmcr.scorers.caches import count_cache, word_vectors
+from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir, load_lm
+from lmcr.scorers.resources import (
+    MethodResources,
+    corpus_sentences,
+    corpus_words,
+    robot_terms,
+    store_corpus_hash,
+    store_path,
+)
+from lmcr.setting import LM_METHODS
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from lmcr.frame import Frame
+
+# The scorers' own modules (torch, gensim, scipy) are imported where a scorer is built, so that the
+# command line and light commands start fast (`bench/bench_cli.py`).
+
+# What completes instructions by default: the sentence LM times the frame counts times what the verbs
+# most like the predicate do with the same fillers (lmcr/scorers/similar_verbs.py), less how common the fillers
+# are anyway (lmcr/scorers/rarity.py), plus what the instruction's purpose says of each filler
+# (lmcr/scorers/context_pmi.py; 0 without one, so on the rated frames). The household weight under which it runs is
+# chosen on both dev sets (lmcr/evaluate/choose_mixture.py); its figures are in the README.
+COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi"
+
+
+class Scorer(Protocol):
+    """Complete frames in, one float each out (higher = more plausible; log-probabilities for the LMs
+    and frame_counts, so that 'a+b' sums are products of experts). `context` is the rest of the
+    instruction ("for my tea", `srl.context`): scorers that can read text take it, the others ignore it,
+    and "" scores as if there were none."""
+
+    def __call__(self, frames: list[Frame], context: str = "") -> list[float]: ...
+
+
+@dataclass(frozen=True)
+class ScorerSpec:
+    """How to build a method's scorer from the resources (a function of the frames, and of the context
+    when `reads_context`), and what a completion calibration of it is valid for (None: not calibrated)."""
+
+    build: Callable[[MethodResources], Callable[..., list[float]]]
+    fingerprint: Callable[[MethodResources], str | None] = lambda res: None
+    reads_context: bool = False
+
+
+def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
+    def build(res: MethodResources):
+        from lmcr.lm.score import MixedLM
+
+        experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
+        return experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
+    return build
+
+
+def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
+    def fingerprint(res: MethodResources) -> str:
+        return ",".join(file_sha256(lm_version_dir(res, linearization, corpus) / "manifest.json")
+                        for corpus, _ in lm_experts(res))
+    return fingerprint
+
+
+def _frame_counts(res: MethodResources) -> Scorer:
+    from lmcr.scorers.frame_counts import FrameCountScorer
+
+    counts = FrameCountScorer.from_store(store_path(res, "frame_counts"), res.sql_dir, res.corpus, mixture=res.mixture)
+    return counts.score_frames
+
+
+def _similar_verbs(res: MethodResources) -> Scorer:
+    from lmcr.scorers.similar_verbs import MIN_PAIRS, NEIGHBOURS, SimilarVerbs
+
+    db = store_path(res, "similar_verbs")
+    cache = count_cache(res, "similar-verbs", "frame", f"-{NEIGHBOURS}-{MIN_PAIRS}")
+    return SimilarVerbs.cached(db, res.sql_dir, load_lexicon(), res.corpus, res.mixture, cache).score_frames
+
+
+def _similar_verbs_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.similar_verbs import MIN_PAIRS, NEIGHBOURS, WEIGHT
+
+    return f"{_frame_corpus_hash(res)}*{WEIGHT:g}/{NEIGHBOURS}/{MIN_PAIRS}"
+
+
+def _frame_corpus_hash(res: MethodResources) -> str:
+    return store_corpus_hash(res.db, "frame")
+
+
+def _rarity(res: MethodResources) -> Scorer:
+    from lmcr.scorers.rarity import PhraseCounts
+
+    db = store_path(res, "rarity", "sentences")
+    counts = PhraseCounts(db, res.sql_dir, corpus_words(res), res.corpus, res.mixture)
+    # the detector's objects up front (completion then never scans), cached by the corpus content
+    counts.count_cached(load_lexicon().objects, count_cache(res, "phrases", "sentence"))
+    return counts.rarity
+
+
+def _rarity_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.rarity import WEIGHT
+
+    return f"{store_corpus_hash(res.db, 'sentence')}*{WEIGHT:g}"
+
+
+def _context_pmi(res: MethodResources) -> Scorer:
+    from lmcr.scorers.context_pmi import ContextCooccurrence
+
+    store_path(res, "context_pmi", "sentences")
+    corpora = res.mixture.parts(res.corpus)
+    cache = count_cache(res, "context-sentences", "sentence")
+
+    @functools.cache
+    def counts() -> ContextCooccurrence:  # counted (or read) at the first context: rated frames have none
+        return ContextCooccurrence.cached(res.db, res.sql_dir, load_lexicon().objects, corpora, cache)
+
+    weight = res.context_weight
+    return lambda frames, context="": counts().score(frames, context, weight) if context else [0.0] * len(frames)
+
+
+def _context_pmi_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.context_pmi import MIN_SENTENCES
+
+    return f"{store_corpus_hash(res.db, 'sentence')}*{res.context_weight:g}/{MIN_SENTENCES}/sentences"
+
+
+def _cooccur(res: MethodResources) -> Scorer:
+    from lmcr.scorers.baselines.cooccur import CooccurrenceScorer
+    from lmcr.scorers.baselines.terms import default_lemmatizer
+
+    return CooccurrenceScorer(corpus_sentences(res), default_lemmatizer(res.spacy_model), robot_terms()).score_frames
+
+
+def _word2vec(res: MethodResources) -> Scorer:
+    from lmcr.scorers.baselines.vectors import VectorScorer, load_vectors
+
+    return VectorScorer(load_vectors(word_vectors(res))).score_frames
+
+
+def _conceptnet_edges(res: MethodResources) -> Path:
+    if res.conceptnet is None:
+        raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+    return res.conceptnet
+
+
+def _conceptnet(res: MethodResources) -> Scorer:
+    from lmcr.scorers.baselines.conceptnet import ConceptNetScorer
+
+    return ConceptNetScorer.from_path(_conceptnet_edges(res)).score_frames
+
+
+def _conceptnet_retrofit(res: MethodResources) -> Scorer:
+    from lmcr.scorers.baselines.conceptnet import read_edges, relatedness
+    from lmcr.scorers.baselines.retrofit import retrofit
+    from lmcr.scorers.baselines.vectors import VectorScorer, load_vectors
+
+    retrofitted = VectorScorer(retrofit(read_edges(_conceptnet_edges(res)), load_vectors(word_vectors(res))))
+    return relatedness(retrofitted.vector)
+
+
+def _random(res: MethodResources) -> Scorer:
+    rng = random.Random(res.seed)
+    return lambda frames: [rng.random() for _ in frames]
+
+
+# The methods, in the order reports list them: a new method is one entry here. The sentence LM reads
+# the instruction's context after the filled frame, as one more stretch of text; the frame LM learned
+# bare frames, where a purpose clause never occurs.
+SCORERS: dict[str, ScorerSpec] = {
+    **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
+       for method, lin in LM_METHODS.items()},
+    "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
+    "similar_verbs": ScorerSpec(_similar_verbs, _similar_verbs_fingerprint),
+    "cooccur": ScorerSpec(_cooccur),
+    "word2vec": ScorerSpec(_word2vec),
+    "conceptnet": ScorerSpec(_conceptnet),
+    "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
+    "random": ScorerSpec(_random),
+    "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
+    "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
+}
+
+
+METHODS = tuple(SCORERS)
+TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
+# what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
+# its third expert
+EVALUATED = (*METHODS[:4], "sentence_lm+frame_counts", COMPLETION_METHOD.replace("+similar_verbs", ""),
+             COMPLETION_METHOD, *(m for m in METHODS[4:] if m not in TERMS))
+
+
+def make_scorer(method: str, res: MethodResources) -> Scorer:
+    """The scorer of `method`; 'a+b' sums the scores of methods a and b (for log-probability methods,
+    a product of experts)."""
+    if "+" in method:
+        parts = [make_scorer(m, res) for m in method.split("+")]
+        return lambda frames, context="": [sum(s) for s in zip(*(part(frames, context) for part in parts))]
+    if method not in SCORERS:
+        raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+    spec = SCORERS[method]
+    score = spec.build(res)
+    if spec.reads_context:
+        return lambda frames, context="": score(frames, context=context)
+    return lambda frames, context="": score(frames)
+
+
+def scorer_fingerprint(method: str, res: MethodResources) -> str | None:
+    """What a completion calibration of `method` is valid for: each part's fingerprint (an LM's
+    checkpoint manifest sha256, the frame corpus hash), joined; None when any part is not calibrated."""
+    parts = [SCORERS[m].fingerprint(res) if m in SCORERS else None for m in method.split("+")]
+    if None in parts:
+        return None
+    return "+".join(parts) + (f"@{res.mixture.label}" if res.mixed else "")
+
+
+def is_method_name(column: str) -> bool:
+    """Whether `column` is named like a method or a sum of methods: scores are written under such names."""
+    return column in METHODS or "+" in column
