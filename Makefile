@@ -26,6 +26,7 @@ test: setup
 	-$(MAKE) browser
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
 	$(BIN)/ruff check lmcr flows tests bench docs
+	$(BIN)/ruff format --check lmcr flows tests bench docs
 	$(BIN)/python -m pytest -q --durations=10
 
 # Headless Chromium from the npm registry (@sparticuz/chromium bundles the binary) for the HIT preview check.

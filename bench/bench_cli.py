@@ -20,8 +20,12 @@ TARGET_S = 1.5
 
 def timed(args: list[str], env_dir: str) -> float:
     started = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "lmcr.cli", *args], capture_output=True, check=False,
-                   env={"LMCR_DATA_DIR": env_dir, "PATH": "/usr/bin:/bin"})
+    subprocess.run(
+        [sys.executable, "-m", "lmcr.cli", *args],
+        capture_output=True,
+        check=False,
+        env={"LMCR_DATA_DIR": env_dir, "PATH": "/usr/bin:/bin"},
+    )
     return time.perf_counter() - started
 
 
@@ -32,9 +36,15 @@ def main() -> None:
     args = parser.parse_args()
     figures = {"runs per command": args.runs, "target median s": TARGET_S}
     with tempfile.TemporaryDirectory() as data:
-        commands = {"--help": ["--help"], "--version": ["--version"], "migrate": ["migrate"],
-                    "query corpus_summary": ["query", "corpus_summary"], "schema": ["schema"],
-                    "srl-eval --help": ["srl-eval", "--help"], "execute --help": ["execute", "--help"]}
+        commands = {
+            "--help": ["--help"],
+            "--version": ["--version"],
+            "migrate": ["migrate"],
+            "query corpus_summary": ["query", "corpus_summary"],
+            "schema": ["schema"],
+            "srl-eval --help": ["srl-eval", "--help"],
+            "execute --help": ["execute", "--help"],
+        }
         print(f"{'command':<26} {'median s':>9} {'max s':>7}  target <= {TARGET_S} s")
         for name, argv in commands.items():
             times = [timed(argv, data) for _ in range(args.runs)]

@@ -42,14 +42,17 @@ def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs:
         complete(parser, scorer, instruction, objects, config)
         times.append(time.perf_counter() - started)
     times.sort()
-    return {"objects": len(objects), "median ms": round(1000 * statistics.median(times), 2),
-            "p90 ms": round(1000 * times[int(0.9 * runs)], 2)}
+    return {
+        "objects": len(objects),
+        "median ms": round(1000 * statistics.median(times), 2),
+        "p90 ms": round(1000 * times[int(0.9 * runs)], 2),
+    }
 
 
 def filled_scene(record: dict, size: int) -> dict:
     """The record with its objects followed by robot-vocabulary objects it lacks, up to `size` in all."""
     objects = list(dict.fromkeys([*record["objects"], *load_lexicon().objects]))
-    return {**record, "objects": objects[:max(size, len(record["objects"]))]}
+    return {**record, "objects": objects[: max(size, len(record["objects"]))]}
 
 
 def main() -> None:
@@ -57,9 +60,12 @@ def main() -> None:
     parser_.add_argument("--instructions", type=Path, required=True)
     parser_.add_argument("--method", default=COMPLETION_METHOD)
     parser_.add_argument("--corpus", default="all")
-    parser_.add_argument("--mixture", default=None, help="corpus weights (household=30, plain); default: the chosen one")
-    parser_.add_argument("--context-weight", type=float, default=None,
-                         help="weight of the context term; default: the chosen one")
+    parser_.add_argument(
+        "--mixture", default=None, help="corpus weights (household=30, plain); default: the chosen one"
+    )
+    parser_.add_argument(
+        "--context-weight", type=float, default=None, help="weight of the context term; default: the chosen one"
+    )
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
     parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
     parser_.add_argument("--scene-size", type=int, default=0, help="fill each scene with other objects up to this")
@@ -72,24 +78,38 @@ def main() -> None:
     scorer, config = ws.completion_scorer(args.method, res)
     config = replace(config, context=not args.no_context)
     parser = ws.parser()
-    setting = (f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
-               f"{f'weight {res.context_weight:g}' if config.context else 'off'})")
+    setting = (
+        f"{args.method} ({args.corpus}, mixture {res.mixture.label}, context "
+        f"{f'weight {res.context_weight:g}' if config.context else 'off'})"
+    )
     print(f"{setting}; {config.source}")
-    figures = {"method": setting, "instructions file": args.instructions.name, "scene size": args.scene_size or "as given"}
+    figures = {
+        "method": setting,
+        "instructions file": args.instructions.name,
+        "scene size": args.scene_size or "as given",
+    }
     records = load_instructions(args.instructions)
     if args.scene_size:
         records = [filled_scene(r, args.scene_size) for r in records]
         print(f"scenes filled to {args.scene_size} objects with the robot vocabulary")
     accuracy = instruction_accuracy(parser, scorer, config, records)
     print(accuracy.summary())
-    figures |= {"instructions right": f"{accuracy.right}/{accuracy.total}", "accuracy": round(accuracy.accuracy, 3),
-                "answered right without a question": accuracy.answered_right, "questions asked": accuracy.asked,
-                "questions whose best guess is right": accuracy.asked_right}
+    figures |= {
+        "instructions right": f"{accuracy.right}/{accuracy.total}",
+        "accuracy": round(accuracy.accuracy, 3),
+        "answered right without a question": accuracy.answered_right,
+        "questions asked": accuracy.asked,
+        "questions whose best guess is right": accuracy.asked_right,
+    }
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
         took = latency(parser, scorer, config, instruction, runs=args.runs)
-        print(f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
-              f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)")
-        figures |= {f"latency {instruction!r}, {took['objects']} objects: {k}": v for k, v in took.items() if k != "objects"}
+        print(
+            f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
+            f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)"
+        )
+        figures |= {
+            f"latency {instruction!r}, {took['objects']} objects: {k}": v for k, v in took.items() if k != "objects"
+        }
     write_results(args.json, "bench_complete", __doc__.splitlines()[0], figures)
 
 

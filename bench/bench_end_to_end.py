@@ -8,8 +8,8 @@ candidates the instruction's author did not weigh); a stated object that is not 
 the robot's hand (`"holding"`). One
 `lmcr execute --input IN.jsonl --output OUT.jsonl` process (the published checkpoint and store of
 $LMCR_DATA_DIR) runs them all. Prints: completed right (the frame is the expected one), executed
-successfully, both, executed plans that failed, refused before moving, errors; per predicate; then every instruction that is not
-both right and successful, with why.
+successfully, both, executed plans that failed, refused before moving, errors; per predicate; then
+every instruction that is not both right and successful, with why.
 """
 
 from __future__ import annotations
@@ -72,7 +72,9 @@ def main() -> None:
     work = args.work or Path(tempfile.mkdtemp(prefix="lmcr-e2e-"))
     work.mkdir(parents=True, exist_ok=True)
     inp, outp = work / "in.jsonl", work / "out.jsonl"
-    inp.write_text("".join(json.dumps(batch_line(r, args.seed * 1000 + k, args.distractors)) + "\n" for k, r in enumerate(records)))
+    inp.write_text(
+        "".join(json.dumps(batch_line(r, args.seed * 1000 + k, args.distractors)) + "\n" for k, r in enumerate(records))
+    )
     outp.unlink(missing_ok=True)
     command = [sys.executable, "-m", "lmcr.cli", "execute", "--input", str(inp), "--output", str(outp)]
     command += ["--method", args.method] if args.method else []
@@ -86,27 +88,45 @@ def main() -> None:
         why = verdict(r, out)
         right = "error" not in out and out["frame"] == r["expected"]
         done = "error" not in out and out.get("success", False)
-        for key, hit in (("n", True), ("right", right), ("success", done), ("both", why == "ok"),
-                         ("failed", "error" not in out and out["feasible"] and not done),
-                         ("refused", "error" not in out and not out["feasible"]), ("error", "error" in out)):
+        for key, hit in (
+            ("n", True),
+            ("right", right),
+            ("success", done),
+            ("both", why == "ok"),
+            ("failed", "error" not in out and out["feasible"] and not done),
+            ("refused", "error" not in out and not out["feasible"]),
+            ("error", "error" in out),
+        ):
             rows[key] += hit
             per[pred][key] += hit
         if why != "ok":
             misses.append(f"  {r['id']} {r['instruction']!r}: {why}")
     n = rows["n"]
-    print(f"{n} instructions, seed {args.seed}, {args.distractors} distractors: completed right {rows['right']}/{n} = "
-          f"{rows['right'] / n:.3f}; executed successfully {rows['success']}/{n} = {rows['success'] / n:.3f}; "
-          f"**both {rows['both']}/{n} = {rows['both'] / n:.3f}**; executed plans that failed {rows['failed']}; "
-          f"refused before moving {rows['refused']}; errors {rows['error']}")
+    print(
+        f"{n} instructions, seed {args.seed}, {args.distractors} distractors: completed right {rows['right']}/{n} = "
+        f"{rows['right'] / n:.3f}; executed successfully {rows['success']}/{n} = {rows['success'] / n:.3f}; "
+        f"**both {rows['both']}/{n} = {rows['both'] / n:.3f}**; executed plans that failed {rows['failed']}; "
+        f"refused before moving {rows['refused']}; errors {rows['error']}"
+    )
     for pred, c in sorted(per.items()):
-        print(f"  {pred:9s} both {c['both']}/{c['n']} (right {c['right']}, succeeded {c['success']}, refused {c['refused']})")
+        print(
+            f"  {pred:9s} both {c['both']}/{c['n']} (right {c['right']}, succeeded {c['success']}, "
+            f"refused {c['refused']})"
+        )
     print("not both right and successful:" if misses else "every instruction right and successful")
     print("\n".join(misses))
-    figures = {"instructions": n, "seed": args.seed, "distractors per scene": args.distractors,
-               "completed right": f"{rows['right']}/{n}", "executed successfully": f"{rows['success']}/{n}",
-               "both": f"{rows['both']}/{n}", "both, share": round(rows["both"] / n, 3),
-               "executed plans that failed": rows["failed"], "refused before moving": rows["refused"],
-               "errors": rows["error"]}
+    figures = {
+        "instructions": n,
+        "seed": args.seed,
+        "distractors per scene": args.distractors,
+        "completed right": f"{rows['right']}/{n}",
+        "executed successfully": f"{rows['success']}/{n}",
+        "both": f"{rows['both']}/{n}",
+        "both, share": round(rows["both"] / n, 3),
+        "executed plans that failed": rows["failed"],
+        "refused before moving": rows["refused"],
+        "errors": rows["error"],
+    }
     figures |= {f"{pred}: both": f"{c['both']}/{c['n']}" for pred, c in sorted(per.items())}
     write_results(args.json, "bench_end_to_end", __doc__.splitlines()[0], figures)
 

@@ -5,11 +5,11 @@ Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--see
 For each of the 11 predicates, an incomplete instruction on `--placements` random layouts: the two
 objects the frame needs plus `--distractors` random other objects (obstacles, and other candidates for
 the completion), placed at random with a seed. With `--holding` the stated object starts in the robot's
-hand instead of on the table (for fill and season it is the target: the robot puts it down first). The task's own object is given as the answer, so the run measures
-execution; how often the language model (the published checkpoint of $LMCR_DATA_DIR) would have chosen
-another object is counted beside it. Prints per predicate: executed successfully / executed, refused
-before moving (infeasible), then a histogram of failure and refusal reasons, and the time to plan and
-execute one instruction.
+hand instead of on the table (for fill and season it is the target: the robot puts it down first).
+The task's own object is given as the answer, so the run measures execution; how often the language
+model (the published checkpoint of $LMCR_DATA_DIR) would have chosen another object is counted beside it.
+Prints per predicate: executed successfully / executed, refused before moving (infeasible), then a
+histogram of failure and refusal reasons, and the time to plan and execute one instruction.
 """
 
 from __future__ import annotations
@@ -72,9 +72,13 @@ def failure_reason(out: dict, held: str, target: str) -> str:
 def refusal_reason(out: dict) -> str:
     """The refusal's kind: out of reach, an obstacle, no clear path."""
     reason = out.get("reason", "")
-    for key, name in (("cannot reach", "out of reach"), ("no clear way", "no collision-free path"),
-                      ("against the table", "pose hits the table"), ("against", "pose hits an object"),
-                      ("hand is full", "hand full")):
+    for key, name in (
+        ("cannot reach", "out of reach"),
+        ("no clear way", "no collision-free path"),
+        ("against the table", "pose hits the table"),
+        ("against", "pose hits an object"),
+        ("hand is full", "hand full"),
+    ):
         if key in reason:
             return name
     return reason[:40]
@@ -102,8 +106,9 @@ def main() -> None:
     parser_.add_argument("--seed", type=int, default=0)
     parser_.add_argument("--predicates", default=",".join(TASKS), help="comma-separated subset")
     parser_.add_argument("--urdf", help="a Baxter URDF to use instead of the built-in one (LMCR_BAXTER_URDF)")
-    parser_.add_argument("--holding", action="store_true",
-                         help="the stated object starts in the hand (fill, season: put down first)")
+    parser_.add_argument(
+        "--holding", action="store_true", help="the stated object starts in the hand (fill, season: put down first)"
+    )
     add_json_option(parser_, "bench_executor")
     args = parser_.parse_args()
     if args.urdf:
@@ -118,10 +123,18 @@ def main() -> None:
         instruction, stated, expected, role = TASKS[predicate]
         row = collections.Counter()
         for k in range(args.placements):
-            scene = random_scene(f"{args.seed}:{predicate}:{k}", stated, expected, objects, args.distractors,
-                                 stated if args.holding else None)
+            scene = random_scene(
+                f"{args.seed}:{predicate}:{k}",
+                stated,
+                expected,
+                objects,
+                args.distractors,
+                stated if args.holding else None,
+            )
             started = time.perf_counter()
-            out = execute(instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf)
+            out = execute(
+                instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf
+            )
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])
             slowest.append((times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
             lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
@@ -138,26 +151,40 @@ def main() -> None:
                 reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
         totals.update(row)
         per_predicate[f"{predicate}: succeeded"] = f"{row['ok']}/{args.placements}"
-        print(f"{predicate:9s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
-              f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "
-              f"would have chosen another object than {expected!r} {row['other_choice']} times", flush=True)
+        print(
+            f"{predicate:9s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
+            f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "
+            f"would have chosen another object than {expected!r} {row['other_choice']} times",
+            flush=True,
+        )
     n = totals["executed"] + totals["refused"]
-    print(f"overall: succeeded {totals['ok']}/{n} = {totals['ok'] / n:.3f}; of executed plans "
-          f"{totals['ok']}/{totals['executed']} = {totals['ok'] / max(totals['executed'], 1):.3f}; "
-          f"refused {totals['refused']}; planned afresh after a grasp that shifted the object {totals['replanned']}")
+    print(
+        f"overall: succeeded {totals['ok']}/{n} = {totals['ok'] / n:.3f}; of executed plans "
+        f"{totals['ok']}/{totals['executed']} = {totals['ok'] / max(totals['executed'], 1):.3f}; "
+        f"refused {totals['refused']}; planned afresh after a grasp that shifted the object {totals['replanned']}"
+    )
     print("failures of executed plans:", dict(reasons.most_common()) or "none")
     print("refusals:", dict(refusals.most_common()) or "none")
-    print(f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
-          f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); slowest: "
-          + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(slowest)[::-1][:3]))
-    figures = {"robot": "official Baxter URDF" if args.urdf else "built-in Baxter", "seed": args.seed,
-               "placements per predicate": args.placements, "distractors": args.distractors,
-               "stated object in the hand": args.holding, "succeeded": f"{totals['ok']}/{n}",
-               "success rate": round(totals["ok"] / n, 3),
-               "of executed plans": f"{totals['ok']}/{totals['executed']}", "refused before moving": totals["refused"],
-               "planned afresh after the grasp": totals["replanned"],
-               "plan and execute, median s": round(statistics.median(times), 2),
-               "plan and execute, max s": round(max(times), 2), **per_predicate}
+    print(
+        f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
+        f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); slowest: "
+        + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(slowest)[::-1][:3])
+    )
+    figures = {
+        "robot": "official Baxter URDF" if args.urdf else "built-in Baxter",
+        "seed": args.seed,
+        "placements per predicate": args.placements,
+        "distractors": args.distractors,
+        "stated object in the hand": args.holding,
+        "succeeded": f"{totals['ok']}/{n}",
+        "success rate": round(totals["ok"] / n, 3),
+        "of executed plans": f"{totals['ok']}/{totals['executed']}",
+        "refused before moving": totals["refused"],
+        "planned afresh after the grasp": totals["replanned"],
+        "plan and execute, median s": round(statistics.median(times), 2),
+        "plan and execute, max s": round(max(times), 2),
+        **per_predicate,
+    }
     write_results(args.json, "bench_executor", __doc__.splitlines()[0], figures)
 
 

@@ -23,7 +23,9 @@ from lmcr.workspace import Workspace
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared"))
+    parser.add_argument(
+        "--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
+    )
     parser.add_argument("--workers", type=int, default=2)
     add_json_option(parser, "bench_ingest")
     args = parser.parse_args()
@@ -33,7 +35,9 @@ def main() -> None:
         paths = Workspace.from_env(data_dir=tmp)
         con = connect(paths.db, paths.sql_dir)
         sources = expand_inputs([data / "youcook2" / "youcookii_annotations_trainval.json"], "youcook2")
-        sources += expand_inputs([data / "recipes" / "web_recipes.jsonl.gz", data / "recipes" / "feeding_america"], "recipes")
+        sources += expand_inputs(
+            [data / "recipes" / "web_recipes.jsonl.gz", data / "recipes" / "feeding_america"], "recipes"
+        )
         started = time.perf_counter()
         loaded, _ = ingest_sources(con, sources, paths.staging, args.workers)
         cold = time.perf_counter() - started
@@ -44,12 +48,20 @@ def main() -> None:
             print(" ".join(f"{k}={v}" for k, v in row.items()))
             figures |= {f"corpus {row['corpus']}: {k}": v for k, v in row.items() if k != "corpus"}
     sentences, words = sum(s.sentences for s in loaded), sum(s.words for s in loaded)
-    print(f"cold ingest: {cold:.1f}s wall, {sentences / cold:,.0f} sentences/s, {words / cold:,.0f} words/s "
-          f"({len(loaded)} sources, {args.workers} workers)")
+    print(
+        f"cold ingest: {cold:.1f}s wall, {sentences / cold:,.0f} sentences/s, {words / cold:,.0f} words/s "
+        f"({len(loaded)} sources, {args.workers} workers)"
+    )
     print(f"unchanged re-run: {warm:.2f}s wall ({cold / warm:.0f}x faster than cold)")
-    figures = {"sources": len(loaded), "workers": args.workers, "cold ingest s": round(cold, 1),
-               "sentences/s": round(sentences / cold), "words/s": round(words / cold),
-               "unchanged re-run s": round(warm, 2), **figures}
+    figures = {
+        "sources": len(loaded),
+        "workers": args.workers,
+        "cold ingest s": round(cold, 1),
+        "sentences/s": round(sentences / cold),
+        "words/s": round(words / cold),
+        "unchanged re-run s": round(warm, 2),
+        **figures,
+    }
     write_results(args.json, "bench_ingest", __doc__.splitlines()[0], figures)
 
 

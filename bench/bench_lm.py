@@ -36,6 +36,7 @@ from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import LMScorer
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 from lmcr.workspace import Workspace
 
 OBJECTS = load_lexicon().objects
@@ -66,7 +67,7 @@ def train_example(stream: torch.Tensor, vocab: int, batch: int = 20, bptt: int =
     started = time.perf_counter()
     for i in range(0, cols.size(0) - 1, bptt):
         seq = min(bptt, cols.size(0) - 1 - i)
-        x, y = cols[i:i + seq], cols[i + 1:i + 1 + seq]
+        x, y = cols[i : i + seq], cols[i + 1 : i + 1 + seq]
         hidden = None if hidden is None else tuple(h.detach() for h in hidden)
         model.zero_grad()
         out, hidden = model(x, hidden)
@@ -97,16 +98,22 @@ def scoring_speed(path: Path) -> dict:
     """Candidate frames per second of a checkpoint over every predicate x ordered object pair."""
     scorer = LMScorer(ckpt.load(path))
     lex = load_lexicon()
-    frames = [(verb, dict(zip(spec.roles, pair))) for verb, spec in lex.predicates.items()
-              for pair in itertools.permutations(OBJECTS, 2)]
+    frames = [
+        (verb, dict(zip(spec.roles, pair)))
+        for verb, spec in lex.predicates.items()
+        for pair in itertools.permutations(OBJECTS, 2)
+    ]
     scorer.score_frames(frames[:500])  # warm-up
     started = time.perf_counter()
     scorer.score_frames(frames)
     wall = time.perf_counter() - started
     name = scorer.checkpoint.path.parent.name
     print(f"scoring {name}: {len(frames):,} frames in {wall:.2f}s = {len(frames) / wall:,.0f} frames/s")
-    return {f"scoring {name}: frames": len(frames), f"scoring {name}: s": round(wall, 2),
-            f"scoring {name}: frames/s": round(len(frames) / wall)}
+    return {
+        f"scoring {name}: frames": len(frames),
+        f"scoring {name}: s": round(wall, 2),
+        f"scoring {name}: frames/s": round(len(frames) / wall),
+    }
 
 
 def normalisation_check(path: Path, ratings_csv: Path) -> dict:
@@ -118,14 +125,16 @@ def normalisation_check(path: Path, ratings_csv: Path) -> dict:
     for norm in ("sum", "mean"):
         rhos[norm] = spearmanr(scorer.score_frames([r.frame for r in rated], norm=norm), means).statistic
     print(f"{name} on {len(rated)} rated dev frames: " + ", ".join(f"{k}: rho={v:.3f}" for k, v in rhos.items()))
-    return {f"{name}: Spearman rho with the mean rating, {k} ({len(rated)} frames)": round(v, 3) for k, v in rhos.items()}
+    return {
+        f"{name}: Spearman rho with the mean rating, {k} ({len(rated)} frames)": round(v, 3) for k, v in rhos.items()
+    }
 
 
 def training_speed(db: Path | None, tokens: int, max_epochs: int) -> dict:
     """The reference trainer for one epoch, ours until it reaches the reference's perplexity."""
     paths = Workspace.from_env(db=db)
     con = duckdb.connect(str(paths.db), read_only=True)
-    text = training_text(con, "sentence", "recipes")
+    text = training_text(con, Setting("sentence", "recipes"))
     train, budget = [], tokens
     for seq in text.train:
         if budget <= 0:
@@ -140,30 +149,46 @@ def training_speed(db: Path | None, tokens: int, max_epochs: int) -> dict:
     ref_speed = train_example(stream, len(vocab))
     ref_seconds = time.perf_counter() - ref_started
     ref_ppl = example_val_ppl(train_example.model, val_ids, len(vocab))
-    print(f"reference (word_language_model defaults): {ref_speed:,.0f} tokens/s, val ppl {ref_ppl:.1f} after 1 epoch "
-          f"({ref_seconds:.0f}s)")
+    print(
+        f"reference (word_language_model defaults): {ref_speed:,.0f} tokens/s, val ppl {ref_ppl:.1f} after 1 epoch "
+        f"({ref_seconds:.0f}s)"
+    )
     model = RecurrentLM(LMConfig(len(vocab)))
     seconds = 0.0
 
     def show(row: dict) -> None:
         nonlocal seconds
         seconds += row["seconds"]
-        print(f"lmcr (defaults, {row['objective']} softmax, {row['precision']}) epoch {row['epoch']}: {row['tokens_per_s']:,.0f} tokens/s, "
-              f"val ppl {row['val_ppl']:.1f} ({seconds:.0f}s of training)")
+        print(
+            f"lmcr (defaults, {row['objective']} softmax, {row['precision']}) epoch {row['epoch']}: "
+            f"{row['tokens_per_s']:,.0f} tokens/s, "
+            f"val ppl {row['val_ppl']:.1f} ({seconds:.0f}s of training)"
+        )
 
     # Ours trains until it matches the reference's perplexity (or --max-epochs): the speed claim is
     # tokens/s at equal or better perplexity, and the time to get there is printed beside it.
-    history = train_lm(model, train_ids, val_ids, TrainConfig(max_epochs=max_epochs, target_ppl=ref_ppl, max_minutes=None), show)
+    history = train_lm(
+        model, train_ids, val_ids, TrainConfig(max_epochs=max_epochs, target_ppl=ref_ppl, max_minutes=None), show
+    )
     speed = sum(h["tokens_per_s"] * h["seconds"] for h in history) / seconds
     reached = history[-1]["val_ppl"] <= ref_ppl
-    print(f"speed ratio {speed / ref_speed:.2f}x tokens/s; val ppl {history[-1]['val_ppl']:.1f} vs {ref_ppl:.1f} "
-          f"{'reached' if reached else 'NOT reached'} after {len(history)} epoch(s), {seconds:.0f}s vs the "
-          f"reference's {ref_seconds:.0f}s ({stream.numel():,} tokens, vocabulary {len(vocab):,})")
-    return {"training tokens": stream.numel(), "vocabulary": len(vocab),
-            "reference tokens/s": round(ref_speed), "reference val ppl after 1 epoch": round(ref_ppl, 1),
-            "lmcr tokens/s": round(speed), "lmcr val ppl": round(history[-1]["val_ppl"], 1),
-            "lmcr epochs": len(history), "speed ratio": round(speed / ref_speed, 2), "reference ppl reached": reached,
-            "lmcr precision": history[-1]["precision"]}
+    print(
+        f"speed ratio {speed / ref_speed:.2f}x tokens/s; val ppl {history[-1]['val_ppl']:.1f} vs {ref_ppl:.1f} "
+        f"{'reached' if reached else 'NOT reached'} after {len(history)} epoch(s), {seconds:.0f}s vs the "
+        f"reference's {ref_seconds:.0f}s ({stream.numel():,} tokens, vocabulary {len(vocab):,})"
+    )
+    return {
+        "training tokens": stream.numel(),
+        "vocabulary": len(vocab),
+        "reference tokens/s": round(ref_speed),
+        "reference val ppl after 1 epoch": round(ref_ppl, 1),
+        "lmcr tokens/s": round(speed),
+        "lmcr val ppl": round(history[-1]["val_ppl"], 1),
+        "lmcr epochs": len(history),
+        "speed ratio": round(speed / ref_speed, 2),
+        "reference ppl reached": reached,
+        "lmcr precision": history[-1]["precision"],
+    }
 
 
 def main() -> None:
@@ -171,7 +196,9 @@ def main() -> None:
     parser.add_argument("--db", type=Path, default=None)
     parser.add_argument("--tokens", type=int, default=1_000_000)
     parser.add_argument("--checkpoint", type=Path, action="append", default=[])
-    parser.add_argument("--ratings", type=Path, default=None, help="dev ratings (MTurk CSV) for the normalisation check")
+    parser.add_argument(
+        "--ratings", type=Path, default=None, help="dev ratings (MTurk CSV) for the normalisation check"
+    )
     parser.add_argument("--skip-training", action="store_true")
     parser.add_argument("--max-epochs", type=int, default=3, help="epochs ours may take to reach the reference's ppl")
     add_json_option(parser, "bench_lm")

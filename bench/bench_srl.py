@@ -35,12 +35,16 @@ def dev_scores(parser, eval_dir: Path) -> dict:
     right = 0
     for task in tasks:
         try:
-            right += instruction_correct(parse_instruction(parser, task["instruction"]).to_json(),
-                                         task["expected"], task["missing"])
+            right += instruction_correct(
+                parse_instruction(parser, task["instruction"]).to_json(), task["expected"], task["missing"]
+            )
         except NoPredicateError:
             pass
-    return {"role F1": round(overall["role_f1"], 3), "predicate recall": round(overall["pred_r"], 3),
-            "instructions parsed right": f"{right}/{len(tasks)}"}
+    return {
+        "role F1": round(overall["role_f1"], 3),
+        "predicate recall": round(overall["pred_r"], 3),
+        "instructions parsed right": f"{right}/{len(tasks)}",
+    }
 
 
 def first_predicates(con: duckdb.DuckDBPyConnection, resources: Path, n: int = 600) -> dict:
@@ -48,14 +52,21 @@ def first_predicates(con: duckdb.DuckDBPyConnection, resources: Path, n: int = 6
     the parser gives that predicate's frame, without and with the first-word table of `resources`."""
     parser = load_parser(resources=resources)
     predicates = list(parser.lex.predicates)
-    texts = [r[0] for r in con.execute(
-        "select text from sentences where kind = 'instruction' and lower(split_part(text, ' ', 1)) in "
-        "(select unnest(?)) order by hash(text) limit ?", [predicates, n]).fetchall()]
+    texts = [
+        r[0]
+        for r in con.execute(
+            "select text from sentences where kind = 'instruction' and lower(split_part(text, ' ', 1)) in "
+            "(select unnest(?)) order by hash(text) limit ?",
+            [predicates, n],
+        ).fetchall()
+    ]
 
     def found(table: dict) -> int:
         parser.forget_first_words(table)
-        return sum(any(f.predicate == t.split()[0].lower() for f in frames)
-                   for t, frames in zip(texts, parser.pipe(texts)))
+        return sum(
+            any(f.predicate == t.split()[0].lower() for f in frames) for t, frames in zip(texts, parser.pipe(texts))
+        )
+
     with_table = found(parser.first_words)
     return {"without the first-word table": f"{found({})}/{len(texts)}", "with it": f"{with_table}/{len(texts)}"}
 
@@ -71,7 +82,9 @@ def _throughput(texts: list[str], resources: str) -> tuple[int, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared"))
+    parser.add_argument(
+        "--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
+    )
     parser.add_argument("--db", type=Path, default=None)
     parser.add_argument("--resources", type=Path, default=None)
     parser.add_argument("--sample", type=int, default=40_000)
@@ -88,13 +101,19 @@ def main() -> None:
         figures |= {f"dev set, imperative repair {'on' if repair else 'off'}: {k}": v for k, v in scores.items()}
     con = duckdb.connect(str(paths.db), read_only=True)
     found = first_predicates(con, resources)
-    print("corpus sentences starting with a robot predicate, the predicate found: "
-          + ", ".join(f"{k} {v}" for k, v in found.items()))
+    print(
+        "corpus sentences starting with a robot predicate, the predicate found: "
+        + ", ".join(f"{k} {v}" for k, v in found.items())
+    )
     figures |= {f"corpus sentences starting with a robot predicate, found {k}": v for k, v in found.items()}
-    texts = [r[0] for r in con.execute(
-        "select text from sentences where kind = 'instruction' order by hash(doc_id || sent_id) limit ?",
-        [args.sample]).fetchall()]
-    halves = [texts[: len(texts) // 2], texts[len(texts) // 2:]]
+    texts = [
+        r[0]
+        for r in con.execute(
+            "select text from sentences where kind = 'instruction' order by hash(doc_id || sent_id) limit ?",
+            [args.sample],
+        ).fetchall()
+    ]
+    halves = [texts[: len(texts) // 2], texts[len(texts) // 2 :]]
     words, wall = _throughput(texts[: len(texts) // 4], str(resources))
     print(f"1 process: {words / wall:,.0f} words/s ({words:,} words)")
     figures["parser words/s, 1 process"] = round(words / wall)
@@ -105,11 +124,16 @@ def main() -> None:
     words = sum(w for w, _ in results)
     print(f"2 processes: {words / wall:,.0f} words/s ({words:,} words, {wall:.1f}s incl. model load)")
     figures["parser words/s, 2 processes"] = round(words / wall)
-    build = con.execute("select sentences, words, wall_s, words_per_s, reparsed, reparse_kept, frames, known_frames "
-                        "from frame_builds order by built_at desc limit 1").fetchone()
+    build = con.execute(
+        "select sentences, words, wall_s, words_per_s, reparsed, reparse_kept, frames, known_frames "
+        "from frame_builds order by built_at desc limit 1"
+    ).fetchone()
     if build:
-        print(f"last full build: {build[0]:,} sentences, {build[1]:,} words in {build[2]:.0f}s = {build[3]:,.0f} "
-              f"words/s; re-parsed {build[4]:,} (kept {build[5]:,}); {build[6]:,} frames, {build[7]:,} of robot predicates")
+        print(
+            f"last full build: {build[0]:,} sentences, {build[1]:,} words in {build[2]:.0f}s = {build[3]:,.0f} "
+            f"words/s; re-parsed {build[4]:,} (kept {build[5]:,}); {build[6]:,} frames, "
+            f"{build[7]:,} of robot predicates"
+        )
         names = ("sentences", "words", "wall s", "words/s", "frames", "frames of robot predicates")
         values = (build[0], build[1], round(build[2]), round(build[3]), build[6], build[7])
         figures |= {f"the store's last frame build: {k}": v for k, v in zip(names, values)}

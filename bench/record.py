@@ -24,8 +24,12 @@ RESULTS_DIR = REPO_ROOT / "bench" / "results"
 
 def add_json_option(parser: argparse.ArgumentParser, name: str) -> None:
     """`--json PATH`: where the figures go (default bench/results/<name>.json; '' writes none)."""
-    parser.add_argument("--json", type=str, default=str(RESULTS_DIR / f"{name}.json"),
-                        help=f"write the figures, command and date here (default bench/results/{name}.json; '' for none)")
+    parser.add_argument(
+        "--json",
+        type=str,
+        default=str(RESULTS_DIR / f"{name}.json"),
+        help=f"write the figures, command and date here (default bench/results/{name}.json; '' for none)",
+    )
 
 
 def command_line() -> str:
@@ -38,9 +42,11 @@ def command_line() -> str:
 
 def git_commit() -> str:
     """The checked-out commit, `-dirty` when tracked files differ from it; '' outside a git checkout."""
+
     def git(*args: str) -> str:
         done = subprocess.run(["git", *args], cwd=REPO_ROOT, capture_output=True, text=True, check=False)
         return done.stdout.strip() if done.returncode == 0 else ""
+
     commit = git("rev-parse", "--short", "HEAD")
     return commit + ("-dirty" if commit and git("status", "--porcelain", "--untracked-files=no") else "")
 
@@ -49,8 +55,11 @@ def machine() -> str:
     """OS, architecture, CPU model and count, Python version."""
     cpu = platform.processor() or platform.machine()
     try:
-        cpu = next(line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                   if line.startswith("model name"))
+        cpu = next(
+            line.split(":", 1)[1].strip()
+            for line in Path("/proc/cpuinfo").read_text().splitlines()
+            if line.startswith("model name")
+        )
     except (OSError, StopIteration):
         pass
     return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} CPUs, Python {platform.python_version()}"
@@ -60,10 +69,17 @@ def write_results(path: str, name: str, title: str, figures: dict) -> None:
     """Write the record (to a temporary name, then renamed) unless `path` is ''; say where it went."""
     if not path:
         return
-    record = {"benchmark": name, "title": title, "command": command_line(),
-              "date": datetime.now(UTC).isoformat(timespec="seconds"), "commit": git_commit(), "machine": machine(),
-              # how busy the machine was (1, 5, 15 minutes): timings on a loaded host are slower
-              "load_average": [round(x, 2) for x in os.getloadavg()], "figures": figures}
+    record = {
+        "benchmark": name,
+        "title": title,
+        "command": command_line(),
+        "date": datetime.now(UTC).isoformat(timespec="seconds"),
+        "commit": git_commit(),
+        "machine": machine(),
+        # how busy the machine was (1, 5, 15 minutes): timings on a loaded host are slower
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+        "figures": figures,
+    }
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = target.with_name(f".{target.name}.tmp")

@@ -37,7 +37,7 @@ def add_noise(clean: Path, out: Path, snr_db: float, seed: int) -> None:
     """White noise at `snr_db` below the speech's RMS (seeded, so the bench is reproducible)."""
     samples = read_wav(clean).astype(np.float64)
     speech = samples[np.abs(samples) > 0.02 * 32768]  # the RMS of the speech, not of the pauses
-    rms = np.sqrt(np.mean(speech ** 2)) if len(speech) else 1.0
+    rms = np.sqrt(np.mean(speech**2)) if len(speech) else 1.0
     noise = np.random.default_rng(seed).normal(0, rms / 10 ** (snr_db / 20), len(samples))
     write_wav(out, np.clip(np.round(samples + noise), -32768, 32767).astype(np.int16))
 
@@ -76,10 +76,19 @@ def main() -> None:
                 phone = args.out / f"{tag}-telephone" / f"{rec['id']}.wav"
                 telephone(clean, phone)
                 for condition, path in (("clean", clean), (f"noise{args.snr:g}", noisy), ("telephone", phone)):
-                    index.append({"id": f"{rec['id']}-{tag}-{condition}", "audio": str(path.relative_to(args.out)),
-                                  "text": rec["instruction"], "voice": voice, "rate": rate, "condition": condition,
-                                  "objects": rec.get("objects"), "expected": rec.get("expected"),
-                                  "missing": rec.get("missing")})
+                    index.append(
+                        {
+                            "id": f"{rec['id']}-{tag}-{condition}",
+                            "audio": str(path.relative_to(args.out)),
+                            "text": rec["instruction"],
+                            "voice": voice,
+                            "rate": rate,
+                            "condition": condition,
+                            "objects": rec.get("objects"),
+                            "expected": rec.get("expected"),
+                            "missing": rec.get("missing"),
+                        }
+                    )
             print(f"{tag}: {len(records)} instructions x 3 conditions", flush=True)
     (args.out / "index.jsonl").write_text("".join(json.dumps(r) + "\n" for r in index), encoding="utf-8")
     print(f"{len(index)} WAVs -> {args.out / 'index.jsonl'}")

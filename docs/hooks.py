@@ -17,9 +17,11 @@ from mkdocs.structure.files import File, Files
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 BENCH_DIR = REPO_ROOT / "bench"
-IMAGES = {"img/pour_me_some_water.png": REPO_ROOT / "bench" / "renders" / "pour_me_some_water.png",
-          "img/pour_me_some_water.gif": REPO_ROOT / "bench" / "renders" / "pour_me_some_water.gif",
-          "img/preview_screenshot.png": REPO_ROOT / "annotation" / "preview_screenshot.png"}
+IMAGES = {
+    "img/pour_me_some_water.png": REPO_ROOT / "bench" / "renders" / "pour_me_some_water.png",
+    "img/pour_me_some_water.gif": REPO_ROOT / "bench" / "renders" / "pour_me_some_water.gif",
+    "img/preview_screenshot.png": REPO_ROOT / "annotation" / "preview_screenshot.png",
+}
 RECORD_FIELDS = ("benchmark", "title", "command", "date", "commit", "machine", "figures")
 
 
@@ -27,8 +29,11 @@ def on_files(files: Files, config) -> Files:
     """Add the generated pages and the pictures to the site's files."""
     from lmcr.catalog import schema_page
 
-    pages = {"reference/cli.md": cli_reference(), "reference/schema.md": schema_page(REPO_ROOT / "sql"),
-             "results.md": results_page(BENCH_DIR)}
+    pages = {
+        "reference/cli.md": cli_reference(),
+        "reference/schema.md": schema_page(REPO_ROOT / "sql"),
+        "results.md": results_page(BENCH_DIR),
+    }
     for uri, text in pages.items():
         files.append(File.generated(config, uri, content=text))
     for uri, path in IMAGES.items():
@@ -38,6 +43,7 @@ def on_files(files: Files, config) -> Files:
 
 # ---------------------------------------------------------------- the CLI reference
 
+
 def cli_reference() -> str:
     """Markdown for every command of `lmcr` (sub-apps' commands under their group), in the app's order."""
     import typer
@@ -46,10 +52,20 @@ def cli_reference() -> str:
 
     root = typer.main.get_command(app)
     ctx = root.context_class(root, info_name="lmcr")
-    lines = ["# Command reference", "",
-             "Generated from the `lmcr` command line itself when the site is built: every command's usage, "
-             "help and options, as `lmcr COMMAND --help` prints them.", "",
-             "## lmcr", "", _usage(root, ctx), "", paragraphs(root.help or ""), "", *_options(root, ctx)]
+    lines = [
+        "# Command reference",
+        "",
+        "Generated from the `lmcr` command line itself when the site is built: every command's usage, "
+        "help and options, as `lmcr COMMAND --help` prints them.",
+        "",
+        "## lmcr",
+        "",
+        _usage(root, ctx),
+        "",
+        paragraphs(root.help or ""),
+        "",
+        *_options(root, ctx),
+    ]
     for name, command, sub_ctx in _commands(root, ctx):
         lines += ["", f"## lmcr {name}", "", _usage(command, sub_ctx), "", paragraphs(command.help or "")]
         lines += ["", *_options(command, sub_ctx)]
@@ -89,16 +105,17 @@ def _options(command, ctx) -> list[str]:
 
 def paragraphs(text: str) -> str:
     """Help text as Markdown: lines of a paragraph joined, blank lines kept, click's \\b markers dropped."""
-    blocks = [" ".join(line.strip() for line in block.splitlines() if line.strip() != "\b")
-              for block in re.split(r"\n\s*\n", text.strip())]
+    blocks = [
+        " ".join(line.strip() for line in block.splitlines() if line.strip() != "\b")
+        for block in re.split(r"\n\s*\n", text.strip())
+    ]
     return "\n\n".join(escape_html(block) for block in blocks if block)
 
 
 def escape_html(text: str) -> str:
     """`<` and `>` outside code spans as entities, so `<path>` stays text and is no HTML tag."""
     parts = re.split(r"(`[^`]*`)", text)
-    return "".join(part if part.startswith("`") else part.replace("<", "&lt;").replace(">", "&gt;")
-                   for part in parts)
+    return "".join(part if part.startswith("`") else part.replace("<", "&lt;").replace(">", "&gt;") for part in parts)
 
 
 def escape_cell(text: str) -> str:
@@ -107,6 +124,7 @@ def escape_cell(text: str) -> str:
 
 
 # ---------------------------------------------------------------- the results page
+
 
 def load_records(results_dir: Path) -> list[dict]:
     """The recorded results, by benchmark then file name; a malformed file fails the build naming it."""
@@ -136,23 +154,39 @@ def results_page(bench_dir: Path) -> str:
     records = load_records(bench_dir / "results")
     scripts = sorted(bench_dir.glob("bench_*.py"))
     recorded = {r["benchmark"] for r in records}
-    lines = ["# Results", "",
-             "Generated when the site is built from the JSON files the benchmarks write into `bench/results/` "
-             "(`bench/record.py`). Every figure here is one a benchmark printed, with the exact command, the date "
-             "(UTC), the commit (`-dirty`: with uncommitted changes) and the machine it ran on; to add or refresh "
-             "one, run the benchmark and commit its JSON file. Nothing on this page is typed by hand.", ""]
+    lines = [
+        "# Results",
+        "",
+        "Generated when the site is built from the JSON files the benchmarks write into `bench/results/` "
+        "(`bench/record.py`). Every figure here is one a benchmark printed, with the exact command, the date "
+        "(UTC), the commit (`-dirty`: with uncommitted changes) and the machine it ran on; to add or refresh "
+        "one, run the benchmark and commit its JSON file. Nothing on this page is typed by hand.",
+        "",
+    ]
     for record in records:
-        lines += [f"## {record['benchmark']}", "", escape_html(record["title"]), "",
-                  f"- command: `{record['command']}`",
-                  f"- date: {record['date']}",
-                  f"- commit: `{record['commit'] or 'unknown'}`",
-                  f"- machine: {escape_html(record['machine'])}"
-                  + (f" (load average {' / '.join(map(str, record['load_average']))} over 1 / 5 / 15 min)"
-                     if record.get("load_average") else ""),
-                  f"- file: `bench/results/{record['file']}`", "",
-                  "| figure | value |", "|---|---|"]
-        lines += [f"| {escape_cell(escape_html(str(k)))} | {escape_cell(escape_html(_value(v)))} |"
-                  for k, v in record["figures"].items()]
+        lines += [
+            f"## {record['benchmark']}",
+            "",
+            escape_html(record["title"]),
+            "",
+            f"- command: `{record['command']}`",
+            f"- date: {record['date']}",
+            f"- commit: `{record['commit'] or 'unknown'}`",
+            f"- machine: {escape_html(record['machine'])}"
+            + (
+                f" (load average {' / '.join(map(str, record['load_average']))} over 1 / 5 / 15 min)"
+                if record.get("load_average")
+                else ""
+            ),
+            f"- file: `bench/results/{record['file']}`",
+            "",
+            "| figure | value |",
+            "|---|---|",
+        ]
+        lines += [
+            f"| {escape_cell(escape_html(str(k)))} | {escape_cell(escape_html(_value(v)))} |"
+            for k, v in record["figures"].items()
+        ]
         lines.append("")
     missing = [s for s in scripts if s.stem not in recorded]
     lines += ["## Benchmarks with no recorded result yet", ""]

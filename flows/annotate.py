@@ -42,10 +42,16 @@ def aggregate_task(decisions_out: str | None, ws: Workspace) -> dict:
         workers = worker_table(con)
         if decisions_out:
             write_decisions(Path(decisions_out), decisions(con, QualityRules(), workers=workers))
-    create_table_artifact(key="krippendorff-alpha", table=[{"verbs": k, "alpha": round(v, 3)} for k, v in alpha.items()],
-                          description="Krippendorff's alpha (interval) over valid ratings")
-    create_table_artifact(key="worker-quality", table=workers.astype(object).where(workers.notna(), None).to_dict("records"),
-                          description="Per worker: leave-one-out agreement, gold accuracy, MACE spam probability")
+    create_table_artifact(
+        key="krippendorff-alpha",
+        table=[{"verbs": k, "alpha": round(v, 3)} for k, v in alpha.items()],
+        description="Krippendorff's alpha (interval) over valid ratings",
+    )
+    create_table_artifact(
+        key="worker-quality",
+        table=workers.astype(object).where(workers.notna(), None).to_dict("records"),
+        description="Per worker: leave-one-out agreement, gold accuracy, MACE spam probability",
+    )
     return {"alpha": alpha, "workers": len(workers)}
 
 

@@ -44,25 +44,57 @@ def evaluation_key(parameters: dict) -> str:
         with read_connection(res.db) as con:
             frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()
     report_there = (Path(parameters["out"]) / "report.md").exists()
-    blob = json.dumps([versions, rating_files, frames, report_there, file_sha256(Path(__file__)), parameters],
-                      default=str, sort_keys=True)
+    blob = json.dumps(
+        [versions, rating_files, frames, report_there, file_sha256(Path(__file__)), parameters],
+        default=str,
+        sort_keys=True,
+    )
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
 @task(name="evaluate", retries=0, cache_policy=NO_CACHE)  # its own JSON cache, below
-def evaluate_task(ratings: str, out: str, methods: list[str], settings: list[str], res: MethodResources,
-                  per_verb: int, seed: int, ws: Workspace, optional: list[str] | None = None) -> dict:
+def evaluate_task(
+    ratings: str,
+    out: str,
+    methods: list[str],
+    settings: list[str],
+    res: MethodResources,
+    per_verb: int,
+    seed: int,
+    ws: Workspace,
+    optional: list[str] | None = None,
+) -> dict:
     """Table I and Fig. 4 on the ratings; completion of the LM methods calibrated into the workspace. The
     result is cached as plain JSON in the workspace (`cache/evaluate-KEY.json`, read with `json` alone:
     nothing in it can run code), so an unchanged re-run returns the same without evaluating."""
-    key = evaluation_key({"ratings": ratings, "out": out, "methods": methods, "settings": settings, "res": res,
-                          "per_verb": per_verb, "seed": seed, "optional": optional})
+    key = evaluation_key(
+        {
+            "ratings": ratings,
+            "out": out,
+            "methods": methods,
+            "settings": settings,
+            "res": res,
+            "per_verb": per_verb,
+            "seed": seed,
+            "optional": optional,
+        }
+    )
 
     def evaluate() -> dict:
         rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-        results = run_evaluation(rated, res, methods, settings, EvalConfig(per_verb=per_verb, seed=seed), Path(out),
-                                 ws.calibration, log=get_run_logger().info, ratings_source=Path(ratings),
-                                 paper=ws.paper, optional=optional or ())
+        results = run_evaluation(
+            rated,
+            res,
+            methods,
+            settings,
+            EvalConfig(per_verb=per_verb, seed=seed),
+            Path(out),
+            ws.calibration,
+            log=get_run_logger().info,
+            ratings_source=Path(ratings),
+            paper=ws.paper,
+            optional=optional or (),
+        )
         return json.loads(json.dumps(results.to_json()))  # as a cached run reads it back
 
     usable = lambda saved: isinstance(saved, dict) and isinstance(saved.get("table1"), dict)  # noqa: E731
@@ -77,8 +109,9 @@ def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions
 
     rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
     dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None
-    chosen, context_weight, _ = choose_and_save(rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir,
-                                                log=get_run_logger().info, instructions=dev)
+    chosen, context_weight, _ = choose_and_save(
+        rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info, instructions=dev
+    )
     return chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
 
 
@@ -103,11 +136,11 @@ def evaluate_flow(
     and a household sentence LM published, the household weight is chosen on the same ratings first
     (and on `instructions`, a JSONL of instructions in scenes, when given), so the default completion is
     evaluated and calibrated under it. `methods` and `settings` default to every method (EVALUATED) and LM
-    setting; a default that cannot be built (a setting not trained) is skipped with a note, while one given
-    explicitly must build."""
+    setting (any spelling `Setting.parse` reads); a default that cannot be built (a setting not trained) is
+    skipped with a note, while one given explicitly must build."""
     optional = [*(EVALUATED if methods is None else ()), *(SETTINGS if settings is None else ())]
     methods = list(EVALUATED) if methods is None else methods
-    settings = list(SETTINGS) if settings is None else settings
+    settings = list(SETTINGS) if settings is None else [Setting.parse(s).label for s in settings]
     ws = Workspace.from_env(data_dir=data_dir)
     if paper:
         ws = replace(ws, paper=Path(paper))
@@ -119,10 +152,17 @@ def evaluate_flow(
             methods, optional = [*methods, f"{COMPLETION_METHOD}@plain"], [*optional, f"{COMPLETION_METHOD}@plain"]
     report = Path(out or ws.report)
     results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws, optional)
-    create_table_artifact(key="table-i", description="Table I overall accuracy (lambda=1, k=6)",
-                          table=[{"method": m, "overall": round(acc.get("all", float("nan")), 3)}
-                                 for m, acc in results["table1"].items()])
-    create_markdown_artifact(key="evaluation-report", markdown=(report / "report.md").read_text(encoding="utf-8"),
-                             description=str(report / "report.html"))
+    create_table_artifact(
+        key="table-i",
+        description="Table I overall accuracy (lambda=1, k=6)",
+        table=[
+            {"method": m, "overall": round(acc.get("all", float("nan")), 3)} for m, acc in results["table1"].items()
+        ],
+    )
+    create_markdown_artifact(
+        key="evaluation-report",
+        markdown=(report / "report.md").read_text(encoding="utf-8"),
+        description=str(report / "report.html"),
+    )
     create_link_artifact(key="evaluation-report-html", link=(report / "report.html").resolve().as_uri())
     return results

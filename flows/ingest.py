@@ -27,8 +27,13 @@ def load_task(ws: Workspace, staged: list[StagedFile]) -> list[dict]:
     with ws.connect() as con:
         for item in staged:
             load_staged(con, item)
-            logger.info("loaded %s: %d in = %d loaded + %d quarantined", Path(item.source_file).name,
-                        item.records_in, item.records_loaded, item.records_quarantined)
+            logger.info(
+                "loaded %s: %d in = %d loaded + %d quarantined",
+                Path(item.source_file).name,
+                item.records_in,
+                item.records_loaded,
+                item.records_quarantined,
+            )
         return corpus_summary(con, ws.sql_dir)
 
 

@@ -1,4 +1,5 @@
-"""The end-to-end pipeline: ingest -> frames -> speech model -> train -> annotate -> evaluate -> publish -> executor check.
+"""The end-to-end pipeline: ingest -> frames -> speech model -> train -> annotate -> evaluate -> publish ->
+executor check.
 
 Each stage is the flow of its own issue; the last one has the simulated Baxter execute an instruction
 completed by the published checkpoint. Unchanged stages cost little on a re-run: ingestion skips
@@ -33,7 +34,6 @@ from lmcr.evaluate.protocol import EvalConfig
 from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.lm.hyperparams import LMConfig, TrainConfig
 from lmcr.scorers.registry import COMPLETION_METHOD, EVALUATED
-from lmcr.setting import Setting
 from lmcr.workspace import Workspace
 
 SAMPLE = REPO_ROOT / "data" / "sample"
@@ -43,8 +43,12 @@ class PipelineParams(BaseModel):
     """Typed parameters (validated by the Prefect UI); defaults run the embedded sample."""
 
     youcook2: list[str] = Field(default_factory=lambda: [str(SAMPLE / "youcook2")])
-    recipes: list[str] = Field(default_factory=lambda: [str(SAMPLE / p) for p in (
-        "nyc", "recipes_json/recipes_sample.jsonl", "recipes_json/folder", "feeding_america")])
+    recipes: list[str] = Field(
+        default_factory=lambda: [
+            str(SAMPLE / p)
+            for p in ("nyc", "recipes_json/recipes_sample.jsonl", "recipes_json/folder", "feeding_america")
+        ]
+    )
     household: list[str] = Field(default_factory=lambda: [str(SAMPLE / "household")])
     ratings: list[str] = Field(default_factory=lambda: [str(SAMPLE / "ratings" / "sample_ratings_mturk.csv")])
     # instructions in scenes the household weight is chosen on besides the ratings (the repo's own set)
@@ -54,8 +58,9 @@ class PipelineParams(BaseModel):
     paper: str | None = None  # the paper's LaTeX source: its Table I beside ours in the report
     # the household LMs: the experts a chosen corpus mixture interpolates with each all-corpora LM
     # (lmcr/scorers/mixture.py); the default methods (frame_lm among them) load them once a mixture is chosen
-    settings: list[str] = Field(default_factory=lambda: ["sentence-all", "frame-all", "sentence-household",
-                                                         "frame-household"])
+    settings: list[str] = Field(
+        default_factory=lambda: ["sentence-all", "frame-all", "sentence-household", "frame-household"]
+    )
     methods: list[str] = Field(default_factory=lambda: list(EVALUATED))
     shard_size: int = Field(FrameCorpusConfig.shard_size, gt=0)
     embedding: int = Field(LMConfig.embedding, gt=0)
@@ -89,18 +94,40 @@ def pipeline_flow(params: PipelineParams = PipelineParams()) -> dict:
     ingest_flow(youcook2=params.youcook2, recipes=params.recipes, household=params.household, data_dir=data_dir)
     frames_flow(shard_size=params.shard_size, data_dir=data_dir)
     speech_flow(data_dir=data_dir)
-    trained = train_flow(settings=params.settings, embedding=params.embedding, max_epochs=params.max_epochs,
-                         max_minutes=params.max_minutes, skip_unchanged=True, data_dir=data_dir)
+    trained = train_flow(
+        settings=params.settings,
+        embedding=params.embedding,
+        max_epochs=params.max_epochs,
+        max_minutes=params.max_minutes,
+        skip_unchanged=True,
+        data_dir=data_dir,
+    )
     annotate_flow(results=params.ratings, data_dir=data_dir)
-    lm_settings = [Setting.parse(s).label for s in params.settings]
-    evaluation = evaluate_flow(methods=params.methods, settings=lm_settings, conceptnet=params.conceptnet,
-                               vectors=params.vectors, per_verb=params.per_verb, seed=params.seed, data_dir=data_dir,
-                               paper=params.paper, instructions=params.instructions)
+    evaluation = evaluate_flow(
+        methods=params.methods,
+        settings=params.settings,
+        conceptnet=params.conceptnet,
+        vectors=params.vectors,
+        per_verb=params.per_verb,
+        seed=params.seed,
+        data_dir=data_dir,
+        paper=params.paper,
+        instructions=params.instructions,
+    )
     check = executor_check_task(params.executor_instruction, params.executor_scene, data_dir)
     logger.info("executor check %r: %s", params.executor_instruction, "success" if check["success"] else "FAILED")
-    create_table_artifact(key="executor-check", description=f"simulated Baxter: {params.executor_instruction!r}",
-                          table=[{"instruction": params.executor_instruction, "chosen_object": check["chosen_object"],
-                                  "frame": json.dumps(check["frame"]["roles"]), "success": check["success"]}])
+    create_table_artifact(
+        key="executor-check",
+        description=f"simulated Baxter: {params.executor_instruction!r}",
+        table=[
+            {
+                "instruction": params.executor_instruction,
+                "chosen_object": check["chosen_object"],
+                "frame": json.dumps(check["frame"]["roles"]),
+                "success": check["success"],
+            }
+        ],
+    )
     checkpoints = {r["setting"]: r["checkpoint"] for r in trained}
     report = str(Workspace.from_env(data_dir=data_dir).report / "report.html")
     print(f"report: {report}")

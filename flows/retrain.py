@@ -21,12 +21,16 @@ from lmcr.workspace import Workspace
 
 
 @task(name="train-candidate")
-def candidate_task(setting: str, ws: Workspace, embedding: int, max_epochs: int, max_minutes: float | None) -> str:
+def candidate_task(setting: Setting, ws: Workspace, embedding: int, max_epochs: int, max_minutes: float | None) -> str:
     """Train a new version of `setting` without making it LATEST."""
-    chosen = Setting.parse(setting)
-    path = train_setting(ws.connect, ws.checkpoints, chosen.linearization,
-                         chosen.corpus, LMConfig(0, embedding), TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
-                         promote=False)
+    path = train_setting(
+        ws.connect,
+        ws.checkpoints,
+        setting,
+        LMConfig(0, embedding),
+        TrainConfig(max_epochs=max_epochs, max_minutes=max_minutes),
+        promote=False,
+    )
     return str(path)
 
 
@@ -61,13 +65,20 @@ def retrain_flow(
         inputs = inputs_sha256(con, config.linearization)
         unchanged = inputs == last_inputs(con, config.setting)
         if unchanged:
-            row = {"setting": config.setting, "inputs_sha256": inputs, "decision": "unchanged",
-                   "reason": "corpus and ratings unchanged since the last decision"}
+            row = {
+                "setting": config.setting.name,
+                "inputs_sha256": inputs,
+                "decision": "unchanged",
+                "reason": "corpus and ratings unchanged since the last decision",
+            }
             record(con, row)
     if not unchanged:
         candidate = candidate_task(config.setting, ws, embedding, max_epochs, max_minutes)
         row = decide_task(candidate, config, inputs, ws)
     logger.info("%s: %s (%s)", config.setting, row["decision"], row["reason"])
-    create_table_artifact(key="retrain-decision", table=[{k: v for k, v in row.items() if k != "inputs_sha256"}],
-                          description=f"retrain {config.setting}: {row['decision']}")
+    create_table_artifact(
+        key="retrain-decision",
+        table=[{k: v for k, v in row.items() if k != "inputs_sha256"}],
+        description=f"retrain {config.setting}: {row['decision']}",
+    )
     return row

@@ -49,8 +49,21 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child between 
 def _start(port: int) -> subprocess.Popen:
     env = {**os.environ, "PREFECT_UI_ENABLED": "0", "PREFECT__SERVER_EPHEMERAL": "1", "PREFECT__SERVER_FINAL": "1"}
     env.pop("PREFECT_API_URL", None)
-    command = [sys.executable, "-m", "uvicorn", "--factory", "prefect.server.api.server:create_app",
-               "--host", "127.0.0.1", "--port", str(port), "--log-level", "error", "--lifespan", "on"]
+    command = [
+        sys.executable,
+        "-m",
+        "uvicorn",
+        "--factory",
+        "prefect.server.api.server:create_app",
+        "--host",
+        "127.0.0.1",
+        "--port",
+        str(port),
+        "--log-level",
+        "error",
+        "--lifespan",
+        "on",
+    ]
     preexec = _die_with_parent if sys.platform.startswith("linux") else None
     return subprocess.Popen(command, env=env, stdin=subprocess.DEVNULL, preexec_fn=preexec)
 
@@ -67,8 +80,10 @@ def _wait_healthy(process: subprocess.Popen, url: str, timeout_s: float) -> None
             except httpx.HTTPError:
                 pass
             time.sleep(0.2)
-    raise ServerStartError(f"the Prefect server did not answer within {timeout_s:.0f} s "
-                           "(set LMCR_PREFECT_STARTUP_TIMEOUT_S to wait longer, or PREFECT_API_URL to use a running one)")
+    raise ServerStartError(
+        f"the Prefect server did not answer within {timeout_s:.0f} s "
+        "(set LMCR_PREFECT_STARTUP_TIMEOUT_S to wait longer, or PREFECT_API_URL to use a running one)"
+    )
 
 
 def _drain_prefect_workers(timeout_s: float = 30.0) -> None:

@@ -18,8 +18,7 @@ def speech_flow(config: SpeechLMConfig = SpeechLMConfig(), db: str | None = None
     """Build (or keep) the speech models; returns the domain model's version folder."""
     ws = Workspace.from_env(data_dir=data_dir, db=db)
     with ws.read() as con:
-        path = build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech, config,
-                               log=get_run_logger().info)
+        path = build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech, config, log=get_run_logger().info)
     if ws.whisper_model is None:
         get_run_logger().info(f"Whisper model: {packaged_model(ws.whisper)}")
     return str(path)

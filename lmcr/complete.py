@@ -5,7 +5,8 @@ frame per detected object (per ordered pair of objects when two roles are missin
 one batch, and turn scores into probabilities with a softmax at a temperature calibrated on the dev
 ratings. When the calibrated prediction set (split conformal, see `calibrate`) holds more than one
 object, or none, the result carries a clarifying `question` naming the top choices instead of a
-silent guess. A complete instruction comes back unchanged.
+silent guess. A complete instruction comes back unchanged. The result is a `Completion`; its `to_json`
+is the CLI contract's output line.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 from lmcr.errors import LMCRError
@@ -54,6 +55,74 @@ class CompletionConfig:
         return asdict(self)
 
 
+@dataclass(frozen=True)
+class Candidate:
+    """One filling of the missing roles: `objects` role -> label (`object` the first missing role's), its
+    score, its probability (softmax at the calibrated temperature) and the ids of the objects `object` names."""
+
+    object: str
+    objects: dict[str, str]
+    score: float
+    probability: float
+    ids: tuple[str, ...]
+
+    def to_json(self) -> dict:
+        return {
+            "object": self.object,
+            "objects": dict(self.objects),
+            "score": self.score,
+            "probability": self.probability,
+            "ids": list(self.ids),
+        }
+
+
+@dataclass(frozen=True)
+class Completion:
+    """An instruction completed: `frame` the completed frame (the chosen objects filled in), the roles that
+    were missing, the roles filled from what the instruction said (`referred` pronouns, `served` vessels),
+    stated words the robot could not ground (`unresolved`), detections outside the vocabulary
+    (`unfamiliar_objects` scored, `ignored_objects` not), the candidates best first, the clarifying
+    `question` (None when the choice is clear), the `context` scored with the frame, the ids each role's
+    label stands for (`instances`) and the calibrated prediction set (`prediction_set`: one candidate's
+    `object` per candidate in the set, best first; empty when nothing was missing)."""
+
+    frame: Frame
+    missing_roles: tuple[str, ...] = ()
+    referred: dict[str, str] = field(default_factory=dict)
+    served: dict[str, str] = field(default_factory=dict)
+    unresolved: dict[str, str] = field(default_factory=dict)
+    unfamiliar_objects: tuple[str, ...] = ()
+    ignored_objects: tuple[str, ...] = ()
+    candidates: tuple[Candidate, ...] = ()
+    question: str | None = None
+    context: str = ""
+    instances: dict[str, list[str]] = field(default_factory=dict)
+    prediction_set: tuple[str, ...] = ()
+
+    @property
+    def missing(self) -> str | None:
+        """The (first) role that was missing, None for a complete instruction."""
+        return self.missing_roles[0] if self.missing_roles else None
+
+    def to_json(self) -> dict:
+        """The CLI contract's output line (without the id)."""
+        return {
+            "frame": self.frame.to_json(),
+            "missing": self.missing,
+            "missing_roles": list(self.missing_roles),
+            "referred": dict(self.referred),
+            "served": dict(self.served),
+            "unresolved": dict(self.unresolved),
+            "unfamiliar_objects": list(self.unfamiliar_objects),
+            "ignored_objects": list(self.ignored_objects),
+            "candidates": [c.to_json() for c in self.candidates],
+            "question": self.question,
+            "context": self.context,
+            "instances": {role: list(ids) for role, ids in self.instances.items()},
+            "prediction_set": list(self.prediction_set),
+        }
+
+
 def softmax(scores: list[float], temperature: float) -> list[float]:
     top = max(scores)
     weights = [math.exp((s - top) / temperature) for s in scores]
@@ -90,7 +159,9 @@ def _referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str
     return referred
 
 
-def _served(parser: FrameParser, doc, frame: FrameMention, detected: list[str], taken: dict[str, str]) -> dict[str, str]:
+def _served(
+    parser: FrameParser, doc, frame: FrameMention, detected: list[str], taken: dict[str, str]
+) -> dict[str, str]:
     """The open role a vessel is poured into, filled with the vessel the request serves in ("pour me a
     glass of water": Destination glass) when a detected object names it and no role states it."""
     vessel = served_in(doc, frame, parser.lex)
@@ -102,8 +173,9 @@ def _served(parser: FrameParser, doc, frame: FrameMention, detected: list[str], 
     return {into[0]: obj} if into else {}
 
 
-def _ground(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]) \
-        -> tuple[dict[str, str | None], dict[str, str]]:
+def _ground(
+    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]
+) -> tuple[dict[str, str | None], dict[str, str]]:
     """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
     the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
     objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept."""
@@ -115,23 +187,30 @@ def _ground(roles: dict[str, str | None], vocabulary: tuple[str, ...], detected:
     return grounded, unresolved
 
 
-def _question(template: str, roles: dict[str, str | None], missing: list[str], choices: list[dict]) -> str:
+def _question(template: str, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
     """'Should I pour milk into the bowl, the glass or the plate?': the predicate's sentence template with
     the choices in the missing slot (one missing role), or one filled template per choice (two)."""
+
     def either(items: list[str]) -> str:
         return ", ".join(items[:-1]) + f" or {items[-1]}" if len(items) > 1 else items[0]
 
     if len(missing) == 1:
         role = missing[0]
         slot = template.replace(f"the {{{role}}}", f"{{{role}}}")  # each choice brings its own "the"
-        return "Should I " + slot.format(**{**roles, role: either([f"the {c['objects'][role]}" for c in choices])}) + "?"
-    return "Should I " + either([template.format(**{**roles, **c["objects"]}) for c in choices]) + "?"
+        return "Should I " + slot.format(**{**roles, role: either([f"the {c.objects[role]}" for c in choices])}) + "?"
+    return "Should I " + either([template.format(**{**roles, **c.objects}) for c in choices]) + "?"
 
 
-def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: list[str],
-             config: CompletionConfig = CompletionConfig(), ids: list[str] | None = None) -> dict:
-    """The completion of one instruction in the CLI contract's output format (without the id); the
-    scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so.
+def complete(
+    parser: FrameParser,
+    scorer: Scorer,
+    instruction: str,
+    objects: list[str],
+    config: CompletionConfig = CompletionConfig(),
+    ids: list[str] | None = None,
+) -> Completion:
+    """The completion of one instruction (`Completion.to_json` is the CLI contract's output line without the
+    id); the scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so.
 
     Objects are scored by label: several objects with one label (three cups) are one candidate, whose
     `ids` list them (`ids`: the objects' ids, in order; assigned as a scene assigns them when not given),
@@ -153,50 +232,100 @@ def complete(parser: FrameParser, scorer: Scorer, instruction: str, objects: lis
     # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
     # seen: the mug): its phrase is read as context, as the rest of the utterance is.
     context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""
-    missing = [r for r, v in roles.items() if v is None]
     stated = {v for v in roles.values() if v}
     # A detection outside the robot's object vocabulary ("salsa" typed to `lmcr complete`) is scored like
     # any other, as the corpora know it (a word they never saw scores low), but never chosen silently;
     # one that names nothing (emoji, digits, a paragraph, only function words) is ignored.
     outside = [o for o in detected if parser.lex.objects and o not in parser.lex.objects and o not in stated]
     ignored = [o for o in outside if not is_object_name(o)]
-    unfamiliar = [o for o in outside if o not in ignored]
+    read = Completion(
+        Frame.of(frame.predicate, {}),
+        referred=referred,
+        served=served,
+        unresolved=unresolved,
+        unfamiliar_objects=tuple(o for o in outside if o not in ignored),
+        ignored_objects=tuple(ignored),
+        context=context,
+    )
+    missing = [r for r, v in roles.items() if v is None]
     if not missing:
-        return {"frame": {"predicate": frame.predicate, "roles": roles}, "missing": None, "missing_roles": [],
-                "referred": referred, "served": served, "unresolved": {}, "unfamiliar_objects": unfamiliar, "ignored_objects": ignored, "candidates": [],
-                "question": None, "context": context, "instances": _instances(roles, ids_of)}
-    pool = [o for o in detected if o not in stated and o not in ignored]
-    if len(pool) < len(missing):
-        shown = [repr(o if len(o) <= 30 else o[:27] + "...") for o in ignored[:3]]  # the error stays one short line
-        unnamed = f" ({', '.join(shown)}{', ...' if len(ignored) > 3 else ''}: no object name)" if ignored else ""
-        raise CompletionError(f"cannot fill {', '.join(missing)} of {frame.predicate!r}: "
-                              f"{'no usable objects' if not pool else 'too few usable objects'} besides "
-                              f"{sorted(stated) or 'none'}{unnamed}", {"predicate": frame.predicate, "roles": roles})
+        return replace(read, frame=Frame.of(frame.predicate, roles), instances=_instances(roles, ids_of))
+    pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
     fillings = _candidate_frames(missing, pool)
-    if len(fillings) > config.max_frames:
-        raise CompletionError(f"{len(pool)} objects give {len(fillings):,} combinations for {missing}; "
-                              f"the limit is {config.max_frames:,}", {"predicate": frame.predicate, "roles": roles})
     scores = scorer([Frame.of(frame.predicate, {**roles, **f}) for f in fillings], context)
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
-    candidates = [{"object": f[missing[0]], "objects": f, "score": round(s, 4), "probability": round(p, 4),
-                   "ids": ids_of[f[missing[0]]]}
-                  for f, s, p in ranked[: len(ranked) if len(missing) == 1 else config.max_listed]]
-    chosen = ranked[0][0]
-    in_set = [c for c in candidates if c["probability"] >= config.set_threshold]
-    question = None
-    confirm = unresolved or any(o in unfamiliar for o in chosen.values())  # always asked, however likely
-    if len(in_set) != 1 and len(candidates) > 1 or confirm:
-        # One likely object is confirmed alone, unless it stands for a word we replaced: then offer others.
-        one = len(in_set) == 1 and not unresolved
-        choices = (in_set if len(in_set) > 1 or one else candidates)[: max(config.max_choices, 2)]
-        question = _question(parser.lex.predicates[frame.predicate].sentence, roles, missing, choices)
-        if unresolved:
-            question = f"I see no {' or '.join(unresolved.values())}. {question}"
-    return {"frame": {"predicate": frame.predicate, "roles": {**roles, **chosen}}, "missing": missing[0],
-            "missing_roles": missing, "referred": referred, "served": served, "unresolved": unresolved, "unfamiliar_objects": unfamiliar,
-            "ignored_objects": ignored, "candidates": candidates, "question": question, "context": context,
-            "instances": _instances({**roles, **chosen}, ids_of)}
+    candidates = tuple(
+        Candidate(f[missing[0]], f, round(s, 4), round(p, 4), tuple(ids_of[f[missing[0]]]))
+        for f, s, p in ranked[: len(ranked) if len(missing) == 1 else config.max_listed]
+    )
+    chosen = {**roles, **candidates[0].objects}
+    in_set = [c for c in candidates if c.probability >= config.set_threshold]
+    template = parser.lex.predicates[frame.predicate].sentence
+    return replace(
+        read,
+        frame=Frame.of(frame.predicate, chosen),
+        missing_roles=tuple(missing),
+        candidates=candidates,
+        question=_ask(template, roles, missing, read, candidates, in_set, config.max_choices),
+        instances=_instances(chosen, ids_of),
+        prediction_set=tuple(c.object for c in in_set),
+    )
+
+
+def _pool(
+    predicate: str,
+    roles: dict[str, str | None],
+    missing: list[str],
+    unstated: list[str],
+    ignored: list[str],
+    config: CompletionConfig,
+) -> list[str]:
+    """The objects the missing roles may be filled with (the unstated detections that name an object), or
+    CompletionError when there are too few of them or they give too many combinations to score."""
+    pool = [o for o in unstated if o not in ignored]
+    if len(pool) < len(missing):
+        stated = sorted({v for v in roles.values() if v})
+        shown = [repr(o if len(o) <= 30 else o[:27] + "...") for o in ignored[:3]]  # the error stays one short line
+        unnamed = f" ({', '.join(shown)}{', ...' if len(ignored) > 3 else ''}: no object name)" if ignored else ""
+        raise CompletionError(
+            f"cannot fill {', '.join(missing)} of {predicate!r}: "
+            f"{'no usable objects' if not pool else 'too few usable objects'} besides "
+            f"{stated or 'none'}{unnamed}",
+            {"predicate": predicate, "roles": roles},
+        )
+    combinations = len(pool) if len(missing) == 1 else len(pool) * (len(pool) - 1)
+    if combinations > config.max_frames:
+        raise CompletionError(
+            f"{len(pool)} objects give {combinations:,} combinations for {missing}; the limit is {config.max_frames:,}",
+            {"predicate": predicate, "roles": roles},
+        )
+    return pool
+
+
+def _ask(
+    template: str,
+    roles: dict[str, str | None],
+    missing: list[str],
+    read: Completion,
+    candidates: tuple[Candidate, ...],
+    in_set: list[Candidate],
+    max_choices: int,
+) -> str | None:
+    """The clarifying question, or None when the choice is clear: asked when the prediction set `in_set`
+    holds more or fewer than one candidate (and there was a choice), and always when the best candidate
+    stands for a word the robot could not ground (`read.unresolved`) or names an object outside its
+    vocabulary, however likely."""
+    confirm = read.unresolved or any(o in read.unfamiliar_objects for o in candidates[0].objects.values())
+    if not (len(in_set) != 1 and len(candidates) > 1 or confirm):
+        return None
+    # One likely object is confirmed alone, unless it stands for a word we replaced: then offer others.
+    one = len(in_set) == 1 and not read.unresolved
+    choices = (in_set if len(in_set) > 1 or one else list(candidates))[: max(max_choices, 2)]
+    question = _question(template, roles, missing, choices)
+    if read.unresolved:
+        return f"I see no {' or '.join(read.unresolved.values())}. {question}"
+    return question
 
 
 def _instances(roles: dict[str, str | None], ids_of: dict[str, list[str]]) -> dict[str, list[str]]:
@@ -213,7 +342,7 @@ def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str
     the ceil((n + 1)(1 - alpha))/n empirical quantile, so the set {p >= 1 - q} holds the right object
     with probability >= 1 - alpha on exchangeable data."""
     if not positive_first:
-        raise ValueError("calibration needs at least one scenario")
+        raise CompletionError("calibration needs at least one scenario (the ratings give none)")
     grid = [10 ** (e / 20) for e in range(-40, 41)]
 
     def nll(t: float) -> float:
@@ -224,8 +353,11 @@ def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str
     n = len(scores)
     rank = min(n, math.ceil((n + 1) * (1 - alpha)))
     q = scores[rank - 1]
-    return CompletionConfig(temperature=temperature, set_threshold=max(1 - q, 1e-6),
-                            source=source or f"calibrated on {n} dev scenarios (alpha={alpha:g}, NLL {nll(temperature):.3f})")
+    return CompletionConfig(
+        temperature=temperature,
+        set_threshold=max(1 - q, 1e-6),
+        source=source or f"calibrated on {n} dev scenarios (alpha={alpha:g}, NLL {nll(temperature):.3f})",
+    )
 
 
 def save_config(config: CompletionConfig, path: Path, fingerprint: str | None) -> None:

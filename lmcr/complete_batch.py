@@ -25,14 +25,21 @@ def read_complete_input(path: Path) -> list[tuple[int, dict]]:
     return records
 
 
-def complete_batch(parser: FrameParser, scorer: Scorer, config: CompletionConfig, records: list[tuple[int, dict]],
-                   path: Path, log: Callable[[str], None] = lambda message: None) -> Iterator[dict]:
+def complete_batch(
+    parser: FrameParser,
+    scorer: Scorer,
+    config: CompletionConfig,
+    records: list[tuple[int, dict]],
+    path: Path,
+    log: Callable[[str], None] = lambda message: None,
+) -> Iterator[dict]:
     """Each record completed, in order, as soon as it is done. A record that cannot be completed (no known
     predicate, no usable objects, a text the parser cannot take) gets {"id", "error"}, `log` hears it with
     its place (`path` and line), and the batch goes on."""
     for line, record in records:
         try:
-            yield {"id": record["id"], **complete(parser, scorer, record["instruction"], record["objects"], config)}
+            completion = complete(parser, scorer, record["instruction"], record["objects"], config)
+            yield {"id": record["id"], **completion.to_json()}
         except (NoPredicateError, CompletionError, InputError) as exc:
             log(f"{path}:{line}: {one_line(exc)}")
             yield {"id": record["id"], "error": one_line(exc)}

@@ -40,8 +40,7 @@ def read_resource(path: Path, what: str, build: Callable[[object], T]) -> T:
     try:
         return build(json.loads(Path(path).read_text(encoding="utf-8")))
     except UNREADABLE_JSON as exc:
-        raise ResourceError(f"{path}: cannot read the {what} ({one_line(exc, 200)}); "
-                            "run `lmcr frames` again") from exc
+        raise ResourceError(f"{path}: cannot read the {what} ({one_line(exc, 200)}); run `lmcr frames` again") from exc
 
 
 def output_target(path: Path) -> Path:
@@ -161,16 +160,19 @@ def check_output_dir(path: Path) -> None:
         return
     marker = target / OUTPUT_MARKER
     if not marker.is_file():
-        raise OutputError(f"{path}: folder is not empty and is not an LMCR output (no {OUTPUT_MARKER}); "
-                          "choose a new or empty folder")
+        raise OutputError(
+            f"{path}: folder is not empty and is not an LMCR output (no {OUTPUT_MARKER}); choose a new or empty folder"
+        )
     try:
         ours = set(json.loads(marker.read_text(encoding="utf-8"))["files"]) | {OUTPUT_MARKER}
     except (ValueError, KeyError, TypeError, OSError) as exc:
         raise OutputError(f"{path}: unreadable output marker {OUTPUT_MARKER}; choose a new or empty folder") from exc
     foreign = sorted(present - ours)
     if foreign:
-        raise OutputError(f"{path}: holds files LMCR did not write ({', '.join(foreign[:3])}"
-                          f"{', ...' if len(foreign) > 3 else ''}); move them or choose another folder")
+        raise OutputError(
+            f"{path}: holds files LMCR did not write ({', '.join(foreign[:3])}"
+            f"{', ...' if len(foreign) > 3 else ''}); move them or choose another folder"
+        )
 
 
 @contextmanager

@@ -78,8 +78,9 @@ def read_frames_csv(path: Path, *, reserved: Callable[[str], bool]) -> tuple[lis
         taken = [c for c in columns if reserved(c)]
         if taken:
             raise InputError(f"{path}:1: column {taken[0]!r} is named like a method; rename it")
-        rows = [FrameRow(reader.line_num, _frame_of(row, path, reader.line_num, lex, len(columns)), row)
-                for row in reader]
+        rows = [
+            FrameRow(reader.line_num, _frame_of(row, path, reader.line_num, lex, len(columns)), row) for row in reader
+        ]
     except csv.Error as exc:
         raise InputError(f"{path}:{reader.line_num}: not CSV: {exc}") from exc
     return columns, rows
@@ -93,8 +94,10 @@ def _frame_of(row: dict, path: Path, line: int, lex: Lexicon, n_columns: int) ->
     spec = lex.predicates.get(verb)
     if spec is None:
         raise InputError(f"{path}:{line}: unknown verb {row['verb']!r} (one of {', '.join(sorted(lex.predicates))})")
-    roles = {(row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
-             (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower()}
+    roles = {
+        (row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
+        (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower(),
+    }
     if set(roles) != set(spec.roles):
         raise InputError(f"{path}:{line}: roles {sorted(roles)} are not {verb}'s {list(spec.roles)}")
     if not all(roles.values()):

@@ -75,8 +75,9 @@ def read_jsonl(path: Path, required: dict[str, type | tuple[type, ...]]) -> Iter
         yield line_no, record
 
 
-def read_jsonl_lines(path: Path, required: dict[str, type | tuple[type, ...]]
-                     ) -> Iterator[tuple[int, dict | None, InputError | None]]:
+def read_jsonl_lines(
+    path: Path, required: dict[str, type | tuple[type, ...]]
+) -> Iterator[tuple[int, dict | None, InputError | None]]:
     """(line number, record, None) for each good non-blank line and (line number, the decoded object or
     None, InputError) for each bad one, so a batch can report a bad line and go on. Only a file that
     cannot be read at all raises."""

@@ -24,8 +24,11 @@ def is_object_name(label: str) -> bool:
     not only function words."""
     from spacy.lang.en.stop_words import STOP_WORDS  # here, not at import: the CLI starts without spaCy
 
-    return len(label) <= MAX_OBJECT_NAME_CHARS and _OBJECT_NAME_RE.fullmatch(label) is not None \
+    return (
+        len(label) <= MAX_OBJECT_NAME_CHARS
+        and _OBJECT_NAME_RE.fullmatch(label) is not None
         and not STOP_WORDS.issuperset(label.split())
+    )
 
 
 @dataclass(frozen=True)
@@ -76,16 +79,24 @@ def load_lexicon(path: str | None = None) -> Lexicon:
     data = json.loads(Path(path or os.environ.get("LMCR_LEXICON") or LEXICON_PATH).read_text("utf-8"))
     predicates = {
         name: PredicateSpec(
-            name=name, roles=tuple(spec["roles"]), object_role=spec["object"], with_role=spec.get("with"),
+            name=name,
+            roles=tuple(spec["roles"]),
+            object_role=spec["object"],
+            with_role=spec.get("with"),
             preps={role: tuple(p) for role, p in spec.get("preps", {}).items()},
-            particles=frozenset(spec.get("particles", [])), alternating=bool(spec.get("alternating")),
-            sentence=spec["sentence"], past=spec.get("past"),
+            particles=frozenset(spec.get("particles", [])),
+            alternating=bool(spec.get("alternating")),
+            sentence=spec["sentence"],
+            past=spec.get("past"),
         )
         for name, spec in data["predicates"].items()
     }
     return Lexicon(
-        predicates=predicates, measure_nouns=frozenset(data["measure_nouns"]),
-        quantity_nouns=frozenset(data["quantity_nouns"]), object_pronouns=frozenset(data["object_pronouns"]),
-        recipient_pronouns=frozenset(data["recipient_pronouns"]), objects=tuple(data.get("objects", ())),
+        predicates=predicates,
+        measure_nouns=frozenset(data["measure_nouns"]),
+        quantity_nouns=frozenset(data["quantity_nouns"]),
+        object_pronouns=frozenset(data["object_pronouns"]),
+        recipient_pronouns=frozenset(data["recipient_pronouns"]),
+        objects=tuple(data.get("objects", ())),
         courtesy_words=frozenset(data.get("courtesy_words", ())),
     )

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from lmcr.errors import LMCRError
+
 LINEARIZATIONS = ("sentence", "frame")
 # What ingest loads each input as; a setting trains on one of them or on all together.
 SOURCE_CORPORA = ("youcook2", "recipes", "household")
@@ -15,10 +17,14 @@ LM_METHODS = {"sentence_lm": "sentence", "frame_lm": "frame"}
 METHOD_OF = {linearization: method for method, linearization in LM_METHODS.items()}
 
 
+class SettingError(LMCRError, ValueError):
+    """A setting, linearisation or corpus name that is not one of the known ones."""
+
+
 def check_corpus(corpus: str) -> str:
-    """`corpus` when it is one of CORPORA (it may become part of SQL text), else ValueError."""
+    """`corpus` when it is one of CORPORA (it may become part of SQL text), else SettingError."""
     if corpus not in CORPORA:
-        raise ValueError(f"corpus must be one of {CORPORA}, not {corpus!r}")
+        raise SettingError(f"corpus must be one of {CORPORA}, not {corpus!r}")
     return corpus
 
 
@@ -29,7 +35,7 @@ class Setting:
 
     def __post_init__(self) -> None:
         if self.linearization not in LINEARIZATIONS:
-            raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {self.linearization!r}")
+            raise SettingError(f"linearization must be one of {LINEARIZATIONS}, not {self.linearization!r}")
         check_corpus(self.corpus)
 
     @classmethod
@@ -38,8 +44,10 @@ class Setting:
         head, sep, corpus = text.partition("/" if "/" in text else "-")
         linearization = LM_METHODS.get(head, head)
         if linearization not in LINEARIZATIONS:
-            raise ValueError(f"unknown setting {text!r}: write linearization-corpus (e.g. sentence-all) or "
-                             f"method/corpus (e.g. sentence_lm/all)")
+            raise SettingError(
+                f"unknown setting {text!r}: write linearization-corpus (e.g. sentence-all) or "
+                f"method/corpus (e.g. sentence_lm/all)"
+            )
         return cls(linearization, corpus if sep else "all")
 
     @property

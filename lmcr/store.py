@@ -20,8 +20,12 @@ MIGRATION_NAME = re.compile(r"^(\d{3})_[a-z0-9_]+\.sql$")
 # written (COPY, EXPORT DATABASE, read_csv, read_text, glob, ATTACH all refused), no extension is
 # installed or loaded, and the configuration is locked once set, so a query cannot SET any of it back.
 QUERY_STATEMENTS = ("SELECT", "EXPLAIN", "PRAGMA", "CALL")  # what a query may be: no ATTACH, COPY, LOAD, SET
-QUERY_CONFIG = {"enable_external_access": False, "allow_community_extensions": False,
-                "autoload_known_extensions": False, "autoinstall_known_extensions": False}
+QUERY_CONFIG = {
+    "enable_external_access": False,
+    "allow_community_extensions": False,
+    "autoload_known_extensions": False,
+    "autoinstall_known_extensions": False,
+}
 
 
 class MigrationError(LMCRError, RuntimeError):
@@ -36,6 +40,10 @@ class StoreBusyError(LMCRError, RuntimeError):
     """Another process holds the store's write lock."""
 
 
+class QueryError(LMCRError, ValueError):
+    """A user's SQL query that is refused or fails (a write, a missing parameter, a DuckDB error)."""
+
+
 def _open(db: str | Path, read_only: bool, config: dict | None = None) -> duckdb.DuckDBPyConnection:
     """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
     try:
@@ -44,7 +52,9 @@ def _open(db: str | Path, read_only: bool, config: dict | None = None) -> duckdb
         raise
     except duckdb.Error as exc:  # a held lock; not a DuckDB file, a newer storage version, ...
         if isinstance(exc, duckdb.IOException) and "lock" in str(exc).lower():
-            raise StoreBusyError(f"store busy: another lmcr process is writing {db}; try again when it finishes") from exc
+            raise StoreBusyError(
+                f"store busy: another lmcr process is writing {db}; try again when it finishes"
+            ) from exc
         raise MigrationError(f"{db}: cannot open the store: {one_line(exc, 200)}") from exc
 
 
@@ -61,8 +71,13 @@ def transaction(con: duckdb.DuckDBPyConnection) -> Iterator[duckdb.DuckDBPyConne
     con.execute("commit")
 
 
-def insert_rows(con: duckdb.DuckDBPyConnection, table: str, rows: list[dict], key: str | None = None,
-                convert: dict[str, str] | None = None) -> None:
+def insert_rows(
+    con: duckdb.DuckDBPyConnection,
+    table: str,
+    rows: list[dict],
+    key: str | None = None,
+    convert: dict[str, str] | None = None,
+) -> None:
     """Insert dict rows by column name (as sqlite-utils' `insert_all`): columns the rows lack take their
     defaults; with `key`, rows whose key is already in the table are left as they are; `convert` maps a
     column to the SQL expression that converts its value on the way in (e.g. `mturk_time(submit_time)`)."""
@@ -154,8 +169,10 @@ def migrate(con: duckdb.DuckDBPyConnection, sql_dir: Path) -> list[str]:
         try:
             with transaction(con):
                 con.execute(mig.path.read_text(encoding="utf-8"))
-                con.execute("insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
-                            [mig.version, mig.name, mig.sha256])
+                con.execute(
+                    "insert into schema_migrations (version, name, sha256) values (?, ?, ?)",
+                    [mig.version, mig.name, mig.sha256],
+                )
         except duckdb.Error as exc:
             raise MigrationError(f"{mig.path}: {one_line(exc)}; rolled back, still pending") from exc
         done.append(mig.name)
@@ -178,11 +195,11 @@ def query_params(sql: str) -> list[str]:
 
 def query_connection(db: str | Path) -> duckdb.DuckDBPyConnection:
     """A connection for a user's SQL: read-only, the store and nothing else (QUERY_CONFIG), locked.
-    The store open in this process under another configuration is a one-line ValueError."""
+    The store open in this process under another configuration is a one-line QueryError."""
     try:
         con = _open(db, read_only=True, config=QUERY_CONFIG)
     except duckdb.ConnectionException as exc:
-        raise ValueError(f"{db}: {one_line(exc)}") from exc
+        raise QueryError(f"{db}: {one_line(exc)}") from exc
     con.execute("set enable_progress_bar = false")  # a session setting: set before the lock
     con.execute("set lock_configuration = true")
     return con
@@ -192,30 +209,33 @@ def run_query(db: str | Path, sql: str, params: dict[str, str] | None = None) ->
     """(column names, rows) of one statement on a `query_connection`: a query never writes, and reads
     nothing but the store. Statements other than QUERY_STATEMENTS are refused before they run (the
     connection's configuration refuses a file access in any case); they, missing or unknown `$name`
-    parameters and SQL errors raise ValueError with a one-line reason."""
+    parameters and SQL errors raise QueryError with a one-line reason."""
     if not Path(db).is_file():
-        raise ValueError(f"no store at {db}: run `lmcr ingest` (or `make demo`) first")
+        raise QueryError(f"no store at {db}: run `lmcr ingest` (or `make demo`) first")
     params = dict(params or {})
     wanted = query_params(sql)
     missing, unknown = sorted(set(wanted) - set(params)), sorted(set(params) - set(wanted))
     if missing or unknown:
-        raise ValueError(f"query parameters: missing {missing or 'none'}, unknown {unknown or 'none'} "
-                         f"(this query takes {wanted or 'none'}; give --param NAME=VALUE)")
+        raise QueryError(
+            f"query parameters: missing {missing or 'none'}, unknown {unknown or 'none'} "
+            f"(this query takes {wanted or 'none'}; give --param NAME=VALUE)"
+        )
     con = query_connection(db)
     try:
         kinds = [s.type.name for s in con.extract_statements(sql)]
         if not kinds:
-            raise ValueError("no SQL statement given")
+            raise QueryError("no SQL statement given")
         refused = [kind for kind in kinds if kind not in QUERY_STATEMENTS]
         if refused:
-            raise ValueError(f"a query reads the store (read-only) and nothing else: {', '.join(QUERY_STATEMENTS)}, "
-                             f"not {refused[0]}")
+            raise QueryError(
+                f"a query reads the store (read-only) and nothing else: {', '.join(QUERY_STATEMENTS)}, not {refused[0]}"
+            )
         cursor = con.execute(sql, params or None)
         if cursor.description is None:
             return [], []
         return [d[0] for d in cursor.description], cursor.fetchall()
     except duckdb.Error as exc:
-        raise ValueError(one_line(exc)) from exc
+        raise QueryError(one_line(exc)) from exc
     finally:
         con.close()
 

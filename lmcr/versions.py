@@ -28,28 +28,32 @@ class CheckpointError(LMCRError, RuntimeError):
     """A published version is missing, incomplete or was modified after publishing."""
 
 
-def publish_version(root: Path, setting: str, files: tuple[str, ...], write: Callable[[Path], None],
-                    promote: bool = True) -> Path:
-    """Write a new version of `setting`: `write(folder)` creates exactly `files` in a temporary folder,
-    the manifest hashes them, the folder is renamed into place, and LATEST points at it when `promote`."""
-    remove_stale_tmp(root / setting)
+def publish_version(
+    root: Path, name: str, files: tuple[str, ...], write: Callable[[Path], None], promote: bool = True
+) -> Path:
+    """Write a new version of `name` (a folder under `root`: an LM setting's `Setting.name`, a speech
+    model's name): `write(folder)` creates exactly `files` in a temporary folder, the manifest hashes them,
+    the folder is renamed into place, and LATEST points at it when `promote`."""
+    remove_stale_tmp(root / name)
     stamp, n = time.strftime("v%Y%m%d-%H%M%S"), 1
-    while (root / setting / f"{stamp}-{n}").exists():  # several versions within one second
+    while (root / name / f"{stamp}-{n}").exists():  # several versions within one second
         n += 1
     version = f"{stamp}-{n}"
-    final = root / setting / version
-    tmp = root / setting / f".{version}.{os.getpid()}.tmp"
+    final = root / name / version
+    tmp = root / name / f".{version}.{os.getpid()}.tmp"
     tmp.mkdir(parents=True)
     try:
         write(tmp)
-        write_json(tmp / MANIFEST, {"setting": setting, "version": version,
-                                    "files": {name: file_sha256(tmp / name) for name in files}})
+        write_json(
+            tmp / MANIFEST,
+            {"setting": name, "version": version, "files": {name: file_sha256(tmp / name) for name in files}},
+        )
         os.replace(tmp, final)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     if promote:
-        set_latest(root, setting, version)
+        set_latest(root, name, version)
     return final
 
 
@@ -78,11 +82,11 @@ def remove_stale_tmp(setting_dir: Path) -> list[Path]:
     return removed
 
 
-def set_latest(root: Path, setting: str, version: str) -> None:
-    """Point the setting's LATEST at `version` (atomic replace)."""
-    if not VERSION_RE.match(version) or not (root / setting / version / MANIFEST).is_file():
-        raise CheckpointError(f"{root / setting}: no published version {version!r}")
-    with atomic_path(root / setting / "LATEST") as tmp:
+def set_latest(root: Path, name: str, version: str) -> None:
+    """Point the LATEST of `name`'s folder at `version` (atomic replace)."""
+    if not VERSION_RE.match(version) or not (root / name / version / MANIFEST).is_file():
+        raise CheckpointError(f"{root / name}: no published version {version!r}")
+    with atomic_path(root / name / "LATEST") as tmp:
         tmp.write_text(version + "\n", encoding="utf-8")
 
 
@@ -119,8 +123,10 @@ def verify(path: Path, files: tuple[str, ...]) -> dict:
     except (ValueError, KeyError, TypeError) as exc:
         raise CheckpointError(f"{manifest_path}: malformed manifest") from exc
     if not isinstance(listed, dict) or set(listed) != set(files):
-        raise CheckpointError(f"{manifest_path}: lists {sorted(listed) if isinstance(listed, dict) else listed!r}, "
-                              f"not the version's files {sorted(files)}")
+        raise CheckpointError(
+            f"{manifest_path}: lists {sorted(listed) if isinstance(listed, dict) else listed!r}, "
+            f"not the version's files {sorted(files)}"
+        )
     present = {p.name for p in path.iterdir()} - {MANIFEST}
     if present != set(files):
         raise CheckpointError(f"{path}: holds {sorted(present ^ set(files))} beyond or short of the manifest")
@@ -130,5 +136,3 @@ def verify(path: Path, files: tuple[str, ...]) -> dict:
         if file_sha256(path / name) != expected:
             raise CheckpointError(f"{path / name}: sha256 differs from the manifest (modified after publishing)")
     return manifest
-
-

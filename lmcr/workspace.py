@@ -27,6 +27,7 @@ if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first 
     from lmcr.speech.whisper import WhisperRecognizer
     from lmcr.srl.parser import FrameParser
 
+
 def _env_path(name: str) -> Path | None:
     return Path(os.environ[name]) if os.environ.get(name) else None
 
@@ -50,12 +51,18 @@ class Workspace:
     def from_env(cls, data_dir: str | Path | None = None, db: str | Path | None = None) -> Workspace:
         """Explicit arguments win, then the environment, then `data/` beside the current directory."""
         data = Path(data_dir or os.environ.get("LMCR_DATA_DIR") or "data")
-        return cls(data_dir=data, db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
-                   sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or SQL_DIR),
-                   spacy_model=spacy_model_from_env(), vectors=_env_path("LMCR_VECTORS"),
-                   conceptnet=_env_path("LMCR_CONCEPTNET"), paper=_env_path("LMCR_PAPER"),
-                   baxter_urdf=_env_path("LMCR_BAXTER_URDF"), asr=os.environ.get("LMCR_ASR") or "whisper",
-                   whisper_model=_env_path("LMCR_WHISPER_MODEL"))
+        return cls(
+            data_dir=data,
+            db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
+            sql_dir=Path(os.environ.get("LMCR_SQL_DIR") or SQL_DIR),
+            spacy_model=spacy_model_from_env(),
+            vectors=_env_path("LMCR_VECTORS"),
+            conceptnet=_env_path("LMCR_CONCEPTNET"),
+            paper=_env_path("LMCR_PAPER"),
+            baxter_urdf=_env_path("LMCR_BAXTER_URDF"),
+            asr=os.environ.get("LMCR_ASR") or "whisper",
+            whisper_model=_env_path("LMCR_WHISPER_MODEL"),
+        )
 
     @property
     def srl_dir(self) -> Path:
@@ -114,19 +121,33 @@ class Workspace:
 
         return read_connection(self.db)
 
-    def resources(self, checkpoint: Path | None = None, corpus: str = "all", vectors: str | Path | None = None,
-                  conceptnet: str | Path | None = None, seed: int = 0) -> MethodResources:
+    def resources(
+        self,
+        checkpoint: Path | None = None,
+        corpus: str = "all",
+        vectors: str | Path | None = None,
+        conceptnet: str | Path | None = None,
+        seed: int = 0,
+    ) -> MethodResources:
         """What the scorers are built from; explicit values win over the workspace's."""
         from lmcr.scorers.context_pmi import WEIGHT
         from lmcr.scorers.mixture import load_choice
         from lmcr.scorers.resources import MethodResources
 
         mixture, context_weight = load_choice(self.data_dir)  # chosen together, saved in one file
-        return MethodResources(checkpoints=Path(checkpoint) if checkpoint else self.checkpoints, corpus=corpus,
-                               db=self.db, sql_dir=self.sql_dir, vectors=Path(vectors) if vectors else self.vectors,
-                               conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
-                               spacy_model=self.spacy_model, cache_dir=self.baselines, seed=seed,
-                               mixture=mixture, context_weight=context_weight or WEIGHT)
+        return MethodResources(
+            checkpoints=Path(checkpoint) if checkpoint else self.checkpoints,
+            corpus=corpus,
+            db=self.db,
+            sql_dir=self.sql_dir,
+            vectors=Path(vectors) if vectors else self.vectors,
+            conceptnet=Path(conceptnet) if conceptnet else self.conceptnet,
+            spacy_model=self.spacy_model,
+            cache_dir=self.baselines,
+            seed=seed,
+            mixture=mixture,
+            context_weight=context_weight or WEIGHT,
+        )
 
     def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:
         """The SRL parser with this workspace's learned compounds and role priors."""

@@ -32,7 +32,12 @@ def test_youcook2_sample(sample_dir):
         "video smp_defects12 annotation 2: annotation has no sentence",
     ]
     first = parsed.sentences[0]
-    assert (first["doc_id"], first["kind"], first["seg_start"], first["seg_end"]) == ("smp_pancakes01", "instruction", 10.0, 25.0)
+    assert (first["doc_id"], first["kind"], first["seg_start"], first["seg_end"]) == (
+        "smp_pancakes01",
+        "instruction",
+        10.0,
+        25.0,
+    )
     assert parsed.documents[0]["subset"] == "training" and parsed.documents[0]["category"] == "201"
 
 
@@ -117,8 +122,12 @@ def test_mealmaster_cp437_sample(sample_dir):
     salad = [s for s in parsed.sentences if s["doc_id"] == "mealmaster_sample_cp437:1"]
     # two-column ingredient lists come out one ingredient per row
     assert [s["text"] for s in salad if s["kind"] == "ingredient"] == [
-        "1 lg Tomato, chopped", "2 tb Red wine vinegar", "1 Bell pepper, sliced", "6 tb Olive oil",
-        "1/2 ts Salt", "1 pn Black pepper",
+        "1 lg Tomato, chopped",
+        "2 tb Red wine vinegar",
+        "1 Bell pepper, sliced",
+        "6 tb Olive oil",
+        "1/2 ts Salt",
+        "1 pn Black pepper",
     ]
     assert salad[-1] == {**salad[-1], "kind": "comment", "text": "Source: Sample Kitchen Notes, 1994"}
     fries = " ".join(s["text"] for s in parsed.sentences if s["doc_id"] == "mealmaster_sample_cp437:4")
@@ -147,7 +156,8 @@ def test_detect_and_expand(sample_dir, tmp_path):
     assert detect_format(sample_dir / "feeding_america" / "sample_book.xml") == "feeding_america"
     sources = expand_inputs([sample_dir / "nyc", sample_dir / "recipes_json" / "folder"], "recipes")
     assert [(s.path.name, s.format) for s in sources] == [
-        ("mealmaster_sample_cp437.mmf", "mealmaster"), ("nyc_sample_latin1.txt", "mealmaster"),
+        ("mealmaster_sample_cp437.mmf", "mealmaster"),
+        ("nyc_sample_latin1.txt", "mealmaster"),
         ("folder", "recipe_json"),
     ]
     with pytest.raises(IngestError, match="no such file"):
@@ -162,6 +172,7 @@ def test_detect_and_expand(sample_dir, tmp_path):
 
 # --- household: EPIC-KITCHENS narrations and VirtualHome programs ---------------------------------
 
+
 def test_epic_kitchens_sample_folder(sample_dir):
     from lmcr.ingest.epic_kitchens import parse_epic_kitchens
 
@@ -170,8 +181,10 @@ def test_epic_kitchens_sample_folder(sample_dir):
     # 43 narrations in the EPIC-100-style file (5 listed twice), 7 more only in the EPIC-55-style file,
     # its 4 P90_01 rows the same narrations in older words; the class list is skipped.
     assert (parsed.records_in, parsed.records_loaded) == (52, 50)
-    assert [r[1] for r in reasons(parsed)] == ["EPIC_sample_100.csv:50: bad narration_id 'not-an-id' (want P01_01_0)",
-                                               "EPIC_sample_100.csv:51: empty narration"]
+    assert [r[1] for r in reasons(parsed)] == [
+        "EPIC_sample_100.csv:50: bad narration_id 'not-an-id' (want P01_01_0)",
+        "EPIC_sample_100.csv:51: empty narration",
+    ]
     docs = {d["doc_id"]: d for d in parsed.documents}
     assert sorted(docs) == ["epic:P90_01", "epic:P90_02", "epic:P91_01", "epic:P92_03"]
     assert (docs["epic:P92_03"]["subset"], docs["epic:P90_01"]["category"]) == ("epic-55", "P90")
@@ -183,15 +196,22 @@ def test_epic_kitchens_ids_from_video_order_and_bad_lines(tmp_path):
     from lmcr.ingest.epic_kitchens import parse_epic_kitchens
 
     path = tmp_path / "narrations.csv"
-    path.write_bytes(b"participant_id,video_id,start_timestamp,stop_timestamp,narration\n"
-                     b"P01,P01_01,0,1,open door\nP01,P01_01,1,2,pour water into glass\n"
-                     b"P01,bad,2,3,take cup\nP01,P01_01,3,4,too,many\nP01,P01_01,4,5,caf\xe9\n\n")
+    path.write_bytes(
+        b"participant_id,video_id,start_timestamp,stop_timestamp,narration\n"
+        b"P01,P01_01,0,1,open door\nP01,P01_01,1,2,pour water into glass\n"
+        b"P01,bad,2,3,take cup\nP01,P01_01,3,4,too,many\nP01,P01_01,4,5,caf\xe9\n\n"
+    )
     parsed = parse_epic_kitchens(path)
     assert_balanced(parsed)
     assert [(s["doc_id"], s["sent_id"], s["text"]) for s in parsed.sentences] == [
-        ("epic:P01_01", 0, "open door"), ("epic:P01_01", 1, "pour water into glass")]
+        ("epic:P01_01", 0, "open door"),
+        ("epic:P01_01", 1, "pour water into glass"),
+    ]
     assert [(p, r.split(": ", 1)[1][:18]) for p, r in reasons(parsed)] == [
-        (4, "no narration_id an"), (5, "6 fields, the head"), (6, "not UTF-8 (byte 0x")]
+        (4, "no narration_id an"),
+        (5, "6 fields, the head"),
+        (6, "not UTF-8 (byte 0x"),
+    ]
     not_narrations = tmp_path / "classes.csv"
     not_narrations.write_text("id,key\n0,take\n")
     with pytest.raises(IngestError, match="classes.csv:1: no 'narration' column"):
@@ -212,8 +232,11 @@ def test_virtualhome_sample(sample_dir):
     parsed = parse_virtualhome(sample_dir / "household" / "virtualhome" / "programs_sample.json")
     assert_balanced(parsed)
     assert (parsed.records_in, len(parsed.documents)) == (8, 5)  # two repeats are the same records
-    assert [r for _, r in reasons(parsed)] == ["entry 8: not a program string",
-                                               "entry 9: does not start with 'Task: <title>'", "entry 10: has no steps"]
+    assert [r for _, r in reasons(parsed)] == [
+        "entry 8: not a program string",
+        "entry 9: does not start with 'Task: <title>'",
+        "entry 10: has no steps",
+    ]
     serve = next(d for d in parsed.documents if d["title"] == "Serve milk")
     texts = [(s["kind"], s["text"]) for s in parsed.sentences if s["doc_id"] == serve["doc_id"]]
     assert texts[0] == ("title", "Serve milk") and ("instruction", "Pour milk into cup") in texts
@@ -223,8 +246,11 @@ def test_virtualhome_not_a_program_list(tmp_path):
     from lmcr.ingest.virtualhome import parse_virtualhome
 
     path = tmp_path / "p.json"
-    for body, message in ((b'{"Task": 1}', "a JSON dict, not a list"), (b"[1,", "not valid JSON"),
-                          (b'["Task: x\xff"]', "not UTF-8")):
+    for body, message in (
+        (b'{"Task": 1}', "a JSON dict, not a list"),
+        (b"[1,", "not valid JSON"),
+        (b'["Task: x\xff"]', "not UTF-8"),
+    ):
         path.write_bytes(body)
         with pytest.raises(IngestError, match=message):
             parse_virtualhome(path)
@@ -232,8 +258,10 @@ def test_virtualhome_not_a_program_list(tmp_path):
 
 def test_household_folder_expands_to_both_adapters(sample_dir):
     sources = expand_inputs([sample_dir / "household"], "household")
-    assert [(s.format, s.path.name) for s in sources] == [("epic_kitchens", "household"),
-                                                          ("virtualhome", "programs_sample.json")]
+    assert [(s.format, s.path.name) for s in sources] == [
+        ("epic_kitchens", "household"),
+        ("virtualhome", "programs_sample.json"),
+    ]
     assert detect_format(sample_dir / "household" / "epic_kitchens" / "EPIC_sample_55.csv") == "epic_kitchens"
     assert detect_format(sample_dir / "household" / "virtualhome" / "programs_sample.json") == "virtualhome"
     # The folder source's hash covers its narration files, so an edit to one is noticed.

@@ -10,18 +10,42 @@ from lmcr.annotate.results import ingest_ratings
 from lmcr.jsonl import InputError
 from lmcr.store import check_contracts
 
-META = ["HITId", "HITTypeId", "Title", "Reward", "MaxAssignments", "AssignmentId", "WorkerId", "AssignmentStatus",
-        "WorkTimeInSeconds"]
+META = [
+    "HITId",
+    "HITTypeId",
+    "Title",
+    "Reward",
+    "MaxAssignments",
+    "AssignmentId",
+    "WorkerId",
+    "AssignmentStatus",
+    "WorkTimeInSeconds",
+]
 
 
 def item(k, verb="pour", arg1="water", arg2="cup"):
-    return {f"Input.verb_{k}": verb, f"Input.role1_{k}": "Theme", f"Input.arg1_{k}": arg1,
-            f"Input.role2_{k}": "Destination", f"Input.arg2_{k}": arg2, f"Input.sentence_{k}": f"{verb} {arg1} {arg2}"}
+    return {
+        f"Input.verb_{k}": verb,
+        f"Input.role1_{k}": "Theme",
+        f"Input.arg1_{k}": arg1,
+        f"Input.role2_{k}": "Destination",
+        f"Input.arg2_{k}": arg2,
+        f"Input.sentence_{k}": f"{verb} {arg1} {arg2}",
+    }
 
 
 def row(aid, worker, ratings, status="Approved", hit="H1", items=None):
-    out = {"HITId": hit, "HITTypeId": "T", "Title": "Rate", "Reward": "$0.30", "MaxAssignments": "3",
-           "AssignmentId": aid, "WorkerId": worker, "AssignmentStatus": status, "WorkTimeInSeconds": "60"}
+    out = {
+        "HITId": hit,
+        "HITTypeId": "T",
+        "Title": "Rate",
+        "Reward": "$0.30",
+        "MaxAssignments": "3",
+        "AssignmentId": aid,
+        "WorkerId": worker,
+        "AssignmentStatus": status,
+        "WorkTimeInSeconds": "60",
+    }
     for k, r in enumerate(ratings, 1):
         out.update((items or {}).get(k, item(k, arg2=["cup", "scissors"][k - 1])))
         out[f"Answer.rating_{k}"] = r
@@ -38,12 +62,16 @@ def write(path, rows):
 
 
 def test_multi_item_file_with_every_defect(con, paths, tmp_path):
-    rows = [row("A1", "W1", ["5", "1"]), row("A2", "W2", ["4", "2"]), row("A3", "W3", ["5", "1"]),
-            row("A4", "SPAM", ["1", "5"], status="Rejected"),
-            row("A2", "W2", ["4", "2"], status="Approved"),  # the same download twice
-            row("A5", "W5", ["7", "1"]),  # out of range
-            row("A6", "W6", ["3", "3"], items={2: {**item(2), "Input.arg2_2": ""}}),  # missing input
-            row("A7", "W7", ["5", ""], items={2: {k: "" for k in item(2)}})]  # empty slot: not an item
+    rows = [
+        row("A1", "W1", ["5", "1"]),
+        row("A2", "W2", ["4", "2"]),
+        row("A3", "W3", ["5", "1"]),
+        row("A4", "SPAM", ["1", "5"], status="Rejected"),
+        row("A2", "W2", ["4", "2"], status="Approved"),  # the same download twice
+        row("A5", "W5", ["7", "1"]),  # out of range
+        row("A6", "W6", ["3", "3"], items={2: {**item(2), "Input.arg2_2": ""}}),  # missing input
+        row("A7", "W7", ["5", ""], items={2: {k: "" for k in item(2)}}),
+    ]  # empty slot: not an item
     counts = ingest_ratings(con, write(tmp_path / "batch.csv", rows))
     assert counts["layout"] == "multi" and counts["rows_in"] == 8
     assert counts["items_in"] == 15 and counts["items_duplicate"] == 2 and counts["items_quarantined"] == 2
@@ -69,10 +97,22 @@ def test_a_conflicting_redownload_is_flagged_and_leaves_the_aggregates(con, tmp_
 
 
 def test_single_item_layout(con, tmp_path):
-    rows = [{"HITId": "H", "AssignmentId": f"A{i}", "WorkerId": f"W{i}", "AssignmentStatus": "Submitted",
-             "Input.verb": "fill", "Input.role1": "Destination", "Input.arg1": "Cup", "Input.role2": "Theme",
-             "Input.arg2": "water", "Input.sentence": "Fill the cup with water.", "Answer.rating": r}
-            for i, r in enumerate(["5", "4", "x"])]
+    rows = [
+        {
+            "HITId": "H",
+            "AssignmentId": f"A{i}",
+            "WorkerId": f"W{i}",
+            "AssignmentStatus": "Submitted",
+            "Input.verb": "fill",
+            "Input.role1": "Destination",
+            "Input.arg1": "Cup",
+            "Input.role2": "Theme",
+            "Input.arg2": "water",
+            "Input.sentence": "Fill the cup with water.",
+            "Answer.rating": r,
+        }
+        for i, r in enumerate(["5", "4", "x"])
+    ]
     counts = ingest_ratings(con, write(tmp_path / "single.csv", rows))
     assert counts["layout"] == "single" and counts["items_loaded"] == 2 and counts["items_quarantined"] == 1
     assert con.execute("select verb, arg1, n, mean from frame_ratings").fetchall() == [("fill", "cup", 2, 4.5)]

@@ -20,8 +20,20 @@ def seed_ratings(con, path):
     """A past batch: 'pour water into cup' rated 5 and 'into scissors' 1 by three workers (gold material)."""
     with open(path, "w", newline="") as handle:
         w = csv.writer(handle)
-        w.writerow(["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
-                    "Input.role2", "Input.arg2", "Answer.rating"])
+        w.writerow(
+            [
+                "HITId",
+                "AssignmentId",
+                "WorkerId",
+                "AssignmentStatus",
+                "Input.verb",
+                "Input.role1",
+                "Input.arg1",
+                "Input.role2",
+                "Input.arg2",
+                "Answer.rating",
+            ]
+        )
         for i, worker in enumerate(["W1", "W2", "W3"]):
             w.writerow(["H0", f"P{i}a", worker, "Approved", "pour", "Theme", "water", "Destination", "cup", "5"])
             w.writerow(["H0", f"P{i}b", worker, "Approved", "pour", "Theme", "water", "Destination", "scissors", "1"])
@@ -53,7 +65,12 @@ def test_tasks_round_trip_with_gold_checks(con, tmp_path):
         writer = None
         for n, hit in enumerate(hits):
             for worker in ("G", "S"):
-                row = {"HITId": f"H{n}", "AssignmentId": f"{worker}{n}", "WorkerId": worker, "AssignmentStatus": "Submitted"}
+                row = {
+                    "HITId": f"H{n}",
+                    "AssignmentId": f"{worker}{n}",
+                    "WorkerId": worker,
+                    "AssignmentStatus": "Submitted",
+                }
                 row |= {f"Input.{k}": v for k, v in hit.items()}
                 for k in range(1, 6):
                     fid = hit[f"frame_id_{k}"]
@@ -114,8 +131,10 @@ def test_preview_page_structure(con, tmp_path):
 BROWSER_DIR = Path(__file__).resolve().parents[1] / "annotation" / "browser"
 
 
-@pytest.mark.skipif(not (shutil.which("node") and (BROWSER_DIR / "node_modules" / "@sparticuz" / "chromium").exists()),
-                    reason="headless Chromium not installed (make browser)")
+@pytest.mark.skipif(
+    not (shutil.which("node") and (BROWSER_DIR / "node_modules" / "@sparticuz" / "chromium").exists()),
+    reason="headless Chromium not installed (make browser)",
+)
 def test_preview_in_headless_browser(con, tmp_path):
     """The preview as Chromium renders it offline: every sentence visible with five clickable radios,
     no unfilled placeholder, and a screenshot that is not blank."""
@@ -123,8 +142,12 @@ def test_preview_in_headless_browser(con, tmp_path):
 
     generate_tasks(con, tmp_path / "tasks", TaskConfig(per_hit=4, gold_per_hit=0, n_frames=8))
     shot = tmp_path / "preview.png"
-    run = subprocess.run(["node", str(BROWSER_DIR / "check_preview.mjs"), str(tmp_path / "tasks" / "preview.html"),
-                          str(shot)], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        ["node", str(BROWSER_DIR / "check_preview.mjs"), str(tmp_path / "tasks" / "preview.html"), str(shot)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 0, run.stderr
     seen = json.loads(run.stdout.strip().splitlines()[-1])
     with open(tmp_path / "tasks" / "batch.csv", newline="") as handle:
@@ -174,9 +197,26 @@ def test_tasks_json_carries_the_hit_settings(con, tmp_path):
 
     con.close()
     db = tmp_path / "lmcr.duckdb"
-    args = ["annotate", "tasks", "--out", str(tmp_path / "t"), "--n-frames", "12", "--db", str(db),
-            "--reward", "0.45", "--assignments", "5", "--title", "Rate kitchen sentences", "--min-approved-hits", "0",
-            "--locale", "GB"]
+    args = [
+        "annotate",
+        "tasks",
+        "--out",
+        str(tmp_path / "t"),
+        "--n-frames",
+        "12",
+        "--db",
+        str(db),
+        "--reward",
+        "0.45",
+        "--assignments",
+        "5",
+        "--title",
+        "Rate kitchen sentences",
+        "--min-approved-hits",
+        "0",
+        "--locale",
+        "GB",
+    ]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     hit = json.loads((tmp_path / "t" / "tasks.json").read_text())["hit"]

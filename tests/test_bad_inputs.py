@@ -25,15 +25,21 @@ from typer.testing import CliRunner
 from lmcr.cli import app
 
 EXAMPLES = int(os.environ.get("LMCR_FUZZ_EXAMPLES", "25"))
-FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
-                suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+FUZZ = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
 runner = CliRunner()
 COUNTS: dict[str, int] = {}
 
 # JSON values of every type, for fields that must have one particular type.
-ANY_JSON = st.recursive(st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=8),
-                        lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=4), inner, max_size=3),
-                        max_leaves=6)
+ANY_JSON = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=4), inner, max_size=3),
+    max_leaves=6,
+)
 
 
 def _count(name: str) -> None:
@@ -70,8 +76,12 @@ def store_snapshot(db: Path) -> dict:
         return {}
     con = duckdb.connect(str(db))  # the CLI ran in this process: same configuration as its connection
     try:
-        tables = [t for (t,) in con.execute("select table_name from information_schema.tables "
-                                            "where table_type = 'BASE TABLE'").fetchall()]
+        tables = [
+            t
+            for (t,) in con.execute(
+                "select table_name from information_schema.tables where table_type = 'BASE TABLE'"
+            ).fetchall()
+        ]
         counts = {t: con.execute(f'select count(*) from "{t}"').fetchone()[0] for t in tables}
         return {t: n for t, n in counts.items() if n and t != "schema_migrations"}
     finally:
@@ -79,6 +89,7 @@ def store_snapshot(db: Path) -> dict:
 
 
 # --- JSON Lines of the batch commands ------------------------------------------------------------
+
 
 def _jsonl_case(fields: dict[str, object], text_field: str, list_field: str | None):
     """(lines, bad line number, mutation) with exactly one malformed line among valid ones."""
@@ -93,8 +104,9 @@ def _jsonl_case(fields: dict[str, object], text_field: str, list_field: str | No
         st.tuples(st.just("surrogate"), st.integers(0xD800, 0xDFFF)),
     )
     if list_field:
-        mutations |= st.tuples(st.just("list of non-strings"),
-                               st.lists(st.integers() | st.none() | st.booleans(), min_size=1, max_size=3))
+        mutations |= st.tuples(
+            st.just("list of non-strings"), st.lists(st.integers() | st.none() | st.booleans(), min_size=1, max_size=3)
+        )
     return st.tuples(st.just(valid), st.integers(1, 4), mutations)
 
 
@@ -131,13 +143,23 @@ def _write_jsonl(path: Path, valid: list[str], at: int, bad: bytes) -> None:
 SRL_FIELDS = {"id": "a", "text": "pour the water into the cup"}
 COMPLETE_FIELDS = {"id": "a", "instruction": "pour me some water", "objects": ["cup", "plate"]}
 LISTEN_FIELDS = {"id": "a", "audio": "said.wav"}
-INSTRUCTION_FIELDS = {"instruction": "pour me some water", "objects": ["cup", "plate"],  # no id: it is not read
-                      "expected": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}}
+INSTRUCTION_FIELDS = {
+    "instruction": "pour me some water",
+    "objects": ["cup", "plate"],  # no id: it is not read
+    "expected": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}},
+}
 SAMPLE_RATINGS = Path(__file__).resolve().parents[1] / "data" / "sample" / "ratings" / "sample_ratings_mturk.csv"
 
 
-def _check_rejected(command: str, fields: dict, text_field: str, list_field: str | None, case,
-                    argv: Callable[[Path, Path], list[str]] | None = None, made: str = "out.jsonl") -> bool:
+def _check_rejected(
+    command: str,
+    fields: dict,
+    text_field: str,
+    list_field: str | None,
+    case,
+    argv: Callable[[Path, Path], list[str]] | None = None,
+    made: str = "out.jsonl",
+) -> bool:
     """Run `lmcr COMMAND --input --output` (or `argv(input, folder)`) on one generated case; the file
     `made` (in the folder) must not appear. False when the mutation was valid."""
     valid, at, (kind, arg) = case
@@ -147,8 +169,11 @@ def _check_rejected(command: str, fields: dict, text_field: str, list_field: str
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         _write_jsonl(tmp / "in.jsonl", valid, at, bad)
-        args = argv(tmp / "in.jsonl", tmp) if argv else [command, "--input", str(tmp / "in.jsonl"),
-                                                          "--output", str(tmp / made)]
+        args = (
+            argv(tmp / "in.jsonl", tmp)
+            if argv
+            else [command, "--input", str(tmp / "in.jsonl"), "--output", str(tmp / made)]
+        )
         result = invoke(args, tmp)
         assert_one_line_error(result, tmp / "in.jsonl", at)
         assert not (tmp / made).exists()
@@ -173,6 +198,7 @@ def test_complete_batch_rejects_malformed_jsonl(case):
 @given(case=_jsonl_case(INSTRUCTION_FIELDS, "instruction", "objects"))
 def test_mixture_rejects_malformed_instructions(case):
     """`lmcr mixture --instructions`: the dev instructions a corpus weight is chosen on; nothing is saved."""
+
     def argv(instructions: Path, folder: Path) -> list[str]:
         return ["mixture", "--ratings", str(SAMPLE_RATINGS), "--instructions", str(instructions)]
 
@@ -188,28 +214,44 @@ def test_listen_batch_rejects_malformed_jsonl(case):
 
 
 SRL_INSTRUCTION_FIELDS = {key: value for key, value in INSTRUCTION_FIELDS.items() if key != "objects"}  # no scene read
-GOLD_FIELDS = {"text": "pour the water into the cup", "frames": [{"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}]}
+GOLD_FIELDS = {
+    "text": "pour the water into the cup",
+    "frames": [{"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}],
+}
 
 
 def _srl_eval_argv(gold: Path | None = None) -> Callable[[Path, Path], list[str]]:
     """srl-eval on the generated file as its gold (or, with `gold`, as its instructions)."""
+
     def argv(path: Path, folder: Path) -> list[str]:
         if gold is None:
             return ["srl-eval", "--gold", str(path)]
         (folder / "gold.jsonl").write_text(json.dumps(GOLD_FIELDS) + "\n")
         return ["srl-eval", "--gold", str(folder / "gold.jsonl"), "--instructions", str(path)]
+
     return argv
 
 
 def _is_gold_frame(value) -> bool:
-    return isinstance(value, dict) and isinstance(value.get("predicate"), str) and isinstance(value.get("roles"), dict) \
+    return (
+        isinstance(value, dict)
+        and isinstance(value.get("predicate"), str)
+        and isinstance(value.get("roles"), dict)
         and all(v is None or isinstance(v, str) for v in value["roles"].values())
+    )
 
 
 @FUZZ
-@given(case=_jsonl_case(GOLD_FIELDS, "text", None),
-       frame=st.one_of(ANY_JSON, st.fixed_dictionaries({"predicate": ANY_JSON, "roles": ANY_JSON}),
-                       st.fixed_dictionaries({"predicate": st.just("pour"), "roles": st.dictionaries(st.text(max_size=5), ANY_JSON, max_size=2)})))
+@given(
+    case=_jsonl_case(GOLD_FIELDS, "text", None),
+    frame=st.one_of(
+        ANY_JSON,
+        st.fixed_dictionaries({"predicate": ANY_JSON, "roles": ANY_JSON}),
+        st.fixed_dictionaries(
+            {"predicate": st.just("pour"), "roles": st.dictionaries(st.text(max_size=5), ANY_JSON, max_size=2)}
+        ),
+    ),
+)
 def test_srl_eval_rejects_malformed_gold(case, frame):
     """`lmcr srl-eval --gold`: the line's fields, or one of its frames not shaped as a frame."""
     if _check_rejected("srl-eval", GOLD_FIELDS, "text", None, case, _srl_eval_argv()):
@@ -219,13 +261,17 @@ def test_srl_eval_rejects_malformed_gold(case, frame):
         with tempfile.TemporaryDirectory() as tmp:
             tmp = Path(tmp)
             _write_jsonl(tmp / "gold.jsonl", valid, at, json.dumps({**GOLD_FIELDS, "frames": [frame]}).encode())
-            assert "field 'frames'" in assert_one_line_error(invoke(["srl-eval", "--gold", str(tmp / "gold.jsonl")], tmp),
-                                                             tmp / "gold.jsonl", at)
+            assert "field 'frames'" in assert_one_line_error(
+                invoke(["srl-eval", "--gold", str(tmp / "gold.jsonl")], tmp), tmp / "gold.jsonl", at
+            )
         _count("SRL gold frames")
 
 
 @FUZZ
-@given(case=_jsonl_case(SRL_INSTRUCTION_FIELDS, "instruction", None), missing=st.one_of(ANY_JSON, st.sampled_from(["Theme", "Tool"])))
+@given(
+    case=_jsonl_case(SRL_INSTRUCTION_FIELDS, "instruction", None),
+    missing=st.one_of(ANY_JSON, st.sampled_from(["Theme", "Tool"])),
+)
 def test_srl_eval_rejects_malformed_instructions(case, missing):
     """`lmcr srl-eval --instructions`: the line's fields, or a `missing` that is no expected role."""
     if _check_rejected("srl-eval", SRL_INSTRUCTION_FIELDS, "instruction", None, case, _srl_eval_argv(Path("gold"))):
@@ -234,8 +280,12 @@ def test_srl_eval_rejects_malformed_instructions(case, missing):
         valid, at, _ = case
         with tempfile.TemporaryDirectory() as tmp:
             tmp = Path(tmp)
-            _write_jsonl(tmp / "in.jsonl", valid, at, json.dumps({**SRL_INSTRUCTION_FIELDS, "missing": missing}).encode())
-            line = assert_one_line_error(invoke(_srl_eval_argv(Path("gold"))(tmp / "in.jsonl", tmp), tmp), tmp / "in.jsonl", at)
+            _write_jsonl(
+                tmp / "in.jsonl", valid, at, json.dumps({**SRL_INSTRUCTION_FIELDS, "missing": missing}).encode()
+            )
+            line = assert_one_line_error(
+                invoke(_srl_eval_argv(Path("gold"))(tmp / "in.jsonl", tmp), tmp), tmp / "in.jsonl", at
+            )
             assert "field 'missing'" in line
         _count("SRL instructions missing")
 
@@ -251,15 +301,17 @@ def test_srl_batch_text_over_the_length_cap_is_one_line(tmp_path):
 
 FRAMES_HEADER = "verb,role1,arg1,role2,arg2,note"
 FRAMES_ROW = "pour,Theme,water,Destination,cup,x"
-FRAME_DEFECTS = st.sampled_from([
-    ("bad header", "verb,role1,arg1,arg2", 1),
-    ("method column", "verb,role1,arg1,role2,arg2,sentence_lm", 1),
-    ("unknown verb", "juggle,Theme,water,Destination,cup,x", None),
-    ("wrong roles", "pour,Theme,water,Source,cup,x", None),
-    ("empty argument", "pour,Theme,,Destination,cup,x", None),
-    ("extra field", "pour,Theme,water,Destination,cup,x,y", None),
-    ("undecodable", b"pour,Theme,wat\xe9r,Destination,cup,x", None),
-])
+FRAME_DEFECTS = st.sampled_from(
+    [
+        ("bad header", "verb,role1,arg1,arg2", 1),
+        ("method column", "verb,role1,arg1,role2,arg2,sentence_lm", 1),
+        ("unknown verb", "juggle,Theme,water,Destination,cup,x", None),
+        ("wrong roles", "pour,Theme,water,Source,cup,x", None),
+        ("empty argument", "pour,Theme,,Destination,cup,x", None),
+        ("extra field", "pour,Theme,water,Destination,cup,x,y", None),
+        ("undecodable", b"pour,Theme,wat\xe9r,Destination,cup,x", None),
+    ]
+)
 
 
 @FUZZ
@@ -273,8 +325,12 @@ def test_score_rejects_malformed_frames_csv(defect, before, after):
             rows = [bad.encode()] + [FRAMES_ROW.encode()] * (before + after)
         else:
             line = 2 + before
-            rows = ([FRAMES_HEADER.encode()] + [FRAMES_ROW.encode()] * before
-                    + [bad if isinstance(bad, bytes) else bad.encode()] + [FRAMES_ROW.encode()] * after)
+            rows = (
+                [FRAMES_HEADER.encode()]
+                + [FRAMES_ROW.encode()] * before
+                + [bad if isinstance(bad, bytes) else bad.encode()]
+                + [FRAMES_ROW.encode()] * after
+            )
         path.write_bytes(b"\n".join(rows) + b"\n")
         result = invoke(["score", "--frames", str(path), "--out", str(tmp / "scores.csv"), "--methods", "random"], tmp)
         assert_one_line_error(result, path, line)
@@ -292,16 +348,32 @@ VECTOR_DEFECTS = st.one_of(
 
 
 @FUZZ
-@given(before=st.lists(st.sampled_from(VECTOR_LINES[:2]), max_size=3), defect=VECTOR_DEFECTS,
-       header=st.booleans(), garbage=st.sampled_from([b"", b"\xff"]))
+@given(
+    before=st.lists(st.sampled_from(VECTOR_LINES[:2]), max_size=3),
+    defect=VECTOR_DEFECTS,
+    header=st.booleans(),
+    garbage=st.sampled_from([b"", b"\xff"]),
+)
 def test_a_malformed_vector_file_is_one_line_naming_its_line(before, defect, header, garbage):
     lines = ([VECTOR_LINES[2]] if header else []) + ["pour 0 1", *before, defect]
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
         (tmp / "v.txt").write_bytes("\n".join(lines).encode() + b"\n" + garbage)
-        result = invoke(["score", "--frames", str(tmp / "frames.csv"), "--out", str(tmp / "scores.csv"),
-                         "--methods", "word2vec", "--vectors", str(tmp / "v.txt")], tmp)
+        result = invoke(
+            [
+                "score",
+                "--frames",
+                str(tmp / "frames.csv"),
+                "--out",
+                str(tmp / "scores.csv"),
+                "--methods",
+                "word2vec",
+                "--vectors",
+                str(tmp / "v.txt"),
+            ],
+            tmp,
+        )
         if result.exit_code == 0:  # the defect made a valid line after all ("milk 1 2")
             assert not garbage and len(defect.split()) == 3
         else:
@@ -310,14 +382,21 @@ def test_a_malformed_vector_file_is_one_line_naming_its_line(before, defect, hea
     _count("vector text")
 
 
-EDGE_LINES = ["RelatedTo\tcup\tmug", "/a/[x]\t/r/AtLocation\t/c/en/milk\t/c/en/fridge\t{}", "RelatedTo\t/c/fr/tasse\t/c/fr/bol"]
+EDGE_LINES = [
+    "RelatedTo\tcup\tmug",
+    "/a/[x]\t/r/AtLocation\t/c/en/milk\t/c/en/fridge\t{}",
+    "RelatedTo\t/c/fr/tasse\t/c/fr/bol",
+]
 
 
 @FUZZ
-@given(before=st.lists(st.sampled_from(EDGE_LINES), max_size=3),
-       defect=st.one_of(st.text(alphabet="ab\t /", max_size=6).filter(lambda t: t.count("\t") < 2 and t.strip()),
-                        st.just("\udcff")),
-       gz=st.sampled_from(["plain", "gzip", "corrupt gzip"]))
+@given(
+    before=st.lists(st.sampled_from(EDGE_LINES), max_size=3),
+    defect=st.one_of(
+        st.text(alphabet="ab\t /", max_size=6).filter(lambda t: t.count("\t") < 2 and t.strip()), st.just("\udcff")
+    ),
+    gz=st.sampled_from(["plain", "gzip", "corrupt gzip"]),
+)
 def test_a_malformed_conceptnet_edge_file_is_one_line(before, defect, gz):
     lines = [EDGE_LINES[0], *before, defect]
     raw = "\n".join(lines).encode("utf-8", "surrogateescape") + b"\n"
@@ -326,8 +405,20 @@ def test_a_malformed_conceptnet_edge_file_is_one_line(before, defect, gz):
         path = tmp / ("edges.txt.gz" if gz != "plain" else "edges.txt")
         path.write_bytes(gzip.compress(raw) if gz == "gzip" else raw if gz == "plain" else b"\x1f\x8b" + raw)
         (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
-        result = invoke(["score", "--frames", str(tmp / "frames.csv"), "--out", str(tmp / "scores.csv"),
-                         "--methods", "conceptnet", "--conceptnet", str(path)], tmp)
+        result = invoke(
+            [
+                "score",
+                "--frames",
+                str(tmp / "frames.csv"),
+                "--out",
+                str(tmp / "scores.csv"),
+                "--methods",
+                "conceptnet",
+                "--conceptnet",
+                str(path),
+            ],
+            tmp,
+        )
         named_line = gz != "corrupt gzip" and defect != "\udcff"
         assert "edge" in assert_one_line_error(result, path, len(lines) if named_line else None)
         assert not (tmp / "scores.csv").exists()
@@ -341,13 +432,19 @@ ANSWERS = st.sampled_from(["1", "5", "0", "6", "٣", "²", "3.0", " 4", "", "x",
 
 
 @FUZZ
-@given(answers=st.lists(st.lists(ANSWERS, min_size=2, max_size=2), min_size=1, max_size=4),
-       extra=st.lists(st.booleans(), min_size=4, max_size=4), work=st.sampled_from(["60", "²", "", "-1"]))
+@given(
+    answers=st.lists(st.lists(ANSWERS, min_size=2, max_size=2), min_size=1, max_size=4),
+    extra=st.lists(st.booleans(), min_size=4, max_size=4),
+    work=st.sampled_from(["60", "²", "", "-1"]),
+)
 def test_mturk_results_quarantine_defects_and_balance(answers, extra, work):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        header = MTURK_META + [f"{f}_{k}" for k in (1, 2) for f in ("Input.verb", "Input.role1", "Input.arg1",
-                                                                     "Input.role2", "Input.arg2", "Answer.rating")]
+        header = MTURK_META + [
+            f"{f}_{k}"
+            for k in (1, 2)
+            for f in ("Input.verb", "Input.role1", "Input.arg1", "Input.role2", "Input.arg2", "Answer.rating")
+        ]
         lines = [",".join(header)]
         for n, pair in enumerate(answers):
             cells = [f"H{n}", f"A{n}", f"W{n}", "Submitted", work]
@@ -361,10 +458,13 @@ def test_mturk_results_quarantine_defects_and_balance(answers, extra, work):
         con = duckdb.connect(str(tmp / "data" / "lmcr.duckdb"))
         ratings = [r for (r,) in con.execute("select rating from ratings").fetchall()]
         items_in, loaded, quarantined = con.execute(
-            "select items_in, items_loaded, items_quarantined from rating_files").fetchone()
+            "select items_in, items_loaded, items_quarantined from rating_files"
+        ).fetchone()
         con.close()
         assert set(ratings) <= {1, 2, 3, 4, 5} and items_in == loaded + quarantined
-        good = sum(a.strip() in ("1", "2", "3", "4", "5") for n, pair in enumerate(answers) if not extra[n] for a in pair)
+        good = sum(
+            a.strip() in ("1", "2", "3", "4", "5") for n, pair in enumerate(answers) if not extra[n] for a in pair
+        )
         assert len(ratings) == good
     _count("MTurk CSV")
 
@@ -378,8 +478,16 @@ def test_mturk_file_that_is_not_results_is_one_line(tmp_path):
 
 # --- scene JSON (lmcr execute --scene) ------------------------------------------------------------
 
-BAD_XY = st.one_of(st.just([float("nan"), 0.0]), st.just([0.0, float("inf")]), st.just(["0.1", 0.2]),
-                   st.just([0.1]), st.just([True, 0.0]), st.just({"x": 0}), st.just("0.1,0.2"), st.just([0.9, 0.0]))
+BAD_XY = st.one_of(
+    st.just([float("nan"), 0.0]),
+    st.just([0.0, float("inf")]),
+    st.just(["0.1", 0.2]),
+    st.just([0.1]),
+    st.just([True, 0.0]),
+    st.just({"x": 0}),
+    st.just("0.1,0.2"),
+    st.just([0.9, 0.0]),
+)
 BAD_SCENES = st.one_of(
     st.tuples(st.just("objects"), ANY_JSON.filter(lambda v: not isinstance(v, list))),
     st.tuples(st.just("object"), ANY_JSON.filter(lambda v: not isinstance(v, dict))),
@@ -417,6 +525,7 @@ def test_execute_rejects_malformed_scenes(bad):
 
 # --- corpus ingestion: every adapter ------------------------------------------------------------
 
+
 def _ingest_and_check(tmp: Path, path: Path, flag: str, extra: list[str] = ()) -> None:
     db = tmp / "data" / "lmcr.duckdb"
     before = store_snapshot(db)
@@ -424,8 +533,9 @@ def _ingest_and_check(tmp: Path, path: Path, flag: str, extra: list[str] = ()) -
     assert "Traceback" not in result.output
     if result.exit_code == 0:
         con = duckdb.connect(str(db))
-        unbalanced = con.execute("select count(*) from ingested_files where records_in <> records_loaded + "
-                                 "records_quarantined").fetchone()[0]
+        unbalanced = con.execute(
+            "select count(*) from ingested_files where records_in <> records_loaded + records_quarantined"
+        ).fetchone()[0]
         con.close()
         assert unbalanced == 0
     else:
@@ -433,9 +543,13 @@ def _ingest_and_check(tmp: Path, path: Path, flag: str, extra: list[str] = ()) -
         assert store_snapshot(db) == before
 
 
-YOUCOOK_VALUES = st.one_of(ANY_JSON, st.just({"v1": {"annotations": [{"segment": [1, 2], "sentence": "fry the egg"}]}}),
-                           st.just({"v1": {"annotations": [{"segment": [float("nan"), 2], "sentence": "x"}],
-                                           "subset": 3, "video_url": ["u"]}}))
+YOUCOOK_VALUES = st.one_of(
+    ANY_JSON,
+    st.just({"v1": {"annotations": [{"segment": [1, 2], "sentence": "fry the egg"}]}}),
+    st.just(
+        {"v1": {"annotations": [{"segment": [float("nan"), 2], "sentence": "x"}], "subset": 3, "video_url": ["u"]}}
+    ),
+)
 
 
 @FUZZ
@@ -450,12 +564,16 @@ def test_ingest_youcook2_never_tracebacks(database, wrap, garbage):
     _count("YouCook2 JSON")
 
 
-RECIPE_LINES = st.lists(st.one_of(
-    ANY_JSON.map(json.dumps),
-    st.fixed_dictionaries({"title": ANY_JSON, "directions": ANY_JSON, "url": ANY_JSON}).map(json.dumps),
-    st.just('{"title": "a\\ud800", "directions": ["fry it"]}'),
-    st.text(max_size=10),
-), min_size=1, max_size=5)
+RECIPE_LINES = st.lists(
+    st.one_of(
+        ANY_JSON.map(json.dumps),
+        st.fixed_dictionaries({"title": ANY_JSON, "directions": ANY_JSON, "url": ANY_JSON}).map(json.dumps),
+        st.just('{"title": "a\\ud800", "directions": ["fry it"]}'),
+        st.text(max_size=10),
+    ),
+    min_size=1,
+    max_size=5,
+)
 
 
 @FUZZ
@@ -474,8 +592,10 @@ def test_ingest_recipe_jsonl_never_tracebacks(lines, gz):
 
 
 @FUZZ
-@given(body=st.binary(max_size=200), header=st.sampled_from([b"", b"MMMMM----- Recipe via Meal-Master\n",
-                                                            b"Title: Soup\n"]))
+@given(
+    body=st.binary(max_size=200),
+    header=st.sampled_from([b"", b"MMMMM----- Recipe via Meal-Master\n", b"Title: Soup\n"]),
+)
 def test_ingest_mealmaster_never_tracebacks(body, header):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -492,20 +612,33 @@ def test_ingest_feeding_america_never_tracebacks(inner, tag, garbage):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         path = tmp / "book.xml"
-        path.write_bytes(f"<{tag}><recipe><p>".encode() + inner.encode("utf-8", "surrogatepass") + garbage
-                         + f"</p></recipe></{tag}>".encode())
+        path.write_bytes(
+            f"<{tag}><recipe><p>".encode()
+            + inner.encode("utf-8", "surrogatepass")
+            + garbage
+            + f"</p></recipe></{tag}>".encode()
+        )
         _ingest_and_check(tmp, path, "--recipes")
     _count("Feeding America XML")
 
 
-EPIC_FIELDS = st.lists(st.one_of(st.sampled_from(["P01", "P01_01", "P01_01_3", "pour water into glass", "", '"', ","]),
-                                 st.text(max_size=6)), min_size=1, max_size=6)
+EPIC_FIELDS = st.lists(
+    st.one_of(
+        st.sampled_from(["P01", "P01_01", "P01_01_3", "pour water into glass", "", '"', ","]), st.text(max_size=6)
+    ),
+    min_size=1,
+    max_size=6,
+)
 
 
 @FUZZ
-@given(header=st.sampled_from([b"narration_id,video_id,narration\n", b"participant_id,video_id,start_timestamp,narration\n",
-                               b"id,key\n", b""]),
-       rows=st.lists(EPIC_FIELDS, max_size=4), garbage=st.binary(max_size=4))
+@given(
+    header=st.sampled_from(
+        [b"narration_id,video_id,narration\n", b"participant_id,video_id,start_timestamp,narration\n", b"id,key\n", b""]
+    ),
+    rows=st.lists(EPIC_FIELDS, max_size=4),
+    garbage=st.binary(max_size=4),
+)
 def test_ingest_epic_kitchens_never_tracebacks(header, rows, garbage):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -517,9 +650,21 @@ def test_ingest_epic_kitchens_never_tracebacks(header, rows, garbage):
 
 
 @FUZZ
-@given(programs=st.one_of(ANY_JSON, st.lists(st.one_of(
-    ANY_JSON, st.just("Task: Serve milk\nStep 1: Pour milk into cup"), st.just("Task: x\nStep 1: a\ud800"),
-    st.text(max_size=20).map(lambda t: "Task: " + t)), max_size=4)), garbage=st.binary(max_size=3))
+@given(
+    programs=st.one_of(
+        ANY_JSON,
+        st.lists(
+            st.one_of(
+                ANY_JSON,
+                st.just("Task: Serve milk\nStep 1: Pour milk into cup"),
+                st.just("Task: x\nStep 1: a\ud800"),
+                st.text(max_size=20).map(lambda t: "Task: " + t),
+            ),
+            max_size=4,
+        ),
+    ),
+    garbage=st.binary(max_size=3),
+)
 def test_ingest_virtualhome_never_tracebacks(programs, garbage):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -531,8 +676,11 @@ def test_ingest_virtualhome_never_tracebacks(programs, garbage):
 
 # --- the learned SRL resources the frames stage publishes, damaged -----------------------------
 
-RESOURCE_KEYS = {"compounds.json": ("head_rates", "strong_bigrams", "predicative", "proper", "singular_counts"),
-                 "role_priors.json": ("by_verb", "pooled"), "first_words.json": ("heat", "pour")}
+RESOURCE_KEYS = {
+    "compounds.json": ("head_rates", "strong_bigrams", "predicative", "proper", "singular_counts"),
+    "role_priors.json": ("by_verb", "pooled"),
+    "first_words.json": ("heat", "pour"),
+}
 
 
 @FUZZ
@@ -557,13 +705,27 @@ BAD_EXECUTE_LINES = st.one_of(
     st.binary(min_size=1, max_size=8).map(lambda b: b'{"id": "x\xff' + b.replace(b"\n", b"")),
     st.text(max_size=10).map(lambda t: ('{"id": ' + t.replace("\n", "")).encode("utf-8", "surrogatepass")),
     ANY_JSON.filter(lambda v: not isinstance(v, dict)).map(lambda v: json.dumps(v).encode()),
-    st.fixed_dictionaries({"id": st.just("s"), "instruction": st.just("pour me some water"),
-                           "scene": ANY_JSON.filter(lambda v: not isinstance(v, dict) or "objects" not in v)}
-                          ).map(lambda r: json.dumps(r).encode()),
-    st.fixed_dictionaries({"id": st.just("f"), "instruction": st.just("pour me some water"),
-                           "scene_file": st.sampled_from(["missing.json", ".", "in.jsonl"])}).map(lambda r: json.dumps(r).encode()),
-    st.fixed_dictionaries({"id": st.just("i"), "instruction": ANY_JSON.filter(lambda v: not isinstance(v, str)),
-                           "scene": st.just({"objects": []})}).map(lambda r: json.dumps(r).encode()),
+    st.fixed_dictionaries(
+        {
+            "id": st.just("s"),
+            "instruction": st.just("pour me some water"),
+            "scene": ANY_JSON.filter(lambda v: not isinstance(v, dict) or "objects" not in v),
+        }
+    ).map(lambda r: json.dumps(r).encode()),
+    st.fixed_dictionaries(
+        {
+            "id": st.just("f"),
+            "instruction": st.just("pour me some water"),
+            "scene_file": st.sampled_from(["missing.json", ".", "in.jsonl"]),
+        }
+    ).map(lambda r: json.dumps(r).encode()),
+    st.fixed_dictionaries(
+        {
+            "id": st.just("i"),
+            "instruction": ANY_JSON.filter(lambda v: not isinstance(v, str)),
+            "scene": st.just({"objects": []}),
+        }
+    ).map(lambda r: json.dumps(r).encode()),
 )
 
 
@@ -593,14 +755,22 @@ def test_batch_execute_with_an_unreadable_input_is_one_line(tmp_path):
 def test_robot_turns_that_are_not_utf8_are_one_line(tmp_path):
     (tmp_path / "scene.json").write_text('{"objects": [{"label": "water", "xy": [0, 0]}]}')
     (tmp_path / "turns.txt").write_bytes(b"pour me some water\n\xff\xfe the cup\n")
-    result = invoke(["robot", "--scene", str(tmp_path / "scene.json"), "--turns", str(tmp_path / "turns.txt")],
-                    tmp_path)
+    result = invoke(
+        ["robot", "--scene", str(tmp_path / "scene.json"), "--turns", str(tmp_path / "turns.txt")], tmp_path
+    )
     assert_one_line_error(result, tmp_path / "turns.txt")
 
 
-@pytest.mark.parametrize("command, flags", [("complete", ("--input", "--output")), ("srl", ("--input", "--output")),
-                                            ("execute", ("--input", "--output")), ("listen", ("--input", "--output")),
-                                            ("score", ("--frames", "--out"))])
+@pytest.mark.parametrize(
+    "command, flags",
+    [
+        ("complete", ("--input", "--output")),
+        ("srl", ("--input", "--output")),
+        ("execute", ("--input", "--output")),
+        ("listen", ("--input", "--output")),
+        ("score", ("--frames", "--out")),
+    ],
+)
 def test_an_output_that_is_the_input_file_is_refused_and_the_input_kept(tmp_path, command, flags):
     """`--output IN.jsonl` would replace what the user gave with the result: refused before any work."""
     given = tmp_path / "in.jsonl"

@@ -10,8 +10,14 @@ from lmcr.scorers.baselines.cooccur import CooccurrenceScorer
 from lmcr.scorers.baselines.terms import TermMatcher
 from lmcr.scorers.baselines.vectors import VectorFileError, VectorScorer, load_vectors, train_word2vec
 
-CORPUS = ["Pour the water into the cups.", "Pour water into a cup and stir.", "Poured the milk into the glass.",
-          "Cut the bell peppers with scissors.", "Cut paper with the scissors.", "Chop one bell pepper."] * 5
+CORPUS = [
+    "Pour the water into the cups.",
+    "Pour water into a cup and stir.",
+    "Poured the milk into the glass.",
+    "Cut the bell peppers with scissors.",
+    "Cut paper with the scissors.",
+    "Chop one bell pepper.",
+] * 5
 
 
 class SuffixLemmas:
@@ -55,9 +61,18 @@ def test_word2vec_trained_on_the_corpus_is_saved_atomically(tmp_path):
 
 def test_conceptnet_relatedness_from_an_edge_list(tmp_path):
     edges = tmp_path / "train.txt"
-    rows = ["UsedFor\tcup\tdrink water", "AtLocation\twater\tcup", "RelatedTo\tpour\twater", "RelatedTo\tpour\tcup",
-            "UsedFor\tscissors\tcut paper", "AtLocation\tscissors\tdrawer", "RelatedTo\tknife\tcut",
-            "AtLocation\tknife\tdrawer", "IsA\tsoy sauce\tsauce", "RelatedTo\tsauce\trice"]
+    rows = [
+        "UsedFor\tcup\tdrink water",
+        "AtLocation\twater\tcup",
+        "RelatedTo\tpour\twater",
+        "RelatedTo\tpour\tcup",
+        "UsedFor\tscissors\tcut paper",
+        "AtLocation\tscissors\tdrawer",
+        "RelatedTo\tknife\tcut",
+        "AtLocation\tknife\tdrawer",
+        "IsA\tsoy sauce\tsauce",
+        "RelatedTo\tsauce\trice",
+    ]
     edges.write_text("\n".join(rows) + "\n")
     assert len(read_edges(tmp_path)) == 10
     scorer = ConceptNetScorer.from_path(tmp_path, dim=4)
@@ -101,15 +116,18 @@ def test_npy_vectors_with_a_word_list_load_without_pickle(tmp_path):
         load_vectors(tmp_path / "glove.npy")
 
 
-@pytest.mark.parametrize(("text", "reason"), [
-    (b"pour 1 0\nwater 1 nope\n", "v.txt:2: not a word and 2 numbers"),
-    (b"pour 1 0\nwater 1\n", "v.txt:2: 1 numbers where the vectors have 2"),  # gensim repeated the 1
-    (b"2 2\npour 1 0\nwater 1 0 3\n", "v.txt:3: 3 numbers where the vectors have 2"),
-    (b"pour 1 0\nwater nan 0\n", "v.txt:2: a value is not a finite number"),
-    (b"pour\n", "v.txt:1: a word without numbers"),
-    (b"\xff\xfe", "v.txt: not a readable vector file"),
-    (b"\n\n", "v.txt: no vectors"),
-])
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        (b"pour 1 0\nwater 1 nope\n", "v.txt:2: not a word and 2 numbers"),
+        (b"pour 1 0\nwater 1\n", "v.txt:2: 1 numbers where the vectors have 2"),  # gensim repeated the 1
+        (b"2 2\npour 1 0\nwater 1 0 3\n", "v.txt:3: 3 numbers where the vectors have 2"),
+        (b"pour 1 0\nwater nan 0\n", "v.txt:2: a value is not a finite number"),
+        (b"pour\n", "v.txt:1: a word without numbers"),
+        (b"\xff\xfe", "v.txt: not a readable vector file"),
+        (b"\n\n", "v.txt: no vectors"),
+    ],
+)
 def test_a_malformed_vector_file_is_a_vector_file_error_naming_the_line(tmp_path, text, reason):
     bad = tmp_path / "v.txt"
     bad.write_bytes(text)
@@ -160,8 +178,10 @@ def test_npy_vectors_with_a_parquet_word_index(tmp_path):
     from lmcr.scorers.baselines.vectors import VectorFileError, load_vectors
 
     np.save(tmp_path / "emb.npy", np.array([[1, 0], [0, 1], [1, 1]], dtype=np.float32))
-    duckdb.sql("copy (select * from (values ('milk'), ('mug'), ('soy')) t(index)) to "
-               f"'{tmp_path / 'index.parquet'}' (format parquet)")
+    duckdb.sql(
+        "copy (select * from (values ('milk'), ('mug'), ('soy')) t(index)) to "
+        f"'{tmp_path / 'index.parquet'}' (format parquet)"
+    )
     kv = load_vectors(tmp_path / "emb.npy")
     assert kv.index_to_key == ["milk", "mug", "soy"] and np.allclose(kv["soy"], [1, 1])
     duckdb.sql(f"copy (select 1 as a) to '{tmp_path / 'index.parquet'}' (format parquet)")

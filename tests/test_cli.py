@@ -5,14 +5,24 @@ from __future__ import annotations
 from typer.testing import CliRunner
 
 from lmcr.cli import app
+from lmcr.setting import Setting
 
 runner = CliRunner()
 
 
 def test_ingest_sample_then_rerun(sample_dir, tmp_path, monkeypatch):
     monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
-    args = ["ingest", "--youcook2", str(sample_dir / "youcook2"), "--recipes", str(sample_dir / "nyc"),
-            "--recipes", str(sample_dir / "feeding_america"), "--workers", "1"]
+    args = [
+        "ingest",
+        "--youcook2",
+        str(sample_dir / "youcook2"),
+        "--recipes",
+        str(sample_dir / "nyc"),
+        "--recipes",
+        str(sample_dir / "feeding_america"),
+        "--workers",
+        "1",
+    ]
     first = runner.invoke(app, args)
     assert first.exit_code == 0, first.output
     assert "youcook2" in first.output and "4 loaded, 0 unchanged" in first.output
@@ -45,11 +55,14 @@ def test_train_passes_its_settings_seed_included(monkeypatch, tmp_path):
     from lmcr.lm import run
 
     seen = {}
-    monkeypatch.setattr(run, "train_setting", lambda *args, **kw: seen.update(config=args[5]) or tmp_path / "v1")
+    monkeypatch.setattr(
+        run, "train_setting", lambda *args, **kw: seen.update(setting=args[2], config=args[4]) or tmp_path / "v1"
+    )
     monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
     result = runner.invoke(app, ["train", "--corpus", "household", "--seed", "7", "--max-epochs", "2"])
     assert result.exit_code == 0, result.output
     assert seen["config"].seed == 7 and seen["config"].max_epochs == 2 and "published" in result.output
+    assert seen["setting"] == Setting("sentence", "household")
 
 
 def test_light_commands_do_not_import_the_heavy_libraries():
@@ -75,8 +88,12 @@ def _commands(group, prefix=()):
 def test_every_option_and_argument_has_help():
     import typer.main
 
-    missing = [f"{' '.join(path)} {param.name}" for path, command in _commands(typer.main.get_group(app))
-               for param in command.params if not getattr(param, "help", None)]
+    missing = [
+        f"{' '.join(path)} {param.name}"
+        for path, command in _commands(typer.main.get_group(app))
+        for param in command.params
+        if not getattr(param, "help", None)
+    ]
     missing += [f"lmcr {param.name}" for param in typer.main.get_group(app).params if not param.help]
     assert missing == []
 
@@ -85,8 +102,9 @@ def test_data_dir_option_is_the_environment_variable(sample_dir, tmp_path, monke
     monkeypatch.delenv("LMCR_DATA_DIR", raising=False)
     monkeypatch.delenv("LMCR_DB", raising=False)
     data = tmp_path / "elsewhere"
-    result = runner.invoke(app, ["--data-dir", str(data), "ingest", "--recipes", str(sample_dir / "nyc"),
-                                 "--workers", "1"])
+    result = runner.invoke(
+        app, ["--data-dir", str(data), "ingest", "--recipes", str(sample_dir / "nyc"), "--workers", "1"]
+    )
     assert result.exit_code == 0, result.output
     assert (data / "lmcr.duckdb").exists()
     listed = runner.invoke(app, ["--data-dir", str(data), "query", "corpus_summary", "--format", "json"])

@@ -45,12 +45,19 @@ def test_a_batch_that_fails_midway_leaves_no_output_and_keeps_the_old_one(tmp_pa
     assert out.read_text() == "before\n" and [p.name for p in tmp_path.iterdir()] == ["out.jsonl"]
 
 
-@pytest.mark.parametrize("args", [["srl", "pour the water", "--input", "IN", "--output", "OUT"],
-                                  ["srl", "--input", "IN"], ["listen"], ["listen", "--output", "OUT"],
-                                  ["execute", "pour it"],
-                                  ["execute", "--input", "IN", "--output", "OUT", "--scene", "s"],
-                                  ["execute", "--input", "IN", "--output", "OUT", "--render", "a.png"],
-                                  ["execute", "pour it", "--audio", "a.wav", "--scene", "s"]])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["srl", "pour the water", "--input", "IN", "--output", "OUT"],
+        ["srl", "--input", "IN"],
+        ["listen"],
+        ["listen", "--output", "OUT"],
+        ["execute", "pour it"],
+        ["execute", "--input", "IN", "--output", "OUT", "--scene", "s"],
+        ["execute", "--input", "IN", "--output", "OUT", "--render", "a.png"],
+        ["execute", "pour it", "--audio", "a.wav", "--scene", "s"],
+    ],
+)
 def test_a_mix_of_the_one_item_and_the_batch_forms_is_one_line(tmp_path, args):
     result = runner.invoke(app, [str(tmp_path / a) if a in ("IN", "OUT") else a for a in args])
     lines = result.output.strip().splitlines()
@@ -62,8 +69,10 @@ def test_objects_that_are_not_strings_name_their_line(tmp_path):
     from lmcr.complete_batch import read_complete_input
 
     path = tmp_path / "in.jsonl"
-    path.write_text('{"id": 1, "instruction": "pour it", "objects": ["cup"]}\n'
-                    '{"id": 2, "instruction": "pour it", "objects": ["cup", 3]}\n')
+    path.write_text(
+        '{"id": 1, "instruction": "pour it", "objects": ["cup"]}\n'
+        '{"id": 2, "instruction": "pour it", "objects": ["cup", 3]}\n'
+    )
     with pytest.raises(InputError, match=f"{path}:2: field 'objects' must be a list of strings"):
         read_complete_input(path)
 
@@ -76,14 +85,19 @@ def test_a_line_that_cannot_be_completed_gets_an_error_and_the_batch_goes_on(tmp
     from lmcr.srl.parser import load_parser
 
     path = tmp_path / "in.jsonl"
-    lines = [{"id": "a", "instruction": "pour me some water", "objects": ["cup", "water"]},
-             {"id": "b", "instruction": "juggle the cup", "objects": ["cup"]},
-             {"id": 3, "instruction": "pour me some water", "objects": []}]
+    lines = [
+        {"id": "a", "instruction": "pour me some water", "objects": ["cup", "water"]},
+        {"id": "b", "instruction": "juggle the cup", "objects": ["cup"]},
+        {"id": 3, "instruction": "pour me some water", "objects": []},
+    ]
     path.write_text("".join(json.dumps(r) + "\n" for r in lines))
     logged = []
     prefers_cup = lambda frames, context="": [float("cup" in f.role_map.values()) for f in frames]  # noqa: E731
-    out = list(complete_batch(load_parser(), prefers_cup, CompletionConfig(), read_complete_input(path), path,
-                              log=logged.append))
+    out = list(
+        complete_batch(
+            load_parser(), prefers_cup, CompletionConfig(), read_complete_input(path), path, log=logged.append
+        )
+    )
     assert [r["id"] for r in out] == ["a", "b", 3]
     assert out[0]["frame"]["roles"]["Destination"] == "cup" and "error" not in out[0]
     assert set(out[1]) == {"id", "error"} and "no known predicate" in out[1]["error"] and "error" in out[2]

@@ -21,6 +21,7 @@ from lmcr.files import OUTPUT_MARKER, OutputError, atomic_dir, atomic_path, file
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 from lmcr.store import connect, query_params
 
 runner = CliRunner()
@@ -44,6 +45,7 @@ def one_line_error(result) -> str:
 
 # 1. a query reads the store and nothing else
 
+
 @pytest.fixture
 def store(tmp_path) -> Path:
     db = tmp_path / "data" / "lmcr.duckdb"
@@ -55,31 +57,60 @@ def test_every_named_query_runs_on_the_locked_down_connection(store):
     values = {"corpus": "all", "phrases": "cup|glass", "min_sentences": "1"}
     for path in sorted((SQL_DIR / "queries").glob("*.sql")):
         wanted = query_params(path.read_text(encoding="utf-8"))
-        result = runner.invoke(app, ["query", path.stem, "--db", str(store), "--format", "json",
-                                     *[a for p in wanted for a in ("--param", f"{p}={values[p]}")]])
+        result = runner.invoke(
+            app,
+            [
+                "query",
+                path.stem,
+                "--db",
+                str(store),
+                "--format",
+                "json",
+                *[a for p in wanted for a in ("--param", f"{p}={values[p]}")],
+            ],
+        )
         assert result.exit_code == 0, (path.stem, result.output)
 
 
-@pytest.mark.parametrize("make_statement", [
-    lambda d: f"copy (select 1 as x) to '{d / 'victim.txt'}'",
-    lambda d: f"copy (select 1 as x) to '{d / 'new.csv'}'",
-    lambda d: f"export database '{d / 'exported'}'",
-    lambda d: "select * from read_csv('/etc/passwd')",
-    lambda d: f"select * from read_text('{d / 'victim.txt'}')",
-    lambda d: f"select * from read_blob('{d / 'victim.txt'}')",
-    lambda d: "select * from glob('~/*')",
-    lambda d: f"select * from glob('{d}/*')",
-    lambda d: f"attach '{d / 'data' / 'lmcr.duckdb'}' as again (read_only)",
-    lambda d: f"attach '{d / 'other.duckdb'}' as other",
-    lambda d: "install httpfs",
-    lambda d: "load httpfs",
-    lambda d: "set enable_external_access = true",
-    lambda d: "set lock_configuration = false",
-    lambda d: "set autoload_known_extensions = true",
-    lambda d: f"select 1; copy (select 2 as x) to '{d / 'victim.txt'}'",
-], ids=["copy-over-a-file", "copy-to-a-new-file", "export-database", "read-csv", "read-text", "read-blob",
-        "glob-home", "glob-folder", "attach-the-store", "attach-a-new-store", "install", "load",
-        "set-external-access", "unlock", "set-autoload", "second-statement"])
+@pytest.mark.parametrize(
+    "make_statement",
+    [
+        lambda d: f"copy (select 1 as x) to '{d / 'victim.txt'}'",
+        lambda d: f"copy (select 1 as x) to '{d / 'new.csv'}'",
+        lambda d: f"export database '{d / 'exported'}'",
+        lambda d: "select * from read_csv('/etc/passwd')",
+        lambda d: f"select * from read_text('{d / 'victim.txt'}')",
+        lambda d: f"select * from read_blob('{d / 'victim.txt'}')",
+        lambda d: "select * from glob('~/*')",
+        lambda d: f"select * from glob('{d}/*')",
+        lambda d: f"attach '{d / 'data' / 'lmcr.duckdb'}' as again (read_only)",
+        lambda d: f"attach '{d / 'other.duckdb'}' as other",
+        lambda d: "install httpfs",
+        lambda d: "load httpfs",
+        lambda d: "set enable_external_access = true",
+        lambda d: "set lock_configuration = false",
+        lambda d: "set autoload_known_extensions = true",
+        lambda d: f"select 1; copy (select 2 as x) to '{d / 'victim.txt'}'",
+    ],
+    ids=[
+        "copy-over-a-file",
+        "copy-to-a-new-file",
+        "export-database",
+        "read-csv",
+        "read-text",
+        "read-blob",
+        "glob-home",
+        "glob-folder",
+        "attach-the-store",
+        "attach-a-new-store",
+        "install",
+        "load",
+        "set-external-access",
+        "unlock",
+        "set-autoload",
+        "second-statement",
+    ],
+)
 def test_a_query_cannot_touch_a_file_or_unlock_itself(store, tmp_path, make_statement):
     victim = tmp_path / "victim.txt"
     victim.write_text("the user's own\n")
@@ -101,9 +132,15 @@ def test_the_connection_itself_refuses_what_the_statement_check_stops_first(stor
     victim.write_text("mine")
     con = query_connection(store)
     try:
-        for statement in [f"copy (select 1 as x) to '{victim}'", f"export database '{tmp_path / 'out'}'",
-                          f"attach '{tmp_path / 'other.duckdb'}' as other", "load httpfs", "install httpfs",
-                          "set enable_external_access = true", "set lock_configuration = false"]:
+        for statement in [
+            f"copy (select 1 as x) to '{victim}'",
+            f"export database '{tmp_path / 'out'}'",
+            f"attach '{tmp_path / 'other.duckdb'}' as other",
+            "load httpfs",
+            "install httpfs",
+            "set enable_external_access = true",
+            "set lock_configuration = false",
+        ]:
             with pytest.raises(duckdb.Error, match="disabled|locked"):
                 con.execute(statement)
     finally:
@@ -113,17 +150,21 @@ def test_the_connection_itself_refuses_what_the_statement_check_stops_first(stor
 
 # 2. usage mistakes: one line, exit 1, naming the option and the value
 
-@pytest.mark.parametrize("args, said", [
-    (["ingest", "--format", "nosuch", "--recipes", "x"], ["--format", "nosuch"]),
-    (["score", "--corpus", "../../x", "--frames", "a.csv", "--out", "b.csv"], ["--corpus", "../../x"]),
-    (["ingest", "--workers", "0", "--recipes", "x"], ["--workers", "0"]),
-    (["ingest", "--workers", "-3", "--recipes", "x"], ["--workers", "-3"]),
-    (["annotate", "tasks", "--out", "o", "--per-hit", "many"], ["--per-hit", "many"]),
-    (["score", "--frames", "a.csv"], ["--out"]),
-    (["ingest", "--nosuch"], ["--nosuch"]),
-    (["nosuch"], ["nosuch"]),
-    (["--data-dir"], ["--data-dir"]),
-])
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["ingest", "--format", "nosuch", "--recipes", "x"], ["--format", "nosuch"]),
+        (["score", "--corpus", "../../x", "--frames", "a.csv", "--out", "b.csv"], ["--corpus", "../../x"]),
+        (["ingest", "--workers", "0", "--recipes", "x"], ["--workers", "0"]),
+        (["ingest", "--workers", "-3", "--recipes", "x"], ["--workers", "-3"]),
+        (["annotate", "tasks", "--out", "o", "--per-hit", "many"], ["--per-hit", "many"]),
+        (["score", "--frames", "a.csv"], ["--out"]),
+        (["ingest", "--nosuch"], ["--nosuch"]),
+        (["nosuch"], ["nosuch"]),
+        (["--data-dir"], ["--data-dir"]),
+    ],
+)
 def test_a_usage_error_is_one_line_naming_option_and_value(args, said):
     line = one_line_error(runner.invoke(app, args))
     assert all(word in line for word in said), line
@@ -137,15 +178,23 @@ def test_help_is_still_help():
 def numeric_options() -> list[tuple[list[str], str, object]]:
     """(command path, option, typer's OptionInfo) of every int or float option of every command."""
     commands = [([c.name or c.callback.__name__], c.callback) for c in app.registered_commands]
-    commands += [([g.name, c.name or c.callback.__name__], c.callback)
-                 for g in app.registered_groups for c in g.typer_instance.registered_commands]
+    commands += [
+        ([g.name, c.name or c.callback.__name__], c.callback)
+        for g in app.registered_groups
+        for c in g.typer_instance.registered_commands
+    ]
     found = []
     for path, callback in commands:
         for name, param in inspect.signature(callback).parameters.items():
             if str(param.annotation).split(" |")[0] in ("int", "float"):
                 info = param.default
-                found.append((path, next((d for d in info.param_decls if d.startswith("--")),
-                                         "--" + name.replace("_", "-")), info))
+                found.append(
+                    (
+                        path,
+                        next((d for d in info.param_decls if d.startswith("--")), "--" + name.replace("_", "-")),
+                        info,
+                    )
+                )
     return found
 
 
@@ -173,6 +222,7 @@ def test_an_io_error_while_ingesting_names_the_file(tmp_path):
 
 # 3. output paths: one rule for files and folders
 
+
 def unwritable_folder(tmp_path) -> Path:
     """A folder no file can be created in: read-only permissions, or (as root, who ignores them) /sys."""
     ro = tmp_path / "read-only"
@@ -194,8 +244,11 @@ def test_a_file_output_follows_the_rule(tmp_path):
     link = tmp_path / "link.md"
     link.symlink_to(real)
     assert runner.invoke(app, [*page, str(link)]).exit_code == 0
-    assert link.is_symlink() and real.read_text().startswith("#") and sorted(p.name for p in tmp_path.iterdir()) == [
-        "link.md", "real.md"]
+    assert (
+        link.is_symlink()
+        and real.read_text().startswith("#")
+        and sorted(p.name for p in tmp_path.iterdir()) == ["link.md", "real.md"]
+    )
     dangling = tmp_path / "dangling.md"
     dangling.symlink_to(tmp_path / "made" / "target.md")
     assert runner.invoke(app, [*page, str(dangling)]).exit_code == 0
@@ -203,10 +256,12 @@ def test_a_file_output_follows_the_rule(tmp_path):
     nested = tmp_path / "new" / "deeper" / "page.md"  # missing parent folders are created
     assert runner.invoke(app, [*page, str(nested)]).exit_code == 0 and nested.is_file()
     (tmp_path / "afile").write_text("x")
-    for bad, reason in [(unwritable_folder(tmp_path) / "page.md", "cannot write there"),
-                        (unwritable_folder(tmp_path) / "sub" / "page.md", "cannot write there"),
-                        (tmp_path / "afile" / "page.md", "is a file, not a folder"),
-                        (tmp_path / "new", "is a folder")]:
+    for bad, reason in [
+        (unwritable_folder(tmp_path) / "page.md", "cannot write there"),
+        (unwritable_folder(tmp_path) / "sub" / "page.md", "cannot write there"),
+        (tmp_path / "afile" / "page.md", "is a file, not a folder"),
+        (tmp_path / "new", "is a folder"),
+    ]:
         line = one_line_error(runner.invoke(app, [*page, str(bad)]))
         assert f"error: {bad}: " in line and reason in line, line
     loop = tmp_path / "loop.md"
@@ -244,8 +299,16 @@ def test_a_write_error_inside_the_block_names_the_users_path(tmp_path):
 @pytest.fixture
 def evaluate_out(tmp_path, sample_dir):
     """`lmcr evaluate` with the random baseline alone (nothing to train), writing to a given --out."""
-    args = ["evaluate", "--ratings", str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-            "--methods", "random", "--settings", "random", "--out"]
+    args = [
+        "evaluate",
+        "--ratings",
+        str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
+        "--methods",
+        "random",
+        "--settings",
+        "random",
+        "--out",
+    ]
     return lambda out: runner.invoke(app, [*args, str(out)], env={"LMCR_DATA_DIR": str(tmp_path / "data")})
 
 
@@ -266,10 +329,13 @@ def test_evaluate_out_follows_the_rule(tmp_path, evaluate_out):
     (mine / "keep.txt").write_text("keep")
     (tmp_path / "LINK2").symlink_to(mine)
     (tmp_path / "afile").write_text("x")
-    for bad, reason in [(mine, "not an LMCR output"), (tmp_path / "LINK2", "not an LMCR output"),
-                        (unwritable_folder(tmp_path) / "report", "cannot write there"),
-                        (tmp_path / "afile", "exists and is not a folder"),
-                        (tmp_path / "afile" / "report", "is a file, not a folder")]:
+    for bad, reason in [
+        (mine, "not an LMCR output"),
+        (tmp_path / "LINK2", "not an LMCR output"),
+        (unwritable_folder(tmp_path) / "report", "cannot write there"),
+        (tmp_path / "afile", "exists and is not a folder"),
+        (tmp_path / "afile" / "report", "is a file, not a folder"),
+    ]:
         line = one_line_error(evaluate_out(bad))
         assert f"error: {bad}: " in line and reason in line, line
     assert (mine / "keep.txt").read_text() == "keep" and sorted(p.name for p in mine.iterdir()) == ["keep.txt"]
@@ -277,6 +343,7 @@ def test_evaluate_out_follows_the_rule(tmp_path, evaluate_out):
 
 
 # 4. a checkpoint's model.pt is a weights-only state dict or refused, by name
+
 
 class TouchOnLoad:
     """Unpickling this creates a file: proof that code ran."""
@@ -293,7 +360,7 @@ def published(tmp_path) -> Path:
     torch.manual_seed(0)
     vocab = Vocab.build([["pour", "water", "into", "the", "cup"]], min_freq=1)
     model = RecurrentLM(LMConfig(len(vocab), embedding=8, layers=1))
-    return ckpt.publish(tmp_path / "checkpoints", "sentence-all", model, vocab, "sentence", {}, {})
+    return ckpt.publish(tmp_path / "checkpoints", Setting("sentence"), model, vocab, {}, {})
 
 
 def replace_model(version: Path, content: bytes) -> Path:
@@ -315,19 +382,34 @@ def test_a_pickle_in_model_pt_is_refused_by_name_and_never_run(published, tmp_pa
     assert not marker.exists()
     frames = tmp_path / "frames.csv"
     frames.write_text("verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\n")
-    result = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(tmp_path / "s.csv"), "--methods",
-                                 "sentence_lm", "--checkpoint", str(tmp_path / "checkpoints")],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    result = runner.invoke(
+        app,
+        [
+            "score",
+            "--frames",
+            str(frames),
+            "--out",
+            str(tmp_path / "s.csv"),
+            "--methods",
+            "sentence_lm",
+            "--checkpoint",
+            str(tmp_path / "checkpoints"),
+        ],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     line = one_line_error(result)
     assert str(model_pt) in line and "refusing to load it" in line and "weights_only" not in line
     assert "internal error" not in line and not marker.exists() and not (tmp_path / "s.csv").exists()
 
 
-@pytest.mark.parametrize("cut, reason", [
-    (lambda data: b"", "empty file"),
-    (lambda data: data[: len(data) // 2], "not a torch weights file"),  # cut short
-    (None, "not a state dict of named tensors"),  # loads weights-only, but holds no tensors
-])
+@pytest.mark.parametrize(
+    "cut, reason",
+    [
+        (lambda data: b"", "empty file"),
+        (lambda data: data[: len(data) // 2], "not a torch weights file"),  # cut short
+        (None, "not a state dict of named tensors"),  # loads weights-only, but holds no tensors
+    ],
+)
 def test_an_unusable_model_pt_says_why(published, cut, reason):
     if cut is None:
         torch.save({"weight": 1.0}, published / "model.pt")
@@ -339,19 +421,32 @@ def test_an_unusable_model_pt_says_why(published, cut, reason):
 
 # 5. a method asked for must build; only defaults are skipped, with a note
 
-@pytest.mark.parametrize("args, method", [
-    (["--methods", "word2vec", "--vectors", "BAD"], "word2vec"),
-    (["--methods", "conceptnet", "--conceptnet", "BAD"], "conceptnet"),
-    (["--methods", "conceptnet_retrofit", "--conceptnet", "BAD", "--vectors", "BAD"], "conceptnet_retrofit"),
-    (["--methods", "conceptnet"], "conceptnet"),  # no edge file at all
-    (["--methods", "sentence_lm"], "sentence_lm"),  # no checkpoint
-    (["--methods", "random", "--settings", "frame_lm/household"], "frame_lm/household"),
-])
+
+@pytest.mark.parametrize(
+    "args, method",
+    [
+        (["--methods", "word2vec", "--vectors", "BAD"], "word2vec"),
+        (["--methods", "conceptnet", "--conceptnet", "BAD"], "conceptnet"),
+        (["--methods", "conceptnet_retrofit", "--conceptnet", "BAD", "--vectors", "BAD"], "conceptnet_retrofit"),
+        (["--methods", "conceptnet"], "conceptnet"),  # no edge file at all
+        (["--methods", "sentence_lm"], "sentence_lm"),  # no checkpoint
+        (["--methods", "random", "--settings", "frame_lm/household"], "frame_lm/household"),
+    ],
+)
 def test_a_requested_method_that_cannot_be_built_is_an_error(tmp_path, sample_dir, args, method):
     (tmp_path / "BAD").write_text("not vectors, not edges\n")
-    result = runner.invoke(app, ["evaluate", "--ratings", str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-                                 "--out", str(tmp_path / "report"), *args],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    result = runner.invoke(
+        app,
+        [
+            "evaluate",
+            "--ratings",
+            str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
+            "--out",
+            str(tmp_path / "report"),
+            *args,
+        ],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert f"method {method}: cannot be built" in one_line_error(result)
     assert not (tmp_path / "report").exists()
 
@@ -359,15 +454,28 @@ def test_a_requested_method_that_cannot_be_built_is_an_error(tmp_path, sample_di
 def test_default_methods_that_cannot_be_built_are_skipped_with_a_note(tmp_path, sample_dir, monkeypatch):
     monkeypatch.chdir(tmp_path)  # `--vectors BAD` relative, as a user types it
     (tmp_path / "BAD").write_text("not vectors\n")
-    result = runner.invoke(app, ["evaluate", "--ratings", str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-                                 "--out", "report", "--vectors", "BAD", "--settings", "random"],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    result = runner.invoke(
+        app,
+        [
+            "evaluate",
+            "--ratings",
+            str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
+            "--out",
+            "report",
+            "--vectors",
+            "BAD",
+            "--settings",
+            "random",
+        ],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert result.exit_code == 0, result.output
     assert "word2vec not evaluated: BAD:1" in result.stderr and "conceptnet not evaluated" in result.stderr
     assert json.loads((tmp_path / "report" / "figures.json").read_text())["table1"].keys() == {"random"}
 
 
 # 6. the evaluation's cached result is JSON
+
 
 def test_the_evaluate_task_caches_json(prefect_api, tmp_path, sample_dir):
     """The evaluation's cache is a JSON file of the workspace, read with `json` alone: the second run
@@ -403,6 +511,7 @@ def test_the_evaluate_task_caches_json(prefect_api, tmp_path, sample_dir):
 
 # 7. the defaults need only the checkpoints the pipeline's defaults train
 
+
 def option_default(command, name: str):
     return inspect.signature(command).parameters[name].default.default
 
@@ -416,10 +525,12 @@ def test_the_defaults_need_only_what_the_pipeline_trains(tmp_path):
     from lmcr.scorers.resources import MethodResources
 
     trained = {s for s in PipelineParams().settings}
-    defaults = {"score": option_default(cli.models.score, "methods").split(","),
-                "complete": [option_default(cli.models.complete, "method")],
-                "execute": [option_default(cli.robot.execute, "method")],
-                "evaluate": list(EVALUATED)}  # `lmcr evaluate` and the pipeline's evaluate flow
+    defaults = {
+        "score": option_default(cli.models.score, "methods").split(","),
+        "complete": [option_default(cli.models.complete, "method")],
+        "execute": [option_default(cli.robot.execute, "method")],
+        "evaluate": list(EVALUATED),
+    }  # `lmcr evaluate` and the pipeline's evaluate flow
     # the pipeline may choose any weight of the household corpus (mixture.json), or none
     for mixture in [Mixture(), *(Mixture.of({"household": w}) for w in GRID)]:
         res = MethodResources(checkpoints=tmp_path, mixture=mixture)
@@ -430,4 +541,8 @@ def test_the_defaults_need_only_what_the_pipeline_trains(tmp_path):
     # and what they need under a mixture is the household expert of each linearisation
     mixed = MethodResources(checkpoints=tmp_path, mixture=Mixture.of({"household": 100}))
     assert {s.name for s in lm_settings("sentence_lm+frame_lm", mixed)} == {
-        "sentence-all", "sentence-household", "frame-all", "frame-household"}
+        "sentence-all",
+        "sentence-household",
+        "frame-all",
+        "frame-household",
+    }

@@ -25,98 +25,153 @@ def parser():
 
 
 def test_one_missing_role_is_filled_with_probabilities(parser):
-    out = complete(parser, scorer, "pour me some water", ["scissors", "cup", "bowl", "water"],
-                   CompletionConfig(set_threshold=0.5))
-    assert out["frame"] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
-    assert out["missing"] == "Destination" and [c["object"] for c in out["candidates"]] == ["cup", "bowl", "scissors"]
-    assert sum(c["probability"] for c in out["candidates"]) == pytest.approx(1, abs=1e-3)
-    assert out["question"] is None  # the stated theme is no candidate; cup clearly wins
+    out = complete(
+        parser, scorer, "pour me some water", ["scissors", "cup", "bowl", "water"], CompletionConfig(set_threshold=0.5)
+    )
+    assert out.frame.to_json() == {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
+    assert out.missing == "Destination" and [c.object for c in out.candidates] == ["cup", "bowl", "scissors"]
+    assert sum(c.probability for c in out.candidates) == pytest.approx(1, abs=1e-3)
+    assert out.question is None  # the stated theme is no candidate; cup clearly wins
 
 
 def test_close_candidates_give_a_question_naming_them(parser):
     out = complete(parser, scorer, "pour me some water", ["glass", "cup", "bowl"], CompletionConfig(set_threshold=0.3))
-    assert out["frame"]["roles"]["Destination"] == "cup"
-    assert out["question"] == "Should I pour water into the cup or the glass?"  # not the unlikely bowl
+    assert out.frame.role_map["Destination"] == "cup"
+    assert out.question == "Should I pour water into the cup or the glass?"  # not the unlikely bowl
     pair = complete(parser, scorer, "pour it", ["water", "milk", "cup", "glass"], CompletionConfig(set_threshold=0.9))
-    assert pair["question"] == ("Should I pour cup into the glass, pour glass into the cup "  # the stand-in's taste
-                                "or pour water into the cup?")
+    assert pair.question == (
+        "Should I pour cup into the glass, pour glass into the cup "  # the stand-in's taste
+        "or pour water into the cup?"
+    )
 
 
 def test_complete_instruction_comes_back_unchanged(parser):
     out = complete(parser, scorer, "pour the water into the bowl", ["cup"])
-    assert out == {"frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
-                   "missing": None, "missing_roles": [], "referred": {}, "served": {}, "unresolved": {}, "unfamiliar_objects": [], "ignored_objects": [], "candidates": [],
-                   "question": None, "context": "", "instances": {"Theme": [], "Destination": []}}
+    assert out.to_json() == {
+        "frame": {"predicate": "pour", "roles": {"Theme": "water", "Destination": "bowl"}},
+        "missing": None,
+        "missing_roles": [],
+        "referred": {},
+        "served": {},
+        "unresolved": {},
+        "unfamiliar_objects": [],
+        "ignored_objects": [],
+        "candidates": [],
+        "question": None,
+        "context": "",
+        "instances": {"Theme": [], "Destination": []},
+        "prediction_set": [],  # nothing was predicted
+    }
+
+
+@pytest.mark.parametrize(
+    ("objects", "threshold", "expected_set"),
+    [
+        (["scissors", "cup", "bowl"], 0.5, ["cup"]),  # one likely object: no question
+        (["glass", "cup", "bowl"], 0.3, ["cup", "glass"]),  # two: ask between them
+        (["glass", "cup", "bowl"], 0.9, []),  # none sure enough: ask among the best
+    ],
+)
+def test_to_json_keeps_the_contract_keys_and_the_prediction_set_matches_the_question(
+    parser, objects, threshold, expected_set
+):
+    out = complete(parser, scorer, "pour me some water", objects, CompletionConfig(set_threshold=threshold))
+    line = out.to_json()
+    assert list(line) == [
+        *("frame", "missing", "missing_roles", "referred", "served", "unresolved", "unfamiliar_objects"),
+        *("ignored_objects", "candidates", "question", "context", "instances", "prediction_set"),
+    ]
+    assert json.loads(json.dumps(line)) == line  # plain JSON: lists, not tuples or dataclasses
+    assert line["frame"] == out.frame.to_json() and line["missing"] == "Destination"
+    assert line["candidates"][0] == {
+        "object": "cup",
+        "objects": {"Destination": "cup"},
+        "score": out.candidates[0].score,
+        "probability": out.candidates[0].probability,
+        "ids": ["cup"],
+    }
+    assert line["prediction_set"] == expected_set == [c.object for c in out.candidates if c.probability >= threshold]
+    assert (line["question"] is not None) == (len(expected_set) != 1)
 
 
 def test_objects_sharing_a_label_are_one_candidate_listing_their_ids(parser):
     """Three cups and two bowls: one candidate per label (the probabilities are not split between
     copies), each with the ids of its objects, assigned in order as a scene assigns them, or given."""
     out = complete(parser, scorer, "pour me some water", ["cup", "bowl", "water", "cup", "bowl", "cup"])
-    assert sorted((c["object"], c["ids"]) for c in out["candidates"]) == [("bowl", ["bowl", "bowl#2"]),
-                                                                          ("cup", ["cup", "cup#2", "cup#3"])]
-    assert out["instances"]["Theme"] == ["water"]
-    assert sum(c["probability"] for c in out["candidates"]) == pytest.approx(1)
+    assert sorted((c.object, list(c.ids)) for c in out.candidates) == [
+        ("bowl", ["bowl", "bowl#2"]),
+        ("cup", ["cup", "cup#2", "cup#3"]),
+    ]
+    assert out.instances["Theme"] == ["water"]
+    assert sum(c.probability for c in out.candidates) == pytest.approx(1)
     given = complete(parser, scorer, "pour the water into the cup", ["cup", "water", "cup"], ids=["a", "w", "b"])
-    assert given["instances"] == {"Theme": ["w"], "Destination": ["a", "b"]}
+    assert given.instances == {"Theme": ["w"], "Destination": ["a", "b"]}
 
 
 def test_a_stated_word_the_robot_cannot_ground_is_filled_and_confirmed(parser):
     """'side' is neither detected nor in the robot's object vocabulary; 'water' (not detected) is."""
     out = complete(parser, scorer, "fry two sunny side up in the pan", ["pan", "cup", "glass"])
-    assert out["unresolved"] == {"Theme": "side"} and out["missing"] == "Theme"
-    assert out["frame"]["roles"] == {"Theme": "cup", "Instrument": "pan"}
-    assert out["question"] == "I see no side. Should I fry the cup or the glass in the pan?"
+    assert out.unresolved == {"Theme": "side"} and out.missing == "Theme"
+    assert out.frame.role_map == {"Theme": "cup", "Instrument": "pan"}
+    assert out.question == "I see no side. Should I fry the cup or the glass in the pan?"
     kept = complete(parser, scorer, "pour the water", ["cup", "bowl"])
-    assert kept["unresolved"] == {} and kept["frame"]["roles"]["Theme"] == "water"
+    assert kept.unresolved == {} and kept.frame.role_map["Theme"] == "water"
     heard = []
-    coffee = complete(parser, lambda frames, context="": heard.append(context) or scorer(frames),
-                      "pour a little milk in my coffee", ["mug", "bowl", "milk"])
-    assert coffee["unresolved"] == {"Destination": "coffee"} and heard == ["in my coffee"]  # what it says of the mug
-    assert coffee["context"] == "in my coffee" and coffee["question"].startswith("I see no coffee. ")
+    coffee = complete(
+        parser,
+        lambda frames, context="": heard.append(context) or scorer(frames),
+        "pour a little milk in my coffee",
+        ["mug", "bowl", "milk"],
+    )
+    assert coffee.unresolved == {"Destination": "coffee"} and heard == ["in my coffee"]  # what it says of the mug
+    assert coffee.context == "in my coffee" and coffee.question.startswith("I see no coffee. ")
 
 
 def test_a_pronoun_refers_back_to_a_detected_object_named_before_it(parser):
     out = complete(parser, scorer, "I'd love some wine, could you pour it?", ["wine", "water", "cup", "glass"])
-    assert out["frame"]["roles"] == {"Theme": "wine", "Destination": "cup"} and out["referred"] == {"Theme": "wine"}
-    assert out["missing_roles"] == ["Destination"]  # the stand-in likes water better: the speaker said wine
+    assert out.frame.role_map == {"Theme": "wine", "Destination": "cup"} and out.referred == {"Theme": "wine"}
+    assert out.missing_roles == ("Destination",)  # the stand-in likes water better: the speaker said wine
     unseen = complete(parser, scorer, "I'd love some juice, could you pour it?", ["wine", "water", "cup", "glass"])
-    assert unseen["referred"] == {} and unseen["missing_roles"] == ["Theme", "Destination"]  # no juice: the scene decides
+    assert unseen.referred == {} and unseen.missing_roles == ("Theme", "Destination")  # no juice: the scene decides
     plain = complete(parser, scorer, "pour it into the cup", ["wine", "water", "cup"])
-    assert plain["referred"] == {} and plain["frame"]["roles"]["Theme"] == "water"
+    assert plain.referred == {} and plain.frame.role_map["Theme"] == "water"
 
 
 def test_the_vessel_a_request_serves_in_is_where_it_goes(parser):
     out = complete(parser, scorer, "could you pour me a glass of water?", ["pot", "bowl", "glass", "water"])
-    assert out["served"] == {"Destination": "glass"} and out["missing"] is None
-    assert out["frame"]["roles"] == {"Theme": "water", "Destination": "glass"} and out["question"] is None
+    assert out.served == {"Destination": "glass"} and out.missing is None
+    assert out.frame.role_map == {"Theme": "water", "Destination": "glass"} and out.question is None
     unseen = complete(parser, scorer, "pour me a glass of water", ["pot", "bowl", "cup"])  # no glass: the scene decides
-    assert unseen["served"] == {} and unseen["missing"] == "Destination"
+    assert unseen.served == {} and unseen.missing == "Destination"
     measured = complete(parser, scorer, "pour me half a cup of milk", ["cup", "bowl", "pot"])  # a quantity
-    assert measured["served"] == {} and measured["missing"] == "Destination"
+    assert measured.served == {} and measured.missing == "Destination"
     stated = complete(parser, scorer, "pour me a glass of water into the pot", ["pot", "glass"])
-    assert stated["served"] == {} and stated["frame"]["roles"]["Destination"] == "pot"
+    assert stated.served == {} and stated.frame.role_map["Destination"] == "pot"
 
 
 def test_a_stated_object_that_is_detected_grounds_without_the_robot_vocabulary(parser):
     """The person named the cucumber and the robot sees one: it is no choice of the scorer's, so it stays
     (not 'I see no cucumber') and is no question; an unnamed detection outside the vocabulary is a candidate."""
     out = complete(parser, scorer, "season the sliced cucumbers", ["cucumber", "salt", "kumquat", "cup"])
-    assert out["unresolved"] == {} and out["missing"] == "Instrument" and out["question"] is None
-    assert out["frame"]["roles"] == {"Theme": "cucumber", "Instrument": "cup"}  # the stand-in likes cups
-    assert out["unfamiliar_objects"] == ["kumquat"] and [c["object"] for c in out["candidates"]] == ["cup", "salt", "kumquat"]
+    assert out.unresolved == {} and out.missing == "Instrument" and out.question is None
+    assert out.frame.role_map == {"Theme": "cucumber", "Instrument": "cup"}  # the stand-in likes cups
+    assert out.unfamiliar_objects == ("kumquat",) and [c.object for c in out.candidates] == [
+        "cup",
+        "salt",
+        "kumquat",
+    ]
     unseen = complete(parser, scorer, "season the sliced cucumbers", ["salt", "cup"])
-    assert unseen["unresolved"] == {"Theme": "cucumber"} and unseen["question"].startswith("I see no cucumber.")
+    assert unseen.unresolved == {"Theme": "cucumber"} and unseen.question.startswith("I see no cucumber.")
 
 
 def test_two_missing_roles_score_object_pairs(parser):
     out = complete(parser, scorer, "pour it", ["water", "milk", "cup", "scissors"])
-    assert out["missing_roles"] == ["Theme", "Destination"]
-    assert set(out["frame"]["roles"].values()) == {"cup", "water"}  # the best-scoring pair
-    assert all(c["objects"]["Theme"] != c["objects"]["Destination"] for c in out["candidates"])
-    assert len(out["candidates"]) == 12
+    assert out.missing_roles == ("Theme", "Destination")
+    assert set(out.frame.role_map.values()) == {"cup", "water"}  # the best-scoring pair
+    assert all(c.objects["Theme"] != c.objects["Destination"] for c in out.candidates)
+    assert len(out.candidates) == 12
     vague = complete(parser, scorer, "I'm thirsty, pour me something", ["water", "milk", "cup", "scissors"])
-    assert vague["missing_roles"] == ["Theme", "Destination"] and vague["unresolved"] == {}  # no "I see no something"
+    assert vague.missing_roles == ("Theme", "Destination") and vague.unresolved == {}  # no "I see no something"
 
 
 def test_empty_objects_and_unknown_verbs_are_clear_errors(parser):
@@ -149,8 +204,9 @@ def test_a_scorer_is_one_registry_entry(monkeypatch):
     from lmcr.scorers import registry as methods
     from lmcr.scorers.resources import MethodResources
 
-    spec = methods.ScorerSpec(lambda res: (lambda frames: [float(len(f.predicate)) for f in frames]),
-                              lambda res: "len-v1")
+    spec = methods.ScorerSpec(
+        lambda res: lambda frames: [float(len(f.predicate)) for f in frames], lambda res: "len-v1"
+    )
     monkeypatch.setitem(methods.SCORERS, "verb_length", spec)
     res = MethodResources(checkpoints=__import__("pathlib").Path("/nonexistent"))
     frames = [Frame.of("pour", {"Theme": "water"}), Frame.of("season", {"Theme": "rice"})]
@@ -164,8 +220,8 @@ def test_a_modifier_the_parser_kept_does_not_hide_a_detected_object(parser):
     """Without learned compounds the parser keeps "leftover pizza" whole; the robot sees a pizza."""
     assert parse_instruction(parser, "heat the leftover pizza").roles["Theme"] == "leftover pizza"
     out = complete(parser, scorer, "heat the leftover pizza", ["pizza", "microwave", "cup"])
-    assert out["unresolved"] == {} and out["missing"] == "Instrument"
-    assert out["frame"]["roles"]["Theme"] == "pizza" and "pizza" not in [c["object"] for c in out["candidates"]]
+    assert out.unresolved == {} and out.missing == "Instrument"
+    assert out.frame.role_map["Theme"] == "pizza" and "pizza" not in [c.object for c in out.candidates]
 
 
 def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_path):
@@ -175,19 +231,26 @@ def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_pa
     def pour(destination):
         return {"predicate": "pour", "roles": {"Theme": "water", "Destination": destination}}
 
-    lines = [{"instruction": "pour me some water", "objects": ["scissors", "cup", "bowl"], "expected": pour("cup")},
-             {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("cup")},  # asks, cup first
-             {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("glass")},  # asks, wrong guess
-             {"instruction": "pour me some water", "objects": ["bowl", "scissors"], "expected": pour("scissors")},
-             {"instruction": "wash the cup", "objects": ["cup", "sink"], "expected": pour("cup")}]  # no robot verb
+    lines = [
+        {"instruction": "pour me some water", "objects": ["scissors", "cup", "bowl"], "expected": pour("cup")},
+        {"instruction": "pour me some water", "objects": ["glass", "cup"], "expected": pour("cup")},  # asks, cup first
+        {
+            "instruction": "pour me some water",
+            "objects": ["glass", "cup"],
+            "expected": pour("glass"),
+        },  # asks, wrong guess
+        {"instruction": "pour me some water", "objects": ["bowl", "scissors"], "expected": pour("scissors")},
+        {"instruction": "wash the cup", "objects": ["cup", "sink"], "expected": pour("cup")},
+    ]  # no robot verb
     path = tmp_path / "instructions.jsonl"
     path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
     done = instruction_accuracy(parser, scorer, CompletionConfig(set_threshold=0.3), load_instructions(path))
     assert (done.total, done.answered_right, done.asked, done.asked_right, done.right) == (5, 1, 2, 1, 2)
     assert done.accuracy == 0.4 and [roles.get("Destination") for _, roles, _ in done.wrong] == ["cup", "bowl", None]
     assert "no known predicate in 'wash the cup'" in done.wrong[-1][1]["error"]  # counted wrong, not a crash
-    assert done.summary().splitlines()[0] == ("dev instructions: 2/5 = 0.400 right (1 answered right, 2 questions "
-                                              "of which 1 guess right)")
+    assert done.summary().splitlines()[0] == (
+        "dev instructions: 2/5 = 0.400 right (1 answered right, 2 questions of which 1 guess right)"
+    )
     path.write_text(json.dumps(lines[0]) + "\n" + '{"instruction": "pour it"}\n', encoding="utf-8")
     with pytest.raises(InputError, match=r"instructions.jsonl:2"):
         load_instructions(path)

@@ -15,7 +15,11 @@ from lmcr.store import connect
 from lmcr.workspace import Workspace
 
 DOCUMENTS = [  # (corpus, document, its sentences)
-    ("recipes", "apple pie", ["Apple Pie", "Toss the apples with cinnamon for the pie.", "Season with a pinch of salt."]),
+    (
+        "recipes",
+        "apple pie",
+        ["Apple Pie", "Toss the apples with cinnamon for the pie.", "Season with a pinch of salt."],
+    ),
     ("recipes", "cherry pie", ["Stir cinnamon into the cherry pie filling."]),
     ("recipes", "soup", ["Season the soup with salt.", "Simmer in a pot."]),
     ("recipes", "pasta", ["Boil the pasta in a pot of salted water.", "Season with salt and black pepper."]),
@@ -29,7 +33,9 @@ def store(tmp_path):
     db = tmp_path / "lmcr.duckdb"
     sql_dir = Workspace.from_env().sql_dir
     con = connect(db, sql_dir)
-    rows = [(corpus, doc, i, text, len(text.split())) for corpus, doc, texts in DOCUMENTS for i, text in enumerate(texts)]
+    rows = [
+        (corpus, doc, i, text, len(text.split())) for corpus, doc, texts in DOCUMENTS for i, text in enumerate(texts)
+    ]
     con.executemany("insert into sentences values (?, 's', ?, ?, 'instruction', ?, ?, 'f', 0, null, null)", rows)
     con.close()
     return db, sql_dir
@@ -39,9 +45,18 @@ def test_sentences_are_counted_with_plurals(store):
     counts = ContextCooccurrence.count(*store, OBJECTS, {"all": 1.0}, min_sentences=1)
     assert counts.sentences == 10
     # 'apples' is the apple, 'salted' no salt
-    assert counts.object_sentences == {"cinnamon": 2, "salt": 3, "black pepper": 1, "pot": 3, "cup": 1, "pasta": 1,
-                                       "apple": 2}
-    assert counts.word_sentences["pie"] == 3 and counts.word_sentences["boil"] == 2 and counts.word_sentences["the"] == 4
+    assert counts.object_sentences == {
+        "cinnamon": 2,
+        "salt": 3,
+        "black pepper": 1,
+        "pot": 3,
+        "cup": 1,
+        "pasta": 1,
+        "apple": 2,
+    }
+    assert (
+        counts.word_sentences["pie"] == 3 and counts.word_sentences["boil"] == 2 and counts.word_sentences["the"] == 4
+    )
     assert counts.pair_sentences["cinnamon"]["pie"] == 2
     # a word and an object in different sentences of one document do not count together (the apple pie's salt)
     assert "pie" not in counts.pair_sentences["salt"] and "pie" not in counts.pair_sentences["pot"]
@@ -62,11 +77,17 @@ def test_a_purpose_lifts_the_filler_named_with_it(store):
 
 def test_words_of_the_filler_itself_do_not_count(store):
     counts = ContextCooccurrence.count(*store, OBJECTS, {"all": 1.0}, min_sentences=1)
-    assert counts.context_words("so I can boil the pasta, the pasta and the pastas!") == ["boil", "pasta"]  # no sentence says pastas
-    pot, pasta = counts.score([Frame.of("fill", {"Theme": "water", "Destination": d}) for d in ("pot", "pasta")],
-                              "so I can boil the pasta")
+    assert counts.context_words("so I can boil the pasta, the pasta and the pastas!") == [
+        "boil",
+        "pasta",
+    ]  # no sentence says pastas
+    pot, pasta = counts.score(
+        [Frame.of("fill", {"Theme": "water", "Destination": d}) for d in ("pot", "pasta")], "so I can boil the pasta"
+    )
     # the pasta is credited for 'boil' only, the pot for 'boil' and 'pasta' (each with the water too)
-    assert pasta == pytest.approx(WEIGHT * (counts.pmi("boil", "pasta") + counts.pmi("boil", "water") + counts.pmi("pasta", "water")))
+    assert pasta == pytest.approx(
+        WEIGHT * (counts.pmi("boil", "pasta") + counts.pmi("boil", "water") + counts.pmi("pasta", "water"))
+    )
     assert pot == pytest.approx(WEIGHT * sum(counts.pmi(w, o) for w in ("boil", "pasta") for o in ("pot", "water")))
 
 
@@ -116,8 +137,10 @@ def test_a_sentence_is_keyed_by_its_source_too(tmp_path):
     """Document ids are unique within a source: two sources' "doc 1, sentence 0" are two sentences."""
     db, sql_dir = tmp_path / "lmcr.duckdb", Workspace.from_env().sql_dir
     con = connect(db, sql_dir)
-    con.executemany("insert into sentences values ('recipes', ?, '1', 0, 'instruction', ?, 3, 'f', 0, null, null)",
-                    [("web:a", "boil the water"), ("web:b", "wash the pot")])
+    con.executemany(
+        "insert into sentences values ('recipes', ?, '1', 0, 'instruction', ?, 3, 'f', 0, null, null)",
+        [("web:a", "boil the water"), ("web:b", "wash the pot")],
+    )
     con.close()
     counts = ContextCooccurrence.count(db, sql_dir, ["pot", "water"], {"all": 1.0}, min_sentences=1)
     assert counts.sentences == 2 and "boil" not in counts.pair_sentences["pot"]

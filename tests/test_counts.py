@@ -11,8 +11,12 @@ from lmcr.scorers.mixture import Mixture, MixtureError, load, save
 from lmcr.store import connect
 from lmcr.workspace import Workspace
 
-FILLERS = [("pour", "Theme", "water", 4), ("pour", "Destination", "cup", 3), ("pour", "Destination", "bowl", 1),
-           ("cut", "Theme", "water", 2)]
+FILLERS = [
+    ("pour", "Theme", "water", 4),
+    ("pour", "Destination", "cup", 3),
+    ("pour", "Destination", "bowl", 1),
+    ("cut", "Theme", "water", 2),
+]
 PAIRS = [("pour", "Theme", "water", "Destination", "cup", 3), ("pour", "Destination", "cup", "Theme", "water", 3)]
 
 
@@ -27,39 +31,61 @@ def test_smoothed_estimates_by_hand():
     assert m.p_given("pour", "Theme", "water", "Destination", "bowl") == pytest.approx(given)
     p_water_theme = (4 + 2 * m.p_value("water")) / (4 + 2)
     back = (0 + 2 * p_water_theme) / (0 + 2)  # bowl never given: the backoff alone
-    assert m.score_frame(("pour", {"Theme": "water", "Destination": "bowl"})) == pytest.approx(math.log(given) + math.log(back))
+    assert m.score_frame(("pour", {"Theme": "water", "Destination": "bowl"})) == pytest.approx(
+        math.log(given) + math.log(back)
+    )
 
 
 def test_seen_together_beats_seen_apart_and_unseen():
     m = FrameCountScorer(FILLERS, PAIRS)
-    cup, bowl, scissors = m.score_frames([("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "bowl", "scissors")])
+    cup, bowl, scissors = m.score_frames(
+        [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "bowl", "scissors")]
+    )
     assert cup > bowl > scissors
-    assert m.score_frames([("pour", {"Destination": "cup"})])[0] == pytest.approx(math.log(m.p_filler("pour", "Destination", "cup")))
+    assert m.score_frames([("pour", {"Destination": "cup"})])[0] == pytest.approx(
+        math.log(m.p_filler("pour", "Destination", "cup"))
+    )
 
 
 def test_counts_come_from_the_stores_robot_frames(tmp_path):
     db = tmp_path / "lmcr.duckdb"
     con = connect(db, Workspace.from_env().sql_dir)
-    frames = [("youcook2", "d1", 0, 0, "pour", True), ("recipes", "d2", 0, 0, "pour", True),
-              ("recipes", "d2", 1, 0, "stir", False)]
-    con.executemany("insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
-                    "values (?, ?, ?, ?, ?, ?, 0, 1)", frames)
-    roles = [("youcook2", "d1", 0, 0, "Theme", "water"), ("youcook2", "d1", 0, 0, "Destination", "cup"),
-             ("recipes", "d2", 0, 0, "Theme", "milk"), ("recipes", "d2", 0, 0, "Destination", None),
-             ("recipes", "d2", 1, 0, "Theme", "soup")]
-    con.executemany("insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles)
+    frames = [
+        ("youcook2", "d1", 0, 0, "pour", True),
+        ("recipes", "d2", 0, 0, "pour", True),
+        ("recipes", "d2", 1, 0, "stir", False),
+    ]
+    con.executemany(
+        "insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
+        "values (?, ?, ?, ?, ?, ?, 0, 1)",
+        frames,
+    )
+    roles = [
+        ("youcook2", "d1", 0, 0, "Theme", "water"),
+        ("youcook2", "d1", 0, 0, "Destination", "cup"),
+        ("recipes", "d2", 0, 0, "Theme", "milk"),
+        ("recipes", "d2", 0, 0, "Destination", None),
+        ("recipes", "d2", 1, 0, "Theme", "soup"),
+    ]
+    con.executemany(
+        "insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles
+    )
     con.close()
     every = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all")
     assert every.value == {"water": 1, "cup": 1, "milk": 1}  # no null, no generic predicate
-    assert every.pair == {("pour", "Theme", "water", "Destination", "cup"): 1, ("pour", "Destination", "cup", "Theme", "water"): 1}
+    assert every.pair == {
+        ("pour", "Theme", "water", "Destination", "cup"): 1,
+        ("pour", "Destination", "cup", "Theme", "water"): 1,
+    }
     assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "recipes").value == {"milk": 1}
     with pytest.raises(ValueError, match="no robot-predicate frames for corpus 'nyc'"):
         FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "nyc")
     # A mixture weighs each corpus's frames: recipes counting 3 times, youcook2 once.
     mixed = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", mixture=Mixture.of({"recipes": 3}))
     assert mixed.value == {"water": 1, "cup": 1, "milk": 3} and mixed.n == 5
-    assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "youcook2",
-                                       mixture=Mixture.of({"recipes": 3})).value == {"water": 1, "cup": 1}
+    assert FrameCountScorer.from_store(
+        db, Workspace.from_env().sql_dir, "youcook2", mixture=Mixture.of({"recipes": 3})
+    ).value == {"water": 1, "cup": 1}
 
 
 def test_mixture_weights_parse_label_and_shares():
@@ -68,8 +94,13 @@ def test_mixture_weights_parse_label_and_shares():
     assert Mixture.parse("plain").plain and Mixture.parse("").plain and Mixture.of({"household": 1}).plain
     # household 1% of the words, weighted 30: its share of the weighted text is 30/129
     assert mixture.shares({"recipes": 90, "youcook2": 9, "household": 1}) == {"household": pytest.approx(30 / 129)}
-    for bad, message in (("household", "write corpus=weight"), ("household=x", "must be a number"),
-                         ("household=0", "positive"), ("nyc=2", "unknown corpus 'nyc'"), ("household=inf", "positive")):
+    for bad, message in (
+        ("household", "write corpus=weight"),
+        ("household=x", "must be a number"),
+        ("household=0", "positive"),
+        ("nyc=2", "unknown corpus 'nyc'"),
+        ("household=inf", "positive"),
+    ):
         with pytest.raises(MixtureError, match=message):
             Mixture.parse(bad)
 
@@ -89,14 +120,18 @@ def test_the_weights_with_the_best_mean_over_the_dev_sets_win():
     # dev ratings alone: the best Table I, and no context weight (the rated frames have no context)
     assert best_choice({1: {"table1": 0.924}, 3: {"table1": 0.922}}) == (1, None)
     # with instructions: the best mean of the two, over the corpus and context weights together
-    both = {1: {"table1": 0.924, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.933}},
-            3: {"table1": 0.922, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.950}},
-            10: {"table1": 0.912, "instructions": {0.5: 0.950, 1: 0.950, 2: 0.950}}}
+    both = {
+        1: {"table1": 0.924, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.933}},
+        3: {"table1": 0.922, "instructions": {0.5: 0.933, 1: 0.933, 2: 0.950}},
+        10: {"table1": 0.912, "instructions": {0.5: 0.950, 1: 0.950, 2: 0.950}},
+    }
     assert best_choice(both) == (3, 2)
     # ties: the smaller corpus weight (the plain pool), then the unscaled context term, then the smaller
     assert best_choice({1: {"table1": 0.9}, 3: {"table1": 0.9}, 10: {"table1": 0.9}}) == (1, None)
-    tied = {1: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}},
-            3: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}}}
+    tied = {
+        1: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}},
+        3: {"table1": 0.9, "instructions": {0.5: 0.9, 1: 0.9, 2: 0.9}},
+    }
     assert best_choice(tied) == (1, 1)
     assert best_choice({1: {"table1": 0.9, "instructions": {0.5: 0.95, 2: 0.95}}}) == (1, 0.5)
 
@@ -111,7 +146,9 @@ def test_the_context_weights_share_one_scoring_of_each_candidate_set(monkeypatch
 
     def stand_in(method, res):
         assert method == "context_pmi" and res.context_weight == 1 or method == "sentence_lm+rarity"
-        return lambda frames, context="": calls.append(method) or [0.5 if method == "context_pmi" else 1.0] * len(frames)
+        return lambda frames, context="": (
+            calls.append(method) or [0.5 if method == "context_pmi" else 1.0] * len(frames)
+        )
 
     monkeypatch.setattr(choosing, "make_scorer", stand_in)
     at = choosing._context_weighted("sentence_lm+rarity+context_pmi", MethodResources(checkpoints=tmp_path))
@@ -130,8 +167,13 @@ def test_the_context_weight_round_trips_in_the_mixture_file(tmp_path):
     assert (load(tmp_path), load_choice(tmp_path)[1]) == (Mixture.of({"household": 3}), 2.0)
     save(tmp_path, Mixture.of({"household": 3}), {})  # chosen on rated frames alone: none
     assert load_choice(tmp_path)[1] is None
-    for bad in ('{"weights": {}, "context_weight": 0}', '{"weights": {}, "context_weight": "2"}',
-                '{"weights": {}, "context_weight": true}', '[1, 2]', '{"weights"'):
+    for bad in (
+        '{"weights": {}, "context_weight": 0}',
+        '{"weights": {}, "context_weight": "2"}',
+        '{"weights": {}, "context_weight": true}',
+        "[1, 2]",
+        '{"weights"',
+    ):
         (tmp_path / "mixture.json").write_text(bad)
         with pytest.raises(MixtureError, match="mixture.json: (context_weight must be|not a mixture file)"):
             load_choice(tmp_path)

@@ -56,10 +56,15 @@ def test_readme_deployment_commands_as_written(tmp_path):
     schedule fires, the pipeline deployment run publishes its results, the annotate run completes."""
     port = free_port()
     env = {k: v for k, v in os.environ.items() if not k.startswith("PREFECT_")}  # only `config set` points at it
-    env |= {"PREFECT_HOME": str(tmp_path / "home"), "PREFECT_SERVER_ANALYTICS_ENABLED": "false", "COLUMNS": "250",
-            "PREFECT_SERVER_SERVICES_SCHEDULER_LOOP_SECONDS": "2", "LMCR_DATA_DIR": str(tmp_path / "pipeline"),
-            "PREFECT_SERVER_API_PORT": str(port),  # `prefect server start` on the free port instead of 4200
-            "PATH": f"{Path(PREFECT).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
+    env |= {
+        "PREFECT_HOME": str(tmp_path / "home"),
+        "PREFECT_SERVER_ANALYTICS_ENABLED": "false",
+        "COLUMNS": "250",
+        "PREFECT_SERVER_SERVICES_SCHEDULER_LOOP_SECONDS": "2",
+        "LMCR_DATA_DIR": str(tmp_path / "pipeline"),
+        "PREFECT_SERVER_API_PORT": str(port),  # `prefect server start` on the free port instead of 4200
+        "PATH": f"{Path(PREFECT).parent}{os.pathsep}{os.environ.get('PATH', '')}",
+    }
     url = f"http://127.0.0.1:{port}/api"
     background, logs = [], []
     try:
@@ -67,20 +72,38 @@ def test_readme_deployment_commands_as_written(tmp_path):
             command = line.replace("4200", str(port)).replace("/path/to/data", str(tmp_path / "annotate"))
             if command.endswith("&"):  # a service: the user leaves it running
                 logs.append(open(tmp_path / f"service{len(logs)}.log", "w"))
-                background.append(subprocess.Popen(command.rstrip("& "), shell=True, env=env, cwd=REPO_ROOT,
-                                                   stdout=logs[-1], stderr=subprocess.STDOUT, start_new_session=True))
+                background.append(
+                    subprocess.Popen(
+                        command.rstrip("& "),
+                        shell=True,
+                        env=env,
+                        cwd=REPO_ROOT,
+                        stdout=logs[-1],
+                        stderr=subprocess.STDOUT,
+                        start_new_session=True,
+                    )
+                )
                 if " server start" in command:
                     wait_for(lambda: api_up(url), "the Prefect server did not come up", 90)
                 continue
-            done = subprocess.run(command, shell=True, env=env, cwd=REPO_ROOT, capture_output=True, text=True,
-                                  timeout=300)
+            done = subprocess.run(
+                command, shell=True, env=env, cwd=REPO_ROOT, capture_output=True, text=True, timeout=300
+            )
             assert done.returncode == 0, (command, done.stdout + done.stderr)
-        wait_for(lambda: any(r["state_type"] == "SCHEDULED" for r in api(url, "flow_runs/filter")),
-                 "the scheduler created no retrain runs", 60)
+        wait_for(
+            lambda: any(r["state_type"] == "SCHEDULED" for r in api(url, "flow_runs/filter")),
+            "the scheduler created no retrain runs",
+            60,
+        )
         finished = {"COMPLETED", "FAILED", "CRASHED", "CANCELLED"}
-        wait_for(lambda: sum(r["state_type"] in finished for r in api(url, "flow_runs/filter", parent_only=True)) >= 2,
-                 "the pipeline and annotate runs did not finish", 540)
-        states = [r["state_type"] for r in api(url, "flow_runs/filter", parent_only=True) if r["state_type"] in finished]
+        wait_for(
+            lambda: sum(r["state_type"] in finished for r in api(url, "flow_runs/filter", parent_only=True)) >= 2,
+            "the pipeline and annotate runs did not finish",
+            540,
+        )
+        states = [
+            r["state_type"] for r in api(url, "flow_runs/filter", parent_only=True) if r["state_type"] in finished
+        ]
         assert states == ["COMPLETED", "COMPLETED"], (states, (tmp_path / "service1.log").read_text()[-3000:])
         keys = {a["key"] for a in api(url, "artifacts/filter")}
         assert {"table-i", "evaluation-report", "executor-check", "krippendorff-alpha", "lm-checkpoints"} <= keys, keys
@@ -102,8 +125,9 @@ def test_readme_deployment_commands_as_written(tmp_path):
 def api(url: str, path: str, parent_only: bool = False) -> list[dict]:
     """POST a filter to the server's REST API (no client state); top-level flow runs only if asked."""
     body = {"flow_runs": {"parent_task_run_id": {"is_null_": True}}} if parent_only else {}
-    request = urllib.request.Request(f"{url}/{path}", data=json.dumps(body).encode(), method="POST",
-                                     headers={"Content-Type": "application/json"})
+    request = urllib.request.Request(
+        f"{url}/{path}", data=json.dumps(body).encode(), method="POST", headers={"Content-Type": "application/json"}
+    )
     with urllib.request.urlopen(request, timeout=30) as response:
         return json.loads(response.read())
 

@@ -17,12 +17,19 @@ from lmcr.robot.reply import error_outcome, past_tense, phrase, say, spoken
 VOCAB = ("water", "milk", "cup", "glass", "mug", "bowl", "plate", "soy sauce")
 
 
-@pytest.mark.parametrize("answer, choice, problem", [
-    ("the glass", "glass", None), ("into the mug please", "mug", None), ("Yes.", "cup", None),
-    ("no, the other one", "glass", None), ("the glasses", "glass", None),
-    ("the bowl", None, "I don't see a bowl on the table."), ("no", None, "Which one should I use then?"),
-    ("hmm", None, "Sorry, I did not understand."),
-])
+@pytest.mark.parametrize(
+    "answer, choice, problem",
+    [
+        ("the glass", "glass", None),
+        ("into the mug please", "mug", None),
+        ("Yes.", "cup", None),
+        ("no, the other one", "glass", None),
+        ("the glasses", "glass", None),
+        ("the bowl", None, "I don't see a bowl on the table."),
+        ("no", None, "Which one should I use then?"),
+        ("hmm", None, "Sorry, I did not understand."),
+    ],
+)
 def test_answers_are_read_against_the_choices_and_the_table(answer, choice, problem):
     reading = read_answer(answer, ["cup", "glass"], ["cup", "glass", "mug", "water"], VOCAB)
     assert (reading.choice, reading.problem) == (choice, problem)
@@ -39,7 +46,12 @@ def robot_parts(tmp_path_factory):
     from lmcr.srl.parser import load_parser
 
     client = p.connect(p.DIRECT)
-    yield load_parser(), (lambda frames, context="": [0.0] * len(frames)), CompletionConfig(), tmp_path_factory.mktemp("robot")
+    yield (
+        load_parser(),
+        (lambda frames, context="": [0.0] * len(frames)),
+        CompletionConfig(),
+        tmp_path_factory.mktemp("robot"),
+    )
     p.disconnect(client)
 
 
@@ -54,8 +66,15 @@ def test_scripted_dialogue_question_answer_execution(robot_parts):
 
     parser, scorer, config, cache = robot_parts
     said = []
-    outcomes = converse(iter(["pour me some water", "the bowl", "into the glass please"]), _scene(), parser, scorer,
-                        config, cache, said.append)
+    outcomes = converse(
+        iter(["pour me some water", "the bowl", "into the glass please"]),
+        _scene(),
+        parser,
+        scorer,
+        config,
+        cache,
+        said.append,
+    )
     assert said[0] == "you: pour me some water" and said[1].startswith("robot: Should I pour water into the")
     assert said[3].startswith("robot: I don't see a bowl on the table. Should I pour")
     assert outcomes[0]["answer"] == {"Destination": "glass"} and outcomes[0]["chosen_object"] == "glass"
@@ -69,12 +88,21 @@ def test_three_unusable_answers_and_the_robot_leaves_it(robot_parts):
 
     parser, scorer, config, cache = robot_parts
     said = []
-    outcomes = converse(iter(["pour me some water", "the bowl", "no", "what?", "juggle the cup"]), _scene(), parser,
-                        scorer, config, cache, said.append)
+    outcomes = converse(
+        iter(["pour me some water", "the bowl", "no", "what?", "juggle the cup"]),
+        _scene(),
+        parser,
+        scorer,
+        config,
+        cache,
+        said.append,
+    )
     assert "robot: I'll leave it." in said and outcomes[0]["left"] and outcomes[0]["reply"] == "I'll leave it."
     assert "no known predicate" in outcomes[1]["error"]  # the next instruction is heard again
-    assert said[-1] == "robot: Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, " \
-                       "pour, rub, season or sprinkle things."
+    assert (
+        said[-1] == "robot: Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, "
+        "pour, rub, season or sprinkle things."
+    )
 
 
 def test_everything_the_robot_says_is_a_sentence(robot_parts):
@@ -83,22 +111,48 @@ def test_everything_the_robot_says_is_a_sentence(robot_parts):
 
     parser, scorer, config, cache = robot_parts
     said = []
-    turns = ["pour some water into the glass", "pour the water into the bowl", "fill the cup", "the water",
-             "juggle the cup", "pour the milk into the cup"]
+    turns = [
+        "pour some water into the glass",
+        "pour the water into the bowl",
+        "fill the cup",
+        "the water",
+        "juggle the cup",
+        "pour the milk into the cup",
+    ]
     converse(iter(turns), _scene(), parser, scorer, config, cache, said.append)
     robot = [line.removeprefix("robot: ") for line in said if line.startswith("robot: ")]
-    assert robot[:4] == ["I poured the water into the glass.", "I see no bowl on the table.",
-                         "Should I fill the cup with the water or the glass?", "I filled the cup with the water."]
+    assert robot[:4] == [
+        "I poured the water into the glass.",
+        "I see no bowl on the table.",
+        "Should I fill the cup with the water or the glass?",
+        "I filled the cup with the water.",
+    ]
     assert robot[4].startswith("Sorry, I don't know how to do that.") and robot[5] == "I see no milk on the table."
     assert all(re.fullmatch(r"[A-Z][A-Za-z ,':.?]+[.?]", line) for line in robot), robot
 
 
-@pytest.mark.parametrize("verb, past", [
-    ("pour", "poured"), ("fill", "filled"), ("sprinkle", "sprinkled"), ("season", "seasoned"), ("heat", "heated"),
-    ("fry", "fried"), ("blend", "blended"), ("dump", "dumped"), ("dip", "dipped"), ("brush", "brushed"),
-    ("rub", "rubbed"), ("stir", "stirred"), ("mix", "mixed"), ("boil", "boiled"), ("play", "played"),
-    ("pour out", "poured out"), ("bake", "baked"),
-])
+@pytest.mark.parametrize(
+    "verb, past",
+    [
+        ("pour", "poured"),
+        ("fill", "filled"),
+        ("sprinkle", "sprinkled"),
+        ("season", "seasoned"),
+        ("heat", "heated"),
+        ("fry", "fried"),
+        ("blend", "blended"),
+        ("dump", "dumped"),
+        ("dip", "dipped"),
+        ("brush", "brushed"),
+        ("rub", "rubbed"),
+        ("stir", "stirred"),
+        ("mix", "mixed"),
+        ("boil", "boiled"),
+        ("play", "played"),
+        ("pour out", "poured out"),
+        ("bake", "baked"),
+    ],
+)
 def test_the_past_tense_follows_the_regular_rule(verb, past):
     assert past_tense(verb) == past
 
@@ -107,8 +161,17 @@ def test_an_irregular_past_comes_from_the_lexicon():
     """Only an irregular verb carries a `past` in the lexicon; the 11 robot predicates are regular."""
     lex = load_lexicon()
     assert all(spec.past is None for spec in lex.predicates.values())
-    put = PredicateSpec("put away", ("Theme", "Destination"), "Theme", None, {"Destination": ("in",)}, frozenset(),
-                        False, "put {Theme} away in the {Destination}", past="put")
+    put = PredicateSpec(
+        "put away",
+        ("Theme", "Destination"),
+        "Theme",
+        None,
+        {"Destination": ("in",)},
+        frozenset(),
+        False,
+        "put {Theme} away in the {Destination}",
+        past="put",
+    )
     mixed = type(lex)(**{**lex.__dict__, "predicates": {**lex.predicates, "put away": put}})
     frame = {"predicate": "put away", "roles": {"Theme": "knife", "Destination": "sink"}}
     assert say({"frame": frame, "feasible": True, "success": True}, mixed) == "I put the knife away in the sink."
@@ -127,42 +190,98 @@ def test_every_predicate_is_said_from_its_template(predicate):
 POUR = {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
 
 
-@pytest.mark.parametrize("outcome, sentence", [
-    ({"frame": POUR, "feasible": True, "success": True, "arm": "right"}, "I poured the water into the cup."),
-    ({"frame": {"predicate": "fill", "roles": {"Destination": "glass", "Theme": "milk"}}, "feasible": True,
-      "success": True}, "I filled the glass with the milk."),
-    ({"frame": {"predicate": "season", "roles": {"Theme": "steak", "Instrument": "salt"}}, "feasible": True,
-      "success": True}, "I seasoned the steak with the salt."),
-    ({"frame": POUR, "feasible": False, "out_of_reach": True, "chosen_object": "cup",
-      "suggestion": {"Destination": "glass"}},
-     "I can't reach the cup: should I pour the water into the glass instead?"),
-    ({"frame": POUR, "feasible": False, "out_of_reach": True, "chosen_object": None},
-     "I can't reach far enough to pour the water into the cup."),
-    ({"frame": POUR, "feasible": False, "blocker": "the pot#2", "reason": "..."},
-     "I can't pour the water into the cup: the second pot is in the way."),
-    ({"frame": POUR, "feasible": False, "reason": "the water would slip"},
-     "I can't pour the water into the cup without a mishap."),
-    ({"frame": POUR, "feasible": True, "success": False,
-      "checks": {"liquid_in_target": 0.4, "verb_check": False, "grasped": True, "knocked": ["glass", "cup#3"]}},
-     "I tried to pour the water into the cup, but only 40% of it went in and I bumped into the glass and the "
-     "third cup."),
-    ({"frame": POUR, "feasible": True, "success": False, "checks": {"grasped": False}},
-     "I tried to pour the water into the cup, but I lost my grip."),
-    ({"frame": {"predicate": "dip", "roles": {"Theme": "strawberry", "Destination": "chocolate"}}, "feasible": True,
-      "success": False, "checks": {"dipped_below_rim": True, "lifted_out": False, "verb_check": False}},
-     "I tried to dip the strawberry in the chocolate, but I could not lift it back out."),
-    ({"frame": POUR, "question": "Should I pour water into the cup or the glass?"},
-     "Should I pour water into the cup or the glass?"),
-    ({"frame": POUR, "left": True, "feasible": False}, "I'll leave it."),
-    ({"error": "no known predicate in 'juggle'", "error_kind": "unknown_predicate"},
-     "Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or "
-     "sprinkle things."),
-    ({"error": "...", "error_kind": "absent", "absent": "onion"}, "I see no onion on the table."),
-    ({"error": "...", "error_kind": "incomplete", "frame": {"predicate": "fill", "roles": {"Destination": "cup",
-                                                                                          "Theme": None}}},
-     "I can't fill the cup with anything here."),
-    ({"error": "scene.json: bad"}, "Sorry, I can't do that: scene.json: bad."),
-])
+@pytest.mark.parametrize(
+    "outcome, sentence",
+    [
+        ({"frame": POUR, "feasible": True, "success": True, "arm": "right"}, "I poured the water into the cup."),
+        (
+            {
+                "frame": {"predicate": "fill", "roles": {"Destination": "glass", "Theme": "milk"}},
+                "feasible": True,
+                "success": True,
+            },
+            "I filled the glass with the milk.",
+        ),
+        (
+            {
+                "frame": {"predicate": "season", "roles": {"Theme": "steak", "Instrument": "salt"}},
+                "feasible": True,
+                "success": True,
+            },
+            "I seasoned the steak with the salt.",
+        ),
+        (
+            {
+                "frame": POUR,
+                "feasible": False,
+                "out_of_reach": True,
+                "chosen_object": "cup",
+                "suggestion": {"Destination": "glass"},
+            },
+            "I can't reach the cup: should I pour the water into the glass instead?",
+        ),
+        (
+            {"frame": POUR, "feasible": False, "out_of_reach": True, "chosen_object": None},
+            "I can't reach far enough to pour the water into the cup.",
+        ),
+        (
+            {"frame": POUR, "feasible": False, "blocker": "the pot#2", "reason": "..."},
+            "I can't pour the water into the cup: the second pot is in the way.",
+        ),
+        (
+            {"frame": POUR, "feasible": False, "reason": "the water would slip"},
+            "I can't pour the water into the cup without a mishap.",
+        ),
+        (
+            {
+                "frame": POUR,
+                "feasible": True,
+                "success": False,
+                "checks": {
+                    "liquid_in_target": 0.4,
+                    "verb_check": False,
+                    "grasped": True,
+                    "knocked": ["glass", "cup#3"],
+                },
+            },
+            "I tried to pour the water into the cup, but only 40% of it went in and I bumped into the glass and the "
+            "third cup.",
+        ),
+        (
+            {"frame": POUR, "feasible": True, "success": False, "checks": {"grasped": False}},
+            "I tried to pour the water into the cup, but I lost my grip.",
+        ),
+        (
+            {
+                "frame": {"predicate": "dip", "roles": {"Theme": "strawberry", "Destination": "chocolate"}},
+                "feasible": True,
+                "success": False,
+                "checks": {"dipped_below_rim": True, "lifted_out": False, "verb_check": False},
+            },
+            "I tried to dip the strawberry in the chocolate, but I could not lift it back out.",
+        ),
+        (
+            {"frame": POUR, "question": "Should I pour water into the cup or the glass?"},
+            "Should I pour water into the cup or the glass?",
+        ),
+        ({"frame": POUR, "left": True, "feasible": False}, "I'll leave it."),
+        (
+            {"error": "no known predicate in 'juggle'", "error_kind": "unknown_predicate"},
+            "Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or "
+            "sprinkle things.",
+        ),
+        ({"error": "...", "error_kind": "absent", "absent": "onion"}, "I see no onion on the table."),
+        (
+            {
+                "error": "...",
+                "error_kind": "incomplete",
+                "frame": {"predicate": "fill", "roles": {"Destination": "cup", "Theme": None}},
+            },
+            "I can't fill the cup with anything here.",
+        ),
+        ({"error": "scene.json: bad"}, "Sorry, I can't do that: scene.json: bad."),
+    ],
+)
 def test_each_outcome_is_said_in_a_sentence(outcome, sentence):
     assert say(outcome) == sentence
 
@@ -172,8 +291,12 @@ def test_a_frame_object_and_ids_are_said_as_a_person_hears_them():
 
     frame = Frame.of("dump", {"Theme": "pasta", "Destination": "pot"})
     assert say({"frame": frame, "feasible": True, "success": True}) == "I dumped the pasta into the pot."
-    assert [spoken(i) for i in ("cup", "cup#2", "red cup", "cup#12")] == ["the cup", "the second cup", "the red cup",
-                                                                         "cup number 12"]
+    assert [spoken(i) for i in ("cup", "cup#2", "red cup", "cup#12")] == [
+        "the cup",
+        "the second cup",
+        "the red cup",
+        "cup number 12",
+    ]
 
 
 def test_errors_carry_what_their_sentence_needs():
@@ -184,7 +307,10 @@ def test_errors_carry_what_their_sentence_needs():
 
     assert error_outcome(NoPredicateError("no known predicate"))["error_kind"] == "unknown_predicate"
     assert error_outcome(ExecutionError("cannot pour here", absent="cup")) == {
-        "error": "cannot pour here", "error_kind": "absent", "absent": "cup"}
+        "error": "cannot pour here",
+        "error_kind": "absent",
+        "absent": "cup",
+    }
     frame = {"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}
     incomplete = error_outcome(CompletionError("cannot fill Destination", frame))
     assert say(incomplete) == "I can't pour the water into anything here."

@@ -36,8 +36,12 @@ def bench_dir(tmp_path, *names):
 def test_a_benchmarks_record_is_on_the_results_page_and_the_others_are_named(tmp_path, monkeypatch):
     bench = bench_dir(tmp_path, "bench_fast", "bench_slow")
     monkeypatch.setattr(sys, "argv", ["bench/bench_fast.py", "--runs", "3"])
-    record.write_results(str(bench / "results" / "bench_fast.json"), "bench_fast", "How fast it is.",
-                         {"median s": 0.412, "items": 12345, "target met": True})
+    record.write_results(
+        str(bench / "results" / "bench_fast.json"),
+        "bench_fast",
+        "How fast it is.",
+        {"median s": 0.412, "items": 12345, "target met": True},
+    )
     written = json.loads((bench / "results" / "bench_fast.json").read_text(encoding="utf-8"))
     assert written["command"].endswith("bench_fast.py --runs 3") and written["date"] and written["machine"]
     page = hooks.results_page(bench)
@@ -49,9 +53,14 @@ def test_a_benchmarks_record_is_on_the_results_page_and_the_others_are_named(tmp
     assert "bench_fast.py" not in missing
 
 
-@pytest.mark.parametrize("text, reason", [("{not json", "not a benchmark record"),
-                                          ('{"benchmark": "b", "figures": {}}', "missing"),
-                                          ('["a list"]', "missing")])
+@pytest.mark.parametrize(
+    "text, reason",
+    [
+        ("{not json", "not a benchmark record"),
+        ('{"benchmark": "b", "figures": {}}', "missing"),
+        ('["a list"]', "missing"),
+    ],
+)
 def test_a_damaged_record_fails_the_build_naming_the_file(tmp_path, text, reason):
     bench = bench_dir(tmp_path, "bench_fast")
     (bench / "results" / "bench_fast.json").write_text(text, encoding="utf-8")
@@ -85,6 +94,8 @@ def test_the_command_reference_covers_every_command_and_option():
 
 
 def test_help_text_becomes_markdown_that_cannot_break_a_table():
-    assert hooks.paragraphs("One line\nand the next.\n\n\b\nSecond <path> and `<kept>`.") == \
-        "One line and the next.\n\nSecond &lt;path&gt; and `<kept>`."
+    assert (
+        hooks.paragraphs("One line\nand the next.\n\n\b\nSecond <path> and `<kept>`.")
+        == "One line and the next.\n\nSecond &lt;path&gt; and `<kept>`."
+    )
     assert hooks.escape_cell("a | b\n\nc") == "a \\| b<br>c"

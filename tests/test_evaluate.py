@@ -16,12 +16,23 @@ OBJECTS = ["cup", "glass", "mug", "bowl", "scissors", "knife", "towel", "sponge"
 
 def rated(verbs=("pour", "fill")) -> list[RatedFrame]:
     """Per verb: water into the first four objects is plausible (4.7), the rest implausible (1.3)."""
-    return [RatedFrame(v, "Theme", "water", "Destination", o, 4.7 if i < 4 else 1.3, 3)
-            for v in verbs for i, o in enumerate(OBJECTS)]
+    return [
+        RatedFrame(v, "Theme", "water", "Destination", o, 4.7 if i < 4 else 1.3, 3)
+        for v in verbs
+        for i, o in enumerate(OBJECTS)
+    ]
 
 
-@pytest.mark.parametrize("mean,lam,expected", [(4.2, 1.0, {"positive"}), (1.9, 1.0, {"negative"}),
-                                               (3.0, 1.0, set()), (4.0, 1.0, set()), (3.5, 1.6, {"positive"})])
+@pytest.mark.parametrize(
+    "mean,lam,expected",
+    [
+        (4.2, 1.0, {"positive"}),
+        (1.9, 1.0, {"negative"}),
+        (3.0, 1.0, set()),
+        (4.0, 1.0, set()),
+        (3.5, 1.6, {"positive"}),
+    ],
+)
 def test_lambda_split(mean, lam, expected):
     assert label(mean, lam) == expected
 

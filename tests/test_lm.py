@@ -19,11 +19,18 @@ from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer
 from lmcr.lm.train import PrecisionError, TrainConfig, bf16_unsupported, pick_precision, train_lm
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 
 CORPUS = [
-    "pour the water into the cup", "pour the milk into the glass", "pour the wine into the glass",
-    "fill the pot with water", "fry the egg in the pan", "heat the oil in the skillet",
-    "sprinkle salt on the steak", "dip the bread in the soup", "blend the banana in the blender",
+    "pour the water into the cup",
+    "pour the milk into the glass",
+    "pour the wine into the glass",
+    "fill the pot with water",
+    "fry the egg in the pan",
+    "heat the oil in the skillet",
+    "sprinkle salt on the steak",
+    "dip the bread in the soup",
+    "blend the banana in the blender",
 ] * 4
 
 
@@ -37,7 +44,16 @@ def test_linearisations():
     with pytest.raises(ValueError, match="unfilled"):
         sentence_text("pour", {"Theme": "water", "Destination": None})
     assert tokens("Pour 1 1/2 cups of Milk's foam, then stir.") == [
-        "pour", "<num>", "<num>", "cups", "of", "milk's", "foam", "then", "stir"]
+        "pour",
+        "<num>",
+        "<num>",
+        "cups",
+        "of",
+        "milk's",
+        "foam",
+        "then",
+        "stir",
+    ]
 
 
 def test_vocab_cutoff_and_unknowns():
@@ -91,8 +107,9 @@ def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
     ids = [vocab.encode(tokens(t)) for t in CORPUS]
     torch.manual_seed(7)
     model = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
-    history = train_lm(model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7,
-                                                    precision="bf16"))
+    history = train_lm(
+        model, ids, ids, TrainConfig(max_epochs=60, lr=0.02, batch_tokens=200, patience=60, seed=7, precision="bf16")
+    )
     assert history[-1]["val_ppl"] < 1.6 and {h["precision"] for h in history} == {"bf16"}
     assert all(p.dtype == torch.float32 for p in model.parameters())  # master weights stay fp32
     assert float(torch.tensor([1e-40]) * 1.0) > 0  # denormal flushing ended with the training steps
@@ -118,8 +135,13 @@ def test_the_lm_tests_pass_on_a_cpu_without_bf16():
     env = os.environ | {"ONEDNN_MAX_CPU_ISA": "AVX2", "LMCR_INNER_AVX2_RUN": "1"}
     if os.environ.get("LMCR_INNER_AVX2_RUN"):
         pytest.skip("already the inner run")
-    run = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rs", __file__],
-                         env=env, capture_output=True, text=True, timeout=900)
+    run = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-rs", __file__],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert run.returncode == 0, run.stdout[-3000:]
     assert "bf16 path: this CPU has no bfloat16 support in oneDNN" in run.stdout
     assert " failed" not in run.stdout and " error" not in run.stdout
@@ -137,15 +159,16 @@ def test_target_perplexity_stops_training(overfit):
     _, vocab, _ = overfit
     ids = [vocab.encode(tokens(t)) for t in CORPUS]
     model = RecurrentLM(LMConfig(len(vocab), embedding=16, layers=1))
-    history = train_lm(model, ids, ids, TrainConfig(max_epochs=50, patience=50, lr=0.02, batch_tokens=200,
-                                                    target_ppl=len(vocab) / 2))
+    history = train_lm(
+        model, ids, ids, TrainConfig(max_epochs=50, patience=50, lr=0.02, batch_tokens=200, target_ppl=len(vocab) / 2)
+    )
     assert 1 <= len(history) < 50 and history[-1]["val_ppl"] <= len(vocab) / 2
     assert all(h["val_ppl"] > len(vocab) / 2 for h in history[:-1])
 
 
 def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
     model, vocab, _ = overfit
-    path = ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})
+    path = ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})
     scorer = LMScorer(ckpt.load(path), precision="fp32")
     texts = ["pour water into the cup", "pour water into the scissors", "pour milk into the glass", "fry egg"]
     with torch.no_grad():
@@ -157,8 +180,9 @@ def test_trie_scores_equal_a_plain_forward_pass(overfit, tmp_path):
         pooled = float(model.token_logprobs(torch.tensor([scorer.encode("pour water into the teapot")])).sum())
     assert abs(unknown - (pooled - math.log(50))) < 1e-4  # the rare word's share of <unk>
     scorer.vocab = vocab
-    cup, scissors = scorer.score_frames([("pour", {"Theme": "water", "Destination": "cup"}),
-                                         ("pour", {"Theme": "water", "Destination": "scissors"})])
+    cup, scissors = scorer.score_frames(
+        [("pour", {"Theme": "water", "Destination": "cup"}), ("pour", {"Theme": "water", "Destination": "scissors"})]
+    )
     assert cup > scissors
 
 
@@ -167,7 +191,7 @@ def test_bf16_scoring_is_within_rounding_of_fp32(overfit, tmp_path):
     """The LSTM and the decoder in bfloat16 (the default where the CPU has it, as in training) move a
     text's log-probability by rounding only; the softmax stays fp32, the checkpoint's model is unchanged."""
     model, vocab, _ = overfit
-    loaded = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}))
+    loaded = ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {}))
     exact, rounded = LMScorer(loaded, precision="fp32"), LMScorer(loaded, precision="bf16")
     assert rounded._decoder[0].dtype == torch.bfloat16 and loaded.model.decoder.weight.dtype == torch.float32
     assert rounded._rnn.weight_hh_l0.dtype == torch.bfloat16 and loaded.model.rnn.weight_hh_l0.dtype == torch.float32
@@ -176,7 +200,9 @@ def test_bf16_scoring_is_within_rounding_of_fp32(overfit, tmp_path):
     assert rounded.score(texts) == pytest.approx(exact.score(texts), abs=0.02 * 6)  # ~0.01 a token
     assert rounded.score(texts) != exact.score(texts)  # it did multiply in bf16
     frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors")]
-    assert rounded.score_frames(frames, "for my tea") == pytest.approx(exact.score_frames(frames, "for my tea"), abs=0.2)
+    assert rounded.score_frames(frames, "for my tea") == pytest.approx(
+        exact.score_frames(frames, "for my tea"), abs=0.2
+    )
     with pytest.raises(ValueError, match="precision"):
         LMScorer(loaded, precision="fp8")
 
@@ -184,27 +210,37 @@ def test_bf16_scoring_is_within_rounding_of_fp32(overfit, tmp_path):
 def test_context_follows_the_frame_and_articles_follow_the_checkpoint(overfit, tmp_path):
     model, vocab, _ = overfit
     frame = ("pour", {"Theme": "water", "Destination": "cup"})
-    kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
+    kept = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})), precision="fp32")
     assert kept.score_frames([frame], context="") == kept.score(["pour water into the cup"])
-    assert kept.score_frames([frame], context="for my tea") == pytest.approx(kept.score(["pour water into the cup for my tea"]))
+    assert kept.score_frames([frame], context="for my tea") == pytest.approx(
+        kept.score(["pour water into the cup for my tea"])
+    )
     # Past the LM's best CONTEXT_TOP frames, a frame gets the lowest context term of those.
     many = [("pour", {"Theme": "water", "Destination": f"cup{i}"}) for i in range(CONTEXT_TOP + 2)]
     bare, read = kept.score_frames(many), kept.score_frames(many, context="for my tea")
     gains = sorted(zip(bare, [r - b for r, b in zip(read, bare)]), reverse=True)
     assert all(g == pytest.approx(min(x for _, x in gains[:CONTEXT_TOP])) for _, g in gains[CONTEXT_TOP:])
-    dropped = ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {}, articles=False))
-    assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == ["pour", "milk", "into", "cup"]
+    dropped = ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {}, articles=False))
+    assert dropped.articles is False and tokens("Pour the milk into a cup", articles=False) == [
+        "pour",
+        "milk",
+        "into",
+        "cup",
+    ]
     assert LMScorer(dropped, precision="fp32").score_frames([frame]) == kept.score(["pour water into cup"])
 
 
 def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, tmp_path):
     model, vocab, _ = overfit
-    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})), precision="fp32")
     scorer.vocab = Vocab(vocab.words, unk_types=50)  # "kettle" is unknown: its <unk> share is charged too
     # A frame whose text is inside another's ("pour water into the cup" / "... cup lid"), one that shares
     # no more than the predicate, and a context with an unknown word.
-    frames = [("pour", {"Theme": "water", "Destination": "cup"}), ("pour", {"Theme": "water", "Destination": "cup lid"}),
-              ("pour", {"Theme": "milk", "Destination": "glass"})]
+    frames = [
+        ("pour", {"Theme": "water", "Destination": "cup"}),
+        ("pour", {"Theme": "water", "Destination": "cup lid"}),
+        ("pour", {"Theme": "milk", "Destination": "glass"}),
+    ]
     texts = ["pour water into the cup", "pour water into the cup lid", "pour milk into the glass"]
     for norm in NORMS:
         whole = scorer.score([f"{t} for the kettle" for t in texts], norm)
@@ -221,8 +257,8 @@ def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monke
     model, vocab, _ = overfit
     torch.manual_seed(3)
     untrained = RecurrentLM(LMConfig(len(vocab), embedding=32, layers=1, dropout=0.0))
-    ckpt.publish(tmp_path, "sentence-all", model, vocab, "sentence", {}, {})
-    ckpt.publish(tmp_path, "sentence-household", untrained, vocab, "sentence", {}, {})
+    ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})
+    ckpt.publish(tmp_path, Setting("sentence", "household"), untrained, vocab, {}, {})
     monkeypatch.setattr(lm_checkpoints, "corpus_words", lambda res: {"recipes": 99, "household": 1})
     frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors")]
     plain = MethodResources(checkpoints=tmp_path)
@@ -239,15 +275,18 @@ def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monke
     assert "@" not in scorer_fingerprint("sentence_lm", plain)
 
 
-@pytest.mark.parametrize("texts", [
-    ["pour water into the cup", "pour water into the glass", "pour water into the bell pepper"],  # shared prefix
-    ["pour water into the cup"],  # one text: all prefix
-    ["pour water", "pour water into the cup", "pour water into the cup"],  # a text inside another, a duplicate
-    ["fill the pot with water", "fill the pot with water"],  # identical texts
-])
+@pytest.mark.parametrize(
+    "texts",
+    [
+        ["pour water into the cup", "pour water into the glass", "pour water into the bell pepper"],  # shared prefix
+        ["pour water into the cup"],  # one text: all prefix
+        ["pour water", "pour water into the cup", "pour water into the cup"],  # a text inside another, a duplicate
+        ["fill the pot with water", "fill the pot with water"],  # identical texts
+    ],
+)
 def test_shared_prefix_scoring_equals_a_plain_forward_pass(overfit, tmp_path, texts):
     model, vocab, _ = overfit
-    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})), precision="fp32")
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})), precision="fp32")
     with torch.no_grad():
         direct = [float(model.token_logprobs(torch.tensor([scorer.encode(t)])).sum()) for t in texts]
     before = torch.backends.mkldnn.enabled
@@ -257,21 +296,21 @@ def test_shared_prefix_scoring_equals_a_plain_forward_pass(overfit, tmp_path, te
 
 def test_publish_reload_identical_and_latest(overfit, tmp_path):
     model, vocab, history = overfit
-    first = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {"history": history}, {"corpus": "x"})
-    reloaded = ckpt.load(tmp_path / "frame-test")  # through LATEST
+    first = ckpt.publish(tmp_path, Setting("frame"), model, vocab, {"history": history}, {"corpus": "x"})
+    reloaded = ckpt.load(tmp_path / "frame-all")  # through LATEST
     assert reloaded.path == first and reloaded.linearization == "frame"
     texts = ["pour water cup", "pour water glass"]
     assert LMScorer(reloaded).score(texts) == LMScorer(ckpt.load(first)).score(texts)
     for name, tensor in model.state_dict().items():
         assert torch.equal(tensor.cpu(), reloaded.model.state_dict()[name])
-    second = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {}, {}, promote=False)
-    assert ckpt.resolve(tmp_path / "frame-test") == first and second.exists()
-    assert not list((tmp_path / "frame-test").glob(".*.tmp"))
+    second = ckpt.publish(tmp_path, Setting("frame"), model, vocab, {}, {}, promote=False)
+    assert ckpt.resolve(tmp_path / "frame-all") == first and second.exists()
+    assert not list((tmp_path / "frame-all").glob(".*.tmp"))
 
 
 def test_tampered_checkpoint_is_refused(overfit, tmp_path):
     model, vocab, _ = overfit
-    path = ckpt.publish(tmp_path, "frame-test", model, vocab, "frame", {}, {})
+    path = ckpt.publish(tmp_path, Setting("frame"), model, vocab, {}, {})
     (path / "vocab.json").write_text(json.dumps({"words": list(vocab.words)[::-1], "unk_types": 1}))
     with pytest.raises(ckpt.CheckpointError, match="vocab.json: sha256 differs"):
         ckpt.load(path)
@@ -281,14 +320,17 @@ def test_tampered_checkpoint_is_refused(overfit, tmp_path):
 
 
 def test_setting_reads_both_spellings():
-    from lmcr.setting import ALL_SETTINGS, Setting
+    from lmcr.setting import ALL_SETTINGS, Setting, SettingError
 
     assert Setting.parse("sentence-all") == Setting.parse("sentence_lm/all") == Setting("sentence", "all")
     assert Setting.parse("frame_lm/recipes").name == "frame-recipes" and Setting.parse("frame").label == "frame_lm/all"
     assert len(ALL_SETTINGS) == 8 and all(Setting.parse(s.name) == s == Setting.parse(s.label) for s in ALL_SETTINGS)
-    for bad, reason in (("nope-all", "unknown setting"), ("sentence-recipe", "corpus must be one of"),
-                        ("frame_lm/x", "corpus must be one of")):
-        with pytest.raises(ValueError, match=reason):
+    for bad, reason in (
+        ("nope-all", "unknown setting"),
+        ("sentence-recipe", "corpus must be one of"),
+        ("frame_lm/x", "corpus must be one of"),
+    ):
+        with pytest.raises(SettingError, match=reason):  # an LMCRError and a ValueError
             Setting.parse(bad)
 
 
@@ -297,7 +339,7 @@ def test_decoder_blocks_give_the_scores_of_one_pass(overfit, tmp_path, monkeypat
     from lmcr.lm import score as score_module
 
     model, vocab, _ = overfit
-    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, "sentence-test", model, vocab, "sentence", {}, {})))
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})))
     texts = ["pour water into the cup", "pour water into the glass", "fill the pot with water", "pour milk"]
     whole = scorer.score(texts)
     monkeypatch.setattr(score_module, "DECODER_BLOCK", 3)

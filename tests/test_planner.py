@@ -56,4 +56,7 @@ def test_without_a_budget_only_the_straight_motion_is_taken():
     q0, q1 = np.zeros(7) + [-1, 0, 0, 0, 0, 0, 0], np.zeros(7) + [1, 0, 0, 0, 0, 0, 0]
     assert joint_path(_wall, q0, q1, LIMITS, budget=0) is None
     over = np.zeros(7) + [0, 1.5, 0, 0, 0, 0, 0]
-    assert [list(q) for q in joint_path(_wall, q0 + over, q1 + over, LIMITS, budget=0)] == [list(q0 + over), list(q1 + over)]
+    assert [list(q) for q in joint_path(_wall, q0 + over, q1 + over, LIMITS, budget=0)] == [
+        list(q0 + over),
+        list(q1 + over),
+    ]

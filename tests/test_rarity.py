@@ -29,8 +29,10 @@ def store(tmp_path):
     db = tmp_path / "lmcr.duckdb"
     sql_dir = Workspace.from_env().sql_dir
     con = connect(db, sql_dir)
-    con.executemany("insert into sentences values (?, 's', ?, ?, 'instruction', ?, ?, 'f', 0, null, null)",
-                    [(corpus, f"d{i}", i, text, len(text.split())) for i, (corpus, text) in enumerate(SENTENCES)])
+    con.executemany(
+        "insert into sentences values (?, 's', ?, ?, 'instruction', ?, ?, 'f', 0, null, null)",
+        [(corpus, f"d{i}", i, text, len(text.split())) for i, (corpus, text) in enumerate(SENTENCES)],
+    )
     con.close()
     return db, sql_dir, corpus_words(MethodResources(checkpoints=tmp_path, db=db))
 
@@ -76,7 +78,8 @@ def test_rarity_is_a_term_of_sums_with_a_fingerprint(store):
     frames = [Frame.of("dump", {"Theme": theme, "Destination": "bowl"}) for theme in ("pan", "cheese")]
     alone = make_scorer("rarity", res)(frames)
     assert make_scorer("random+rarity", res)(frames) == pytest.approx(
-        [a + b for a, b in zip(make_scorer("random", res)(frames), alone)])
+        [a + b for a, b in zip(make_scorer("random", res)(frames), alone)]
+    )
     assert scorer_fingerprint("rarity", res).endswith(f"*{WEIGHT:g}")
     with pytest.raises(ValueError, match="rarity needs the store's sentences"):
         make_scorer("rarity", MethodResources(checkpoints=db.parent, db=db.parent / "none.duckdb", sql_dir=sql_dir))
@@ -92,8 +95,12 @@ def test_counts_are_cached_by_the_caller_named_file_and_a_bad_cache_is_recounted
     again = PhraseCounts(*store)
     again.count_cached(["pan"], cache)
     assert again.counts["pan"] == 7
-    for bad in ("{not json", json.dumps({"words": first.words + 1, "counts": {"pan": 7}}), "[1, 2]",
-                json.dumps({"words": first.words, "counts": {"pan": 7}})):  # the last lacks cheese
+    for bad in (
+        "{not json",
+        json.dumps({"words": first.words + 1, "counts": {"pan": 7}}),
+        "[1, 2]",
+        json.dumps({"words": first.words, "counts": {"pan": 7}}),
+    ):  # the last lacks cheese
         cache.write_text(bad)
         fresh = PhraseCounts(*store)
         fresh.count_cached(["pan", "cheese"], cache)

@@ -38,7 +38,8 @@ def test_the_readme_and_the_guide_document_queries():
 
 def test_every_readme_query_runs(con, paths, sample_dir):
     sources = expand_inputs([sample_dir / "youcook2"], "youcook2") + expand_inputs(
-        [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl"], "recipes")
+        [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl"], "recipes"
+    )
     ingest_sources(con, sources, paths.staging, workers=1)
     build_frame_corpus(con, paths.staging, paths.srl_dir, FrameCorpusConfig(), process_pool(1))
     ingest_ratings(con, sample_dir / "ratings" / "sample_ratings_mturk.csv")
@@ -65,8 +66,9 @@ def test_schema_page_is_current_and_every_column_is_described():
     from lmcr.catalog import schema_page
 
     page = schema_page(REPO_ROOT / "sql")
-    assert (REPO_ROOT / "sql" / "SCHEMA.md").read_text(encoding="utf-8") == page, \
+    assert (REPO_ROOT / "sql" / "SCHEMA.md").read_text(encoding="utf-8") == page, (
         "sql/SCHEMA.md is stale: run `lmcr schema --out sql/SCHEMA.md`"
+    )
     assert "(no comment)" not in page
     rows = [line for line in page.splitlines() if line.startswith("| ") and not line.startswith("| column")]
     assert len(rows) > 150 and all(not line.endswith("|  |") for line in rows)
@@ -86,7 +88,9 @@ def test_mturk_times_and_rewards_are_typed(con, sample_dir, tmp_path):
         writer.writeheader()
         writer.writerows(rows[:2])
     ingest_ratings(con, path)
-    got = con.execute("select a.submit_time::varchar, h.reward::varchar, typeof(a.submit_time), typeof(h.reward) "
-                      "from assignments a join hits h using (hit_id) order by a.line").fetchall()
+    got = con.execute(
+        "select a.submit_time::varchar, h.reward::varchar, typeof(a.submit_time), typeof(h.reward) "
+        "from assignments a join hits h using (hit_id) order by a.line"
+    ).fetchall()
     assert got[0] == ("2026-11-17 18:02:00", "0.30", "TIMESTAMP", "DECIMAL(9,2)")
     assert got[1][0] is None  # unreadable time: NULL, the row itself loads

@@ -25,6 +25,7 @@ from lmcr.ingest.run import ingest_sources
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 
 runner = CliRunner()
 
@@ -43,6 +44,7 @@ def one_line_error(result) -> str:
 
 
 # 1. --out never deletes what LMCR did not write
+
 
 def test_output_folder_with_user_files_is_refused_and_kept(tmp_path):
     out = tmp_path / "report"
@@ -74,8 +76,11 @@ def test_evaluate_and_annotate_tasks_refuse_a_user_folder_before_working(tmp_pat
     out.mkdir()
     (out / "keep.txt").write_text("keep")
     env = {"LMCR_DATA_DIR": str(tmp_path / "data")}
-    evaluated = runner.invoke(app, ["evaluate", "--ratings", str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-                                    "--out", str(out)], env=env)
+    evaluated = runner.invoke(
+        app,
+        ["evaluate", "--ratings", str(sample_dir / "ratings" / "sample_ratings_mturk.csv"), "--out", str(out)],
+        env=env,
+    )
     assert "not an LMCR output" in one_line_error(evaluated)
     tasks = runner.invoke(app, ["annotate", "tasks", "--out", str(out)], env=env)
     assert "not an LMCR output" in one_line_error(tasks)
@@ -89,24 +94,43 @@ def test_a_file_output_that_is_a_folder_is_refused(tmp_path):
 
 
 def test_render_into_a_folder_is_refused_before_the_simulation(tmp_path, sample_dir):
-    result = runner.invoke(app, ["execute", "pour me some water", "--scene",
-                                 str(sample_dir / "scenes" / "pour_me_some_water.json"), "--render", str(tmp_path)],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    result = runner.invoke(
+        app,
+        [
+            "execute",
+            "pour me some water",
+            "--scene",
+            str(sample_dir / "scenes" / "pour_me_some_water.json"),
+            "--render",
+            str(tmp_path),
+        ],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert "is a folder" in one_line_error(result)
-    bad_suffix = runner.invoke(app, ["execute", "pour me some water", "--scene",
-                                     str(sample_dir / "scenes" / "pour_me_some_water.json"),
-                                     "--render", str(tmp_path / "out.txt")], env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    bad_suffix = runner.invoke(
+        app,
+        [
+            "execute",
+            "pour me some water",
+            "--scene",
+            str(sample_dir / "scenes" / "pour_me_some_water.json"),
+            "--render",
+            str(tmp_path / "out.txt"),
+        ],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert ".png or .gif" in one_line_error(bad_suffix)
 
 
 # 3. the checkpoint check cannot be bypassed
 
+
 @pytest.fixture
 def published(tmp_path):
     model, vocab = tiny_model()
     root = tmp_path / "checkpoints"
-    sentence = ckpt.publish(root, "sentence-all", model, vocab, "sentence", {}, {})
-    frame = ckpt.publish(root, "frame-all", model, vocab, "frame", {}, {})
+    sentence = ckpt.publish(root, Setting("sentence"), model, vocab, {}, {})
+    frame = ckpt.publish(root, Setting("frame"), model, vocab, {}, {})
     return root, sentence, frame
 
 
@@ -150,6 +174,7 @@ def test_a_frame_model_copied_into_the_sentence_setting_is_refused(published):
 
 # 4. record, then promote; killed publishes are cleaned up
 
+
 def test_a_failed_run_record_leaves_latest_where_it_was(tmp_path, monkeypatch):
     from lmcr.lm import run as lm_run
     from lmcr.lm.corpus import TrainingText
@@ -157,9 +182,12 @@ def test_a_failed_run_record_leaves_latest_where_it_was(tmp_path, monkeypatch):
     from lmcr.store import StoreBusyError, connect
 
     paths_db = tmp_path / "lmcr.duckdb"
-    text = TrainingText(["pour water into the cup".split()] * 4, ["pour water into the cup".split()],
-                        {"linearization": "sentence", "corpus": "all", "corpus_sha256": "x"})
-    monkeypatch.setattr(lm_run, "training_text", lambda con, lin, corpus, **kwargs: text)
+    text = TrainingText(
+        ["pour water into the cup".split()] * 4,
+        ["pour water into the cup".split()],
+        {"linearization": "sentence", "corpus": "all", "corpus_sha256": "x"},
+    )
+    monkeypatch.setattr(lm_run, "training_text", lambda con, setting, **kwargs: text)
     opened = []
 
     def open_store():
@@ -169,8 +197,14 @@ def test_a_failed_run_record_leaves_latest_where_it_was(tmp_path, monkeypatch):
         return connect(paths_db, REPO_ROOT / "sql")
 
     with pytest.raises(StoreBusyError):
-        lm_run.train_setting(open_store, tmp_path / "ck", "sentence", "all", LMConfig(0, 8, 1, 0.0),
-                             TrainConfig(max_epochs=1, max_minutes=None), min_freq=1)
+        lm_run.train_setting(
+            open_store,
+            tmp_path / "ck",
+            Setting("sentence"),
+            LMConfig(0, 8, 1, 0.0),
+            TrainConfig(max_epochs=1, max_minutes=None),
+            min_freq=1,
+        )
     assert not (tmp_path / "ck" / "sentence-all" / "LATEST").exists()
 
 
@@ -183,7 +217,7 @@ def test_publish_removes_versions_left_half_written_by_a_killed_process(tmp_path
     alive = setting / f".v20260101-000000-3.{os.getpid()}.tmp"  # a publish still under way
     for folder in (dead, legacy, alive):
         folder.mkdir()
-    ckpt.publish(tmp_path, "sentence-all", model, vocab, "sentence", {}, {})
+    ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})
     assert not dead.exists() and not legacy.exists() and alive.exists()
 
 
@@ -196,14 +230,15 @@ from lmcr.lm import run as lm_run
 from lmcr.lm.corpus import TrainingText
 from lmcr.lm.model import LMConfig
 from lmcr.lm.train import TrainConfig
+from lmcr.setting import Setting
 from lmcr.store import connect
 root, db = Path(sys.argv[1]), Path(sys.argv[2])
 text = TrainingText([["pour", "water"]] * 4, [["pour", "water"]], {"linearization": "sentence", "corpus": "all",
                     "corpus_sha256": "x"})
-lm_run.training_text = lambda con, lin, corpus, **kwargs: text
+lm_run.training_text = lambda con, setting, **kwargs: text
 print("ready", flush=True)
 for _ in range(int(sys.argv[4])):
-    train_setting(lambda: connect(db, Path(sys.argv[3])), root, "sentence", "all", LMConfig(0, 8, 1, 0.0),
+    train_setting(lambda: connect(db, Path(sys.argv[3])), root, Setting("sentence"), LMConfig(0, 8, 1, 0.0),
                   TrainConfig(max_epochs=1, max_minutes=None), min_freq=1)
 """
 
@@ -218,8 +253,11 @@ def test_killed_publish_and_promote_always_leave_a_loadable_recorded_latest(tmp_
     env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
 
     def start(loops: int) -> subprocess.Popen:
-        proc = subprocess.Popen([sys.executable, "-c", KILL_SCRIPT, str(root), str(db), str(REPO_ROOT / "sql"),
-                                 str(loops)], stdout=subprocess.PIPE, env=env)
+        proc = subprocess.Popen(
+            [sys.executable, "-c", KILL_SCRIPT, str(root), str(db), str(REPO_ROOT / "sql"), str(loops)],
+            stdout=subprocess.PIPE,
+            env=env,
+        )
         assert proc.stdout.readline().strip() == b"ready"
         return proc
 
@@ -250,13 +288,18 @@ def test_killed_publish_and_promote_always_leave_a_loadable_recorded_latest(tmp_
 
 # 5. ratings are exactly the ASCII digits 1-5
 
+
 def test_non_ascii_digits_are_quarantined_not_ratings(con, tmp_path):
     from lmcr.annotate.results import ingest_ratings
 
-    header = "HITId,AssignmentId,WorkerId,AssignmentStatus,WorkTimeInSeconds,Input.verb,Input.role1,Input.arg1," \
-             "Input.role2,Input.arg2,Answer.rating"
-    rows = [f"H1,A{k},W{k},Submitted,²,pour,Theme,water,Destination,cup,{answer}"
-            for k, answer in enumerate(["٣", "²", "4", "３"])]
+    header = (
+        "HITId,AssignmentId,WorkerId,AssignmentStatus,WorkTimeInSeconds,Input.verb,Input.role1,Input.arg1,"
+        "Input.role2,Input.arg2,Answer.rating"
+    )
+    rows = [
+        f"H1,A{k},W{k},Submitted,²,pour,Theme,water,Destination,cup,{answer}"
+        for k, answer in enumerate(["٣", "²", "4", "３"])
+    ]
     path = tmp_path / "r.csv"
     path.write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
     counts = ingest_ratings(con, path)
@@ -267,15 +310,28 @@ def test_non_ascii_digits_are_quarantined_not_ratings(con, tmp_path):
 
 # 6. one line, never a traceback
 
+
 def test_a_busy_store_is_one_line(tmp_path, sample_dir):
     db = tmp_path / "data" / "lmcr.duckdb"
     db.parent.mkdir()
-    holder = subprocess.Popen([sys.executable, "-c", "import duckdb, sys, time; c = duckdb.connect(sys.argv[1]); "
-                               "print('held', flush=True); time.sleep(60)", str(db)], stdout=subprocess.PIPE)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import duckdb, sys, time; c = duckdb.connect(sys.argv[1]); print('held', flush=True); time.sleep(60)",
+            str(db),
+        ],
+        stdout=subprocess.PIPE,
+    )
     try:
         assert holder.stdout.readline().strip() == b"held"
-        result = runner.invoke(app, ["ingest", "--recipes", str(sample_dir / "nyc")], env={"LMCR_DATA_DIR": str(db.parent)})
-        assert one_line_error(result) == f"error: store busy: another lmcr process is writing {db}; try again when it finishes"
+        result = runner.invoke(
+            app, ["ingest", "--recipes", str(sample_dir / "nyc")], env={"LMCR_DATA_DIR": str(db.parent)}
+        )
+        assert (
+            one_line_error(result)
+            == f"error: store busy: another lmcr process is writing {db}; try again when it finishes"
+        )
     finally:
         holder.kill()
         holder.wait()
@@ -316,6 +372,7 @@ def test_a_non_object_youcook2_database_is_one_line(tmp_path):
 
 # 7. no silent wrong results
 
+
 def test_an_ingested_file_is_not_moved_to_another_corpus(con, paths, sample_dir, tmp_path):
     path = tmp_path / "recipes.jsonl"
     shutil.copy(sample_dir / "recipes_json" / "recipes_sample.jsonl", path)
@@ -337,8 +394,9 @@ def test_a_copy_of_a_loaded_file_is_skipped_and_a_new_encoding_reloads(con, path
     assert con.execute("select count(*) from sentences").fetchone()[0] == sentences
     loaded, _ = ingest_sources(con, expand_inputs([original], "recipes", encoding="latin-1"), paths.staging)
     assert len(loaded) == 1
-    assert con.execute("select encoding from ingested_files where source_file = ?",
-                       [str(original.resolve())]).fetchone() == ("latin-1",)
+    assert con.execute(
+        "select encoding from ingested_files where source_file = ?", [str(original.resolve())]
+    ).fetchone() == ("latin-1",)
 
 
 @pytest.mark.model
@@ -348,16 +406,19 @@ def test_unknown_objects_are_never_chosen_silently():
     from lmcr.srl.parser import load_parser
 
     parser = load_parser()
-    prefer_unknown = lambda frames, context="": [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]  # noqa: E731
+
+    def prefer_unknown(frames, context=""):
+        return [10.0 if f.role_map["Destination"] == "flux capacitor" else 0.0 for f in frames]
+
     confident = CompletionConfig(set_threshold=0.5)
     out = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor", "cup"], confident)
-    assert out["frame"]["roles"]["Destination"] == "flux capacitor" and out["unfamiliar_objects"] == ["flux capacitor"]
-    assert out["candidates"][0]["probability"] > 0.99
-    assert out["question"] == "Should I pour water into the flux capacitor?"  # confident: confirmed alone
+    assert out.frame.role_map["Destination"] == "flux capacitor" and out.unfamiliar_objects == ("flux capacitor",)
+    assert out.candidates[0].probability > 0.99 and out.prediction_set == ("flux capacitor",)
+    assert out.question == "Should I pour water into the flux capacitor?"  # confident: confirmed alone
     alone = complete(parser, prefer_unknown, "pour me some water", ["flux capacitor"], confident)
-    assert alone["question"] == "Should I pour water into the flux capacitor?"
+    assert alone.question == "Should I pour water into the flux capacitor?"
     known = complete(parser, prefer_unknown, "pour me some water", ["bowl", "cup"], confident)
-    assert known["unfamiliar_objects"] == [] and known["question"] == "Should I pour water into the bowl or the cup?"
+    assert known.unfamiliar_objects == () and known.question == "Should I pour water into the bowl or the cup?"
 
 
 @pytest.mark.model
@@ -375,8 +436,8 @@ def test_labels_that_name_nothing_are_ignored():
     seen = []
     prefer_junk = lambda frames, context="": [seen.extend(f.role_map.values()) or 0.0 for f in frames]  # noqa: E731
     out = complete(load_parser(), prefer_junk, "pour it", [*junk, "water", "Cutting  Board"])
-    assert sorted(out["ignored_objects"]) == sorted(j.strip() for j in junk if j.strip())
-    assert set(out["frame"]["roles"].values()) == {"water", "cutting board"} and set(seen) == {"water", "cutting board"}
+    assert sorted(out.ignored_objects) == sorted(j.strip() for j in junk if j.strip())
+    assert set(out.frame.role_map.values()) == {"water", "cutting board"} and set(seen) == {"water", "cutting board"}
     with pytest.raises(CompletionError, match="no usable objects besides .*no object name"):
         complete(load_parser(), prefer_junk, "pour me some water", junk)
 
@@ -385,12 +446,19 @@ def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monke
     import lmcr.complete as completion
 
     path = tmp_path / "in.jsonl"
-    path.write_text(json.dumps({"id": "long", "instruction": "pour " + "🥛" * 3000, "objects": ["cup"]}) + "\n",
-                    encoding="utf-8")
-    monkeypatch.setattr(completion, "completion_scorer",
-                        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()))
-    result = runner.invoke(app, ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    path.write_text(
+        json.dumps({"id": "long", "instruction": "pour " + "🥛" * 3000, "objects": ["cup"]}) + "\n", encoding="utf-8"
+    )
+    monkeypatch.setattr(
+        completion,
+        "completion_scorer",
+        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()),
+    )
+    result = runner.invoke(
+        app,
+        ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert result.exit_code == 0, result.output
     line = json.loads((tmp_path / "o.jsonl").read_text())
     assert line["id"] == "long" and "the limit is 1,000" in line["error"]
@@ -400,16 +468,24 @@ def test_a_line_that_cannot_be_completed_gets_its_error_and_the_batch_goes_on(tm
     """A well-formed line in the middle that cannot be parsed (no predicate) or completed (no objects)."""
     import lmcr.complete as completion
 
-    lines = [{"id": "a", "instruction": "pour me some water", "objects": ["cup", "bowl"]},
-             {"id": "b", "instruction": "wash the dishes", "objects": ["cup"]},
-             {"id": "c", "instruction": "fry the chicken", "objects": []},
-             {"id": "d", "instruction": "heat the leftover pizza", "objects": ["pizza", "microwave"]}]
+    lines = [
+        {"id": "a", "instruction": "pour me some water", "objects": ["cup", "bowl"]},
+        {"id": "b", "instruction": "wash the dishes", "objects": ["cup"]},
+        {"id": "c", "instruction": "fry the chicken", "objects": []},
+        {"id": "d", "instruction": "heat the leftover pizza", "objects": ["pizza", "microwave"]},
+    ]
     path = tmp_path / "in.jsonl"
     path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
-    monkeypatch.setattr(completion, "completion_scorer",
-                        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()))
-    result = runner.invoke(app, ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    monkeypatch.setattr(
+        completion,
+        "completion_scorer",
+        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()),
+    )
+    result = runner.invoke(
+        app,
+        ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert result.exit_code == 0, result.output
     out = [json.loads(line) for line in (tmp_path / "o.jsonl").read_text().splitlines()]
     assert [o["id"] for o in out] == ["a", "b", "c", "d"]
@@ -423,8 +499,11 @@ def test_ratings_that_are_neither_csv_nor_a_store_are_one_line_and_untouched(tmp
     """A read that fails on a non-store file must not fall back to opening it read-write."""
     path = tmp_path / "ratings.txt"
     path.write_text("hello\n")
-    result = runner.invoke(app, ["evaluate", "--ratings", str(path), "--out", str(tmp_path / "rep")],
-                           env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+    result = runner.invoke(
+        app,
+        ["evaluate", "--ratings", str(path), "--out", str(tmp_path / "rep")],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+    )
     assert str(path) in one_line_error(result)
     assert path.read_text() == "hello\n" and not (tmp_path / "rep").exists()
 
@@ -444,9 +523,24 @@ def test_every_lmcr_error_is_one_lmcr_error():
     import lmcr.versions
     from lmcr.errors import LMCRError
 
-    modules = [lmcr.scorers.baselines.vectors, lmcr.complete, lmcr.evaluate.paper, lmcr.robot.execute, lmcr.files,
-               lmcr.ingest.records, lmcr.jsonl, lmcr.lm.checkpoint, lmcr.srl.parser, lmcr.store, lmcr.versions]
-    errors = {obj for m in modules for obj in vars(m).values()
-              if isinstance(obj, type) and issubclass(obj, Exception) and obj.__module__ == m.__name__}
+    modules = [
+        lmcr.scorers.baselines.vectors,
+        lmcr.complete,
+        lmcr.evaluate.paper,
+        lmcr.robot.execute,
+        lmcr.files,
+        lmcr.ingest.records,
+        lmcr.jsonl,
+        lmcr.lm.checkpoint,
+        lmcr.srl.parser,
+        lmcr.store,
+        lmcr.versions,
+    ]
+    errors = {
+        obj
+        for m in modules
+        for obj in vars(m).values()
+        if isinstance(obj, type) and issubclass(obj, Exception) and obj.__module__ == m.__name__
+    }
     assert len(errors) >= 12
     assert all(issubclass(e, LMCRError) and issubclass(e, (ValueError, RuntimeError)) for e in errors), errors

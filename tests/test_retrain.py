@@ -17,9 +17,15 @@ def run(tmp_path, ratings):
     from flows.retrain import retrain_flow
     from lmcr.retrain import RetrainConfig
 
-    return retrain_flow(youcook2=[str(SAMPLE / "youcook2")], recipes=[str(SAMPLE / "nyc")], ratings=ratings,
-                        config=RetrainConfig(setting="sentence-all", per_verb=5), embedding=16, max_epochs=2,
-                        data_dir=str(tmp_path))
+    return retrain_flow(
+        youcook2=[str(SAMPLE / "youcook2")],
+        recipes=[str(SAMPLE / "nyc")],
+        ratings=ratings,
+        config=RetrainConfig(setting="sentence-all", per_verb=5),
+        embedding=16,
+        max_epochs=2,
+        data_dir=str(tmp_path),
+    )
 
 
 def assert_completion_is_calibrated(data_dir):
@@ -48,8 +54,9 @@ def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
     with open(more, "a") as handle:
         handle.write("\n")  # same content, new file hash: counts as changed input
     current = str(tmp_path / "checkpoints" / "sentence-all" / latest.strip())
-    monkeypatch.setattr(lmcr.retrain, "checkpoint_accuracy",
-                        lambda version, rated, config: 0.9 if str(version) == current else 0.5)
+    monkeypatch.setattr(
+        lmcr.retrain, "checkpoint_accuracy", lambda version, rated, config: 0.9 if str(version) == current else 0.5
+    )
     kept = run(tmp_path, [str(more)])
     assert kept["decision"] == "kept" and kept["reason"] == "candidate worse: 0.500 < 0.900"
     assert (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text() == latest
@@ -64,10 +71,14 @@ def test_retrain_promotes_skips_and_keeps(prefect_api, tmp_path, monkeypatch):
     assert (tmp_path / "checkpoints" / "sentence-all" / "LATEST").read_text() != latest
     assert_completion_is_calibrated(tmp_path)  # for the newly promoted checkpoint, not the old one
     con = duckdb.connect(str(tmp_path / "lmcr.duckdb"), read_only=True)
-    decisions = con.execute("select decision, candidate_accuracy, current_accuracy from retrain_decisions "
-                            "order by decided_at").fetchall()
+    decisions = con.execute(
+        "select decision, candidate_accuracy, current_accuracy from retrain_decisions order by decided_at"
+    ).fetchall()
     assert [d[0] for d in decisions] == ["promoted", "unchanged", "kept", "promoted"]
     assert decisions[2][1:] == (0.5, 0.9)
-    calibration = json.loads(con.execute("select calibration from retrain_decisions where decision = 'promoted' "
-                                         "order by decided_at desc limit 1").fetchone()[0])
+    calibration = json.loads(
+        con.execute(
+            "select calibration from retrain_decisions where decision = 'promoted' order by decided_at desc limit 1"
+        ).fetchone()[0]
+    )
     assert calibration["sentence_lm"]["temperature"] > 0

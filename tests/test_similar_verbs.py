@@ -25,25 +25,40 @@ LEX = load_lexicon()
 # into bowls and pots as dump does; 'wash' takes pans 'with' water (not a dump preposition) and 'in' the
 # sink; 'cut' acts 'on' boards.
 GENERIC = [
-    ("transfer", "rice", "into", "bowl", 30), ("transfer", "pasta", "into", "pot", 20), ("transfer", "salad", "into", "bowl", 10),
-    ("tip", "rice", "into", "bowl", 12), ("tip", "pasta", "into", "pot", 9), ("tip", "water", "into", "sink", 4),
-    ("wash", "pan", "with", "water", 40), ("wash", "pan", "in", "sink", 25), ("wash", "skillet", "in", "sink", 10),
-    ("cut", "bread", "on", "cutting board", 30), ("cut", "onion", "on", "cutting board", 20),
+    ("transfer", "rice", "into", "bowl", 30),
+    ("transfer", "pasta", "into", "pot", 20),
+    ("transfer", "salad", "into", "bowl", 10),
+    ("tip", "rice", "into", "bowl", 12),
+    ("tip", "pasta", "into", "pot", 9),
+    ("tip", "water", "into", "sink", 4),
+    ("wash", "pan", "with", "water", 40),
+    ("wash", "pan", "in", "sink", 25),
+    ("wash", "skillet", "in", "sink", 10),
+    ("cut", "bread", "on", "cutting board", 30),
+    ("cut", "onion", "on", "cutting board", 20),
     ("stir", "sugar", "into", "batter", 3),  # fewer than MIN_PAIRS pairs: never a neighbour
 ]
 # (predicate, given role, given value, role, value, n): `frame_filler_pairs`, both orders of each frame
 ROBOT = [
-    ("dump", "Theme", "rice", "Destination", "bowl", 1), ("dump", "Destination", "bowl", "Theme", "rice", 1),
-    ("dump", "Theme", "water", "Destination", "sink", 1), ("dump", "Destination", "sink", "Theme", "water", 1),
-    ("pour", "Theme", "water", "Destination", "glass", 50), ("pour", "Destination", "glass", "Theme", "water", 50),
-    ("pour", "Theme", "milk", "Destination", "mug", 20), ("pour", "Destination", "mug", "Theme", "milk", 20),
-    ("fill", "Destination", "glass", "Theme", "water", 3), ("fill", "Theme", "water", "Destination", "glass", 3),
-    ("fill", "Destination", "mug", "Theme", "milk", 3), ("fill", "Theme", "milk", "Destination", "mug", 3),
+    ("dump", "Theme", "rice", "Destination", "bowl", 1),
+    ("dump", "Destination", "bowl", "Theme", "rice", 1),
+    ("dump", "Theme", "water", "Destination", "sink", 1),
+    ("dump", "Destination", "sink", "Theme", "water", 1),
+    ("pour", "Theme", "water", "Destination", "glass", 50),
+    ("pour", "Destination", "glass", "Theme", "water", 50),
+    ("pour", "Theme", "milk", "Destination", "mug", 20),
+    ("pour", "Destination", "mug", "Theme", "milk", 20),
+    ("fill", "Destination", "glass", "Theme", "water", 3),
+    ("fill", "Theme", "water", "Destination", "glass", 3),
+    ("fill", "Destination", "mug", "Theme", "milk", 3),
+    ("fill", "Theme", "milk", "Destination", "mug", 3),
 ]
 
 
 def test_relations_come_from_the_lexicon():
-    assert Relation.of(LEX.predicates["dump"]) == Relation("Theme", "Destination", frozenset(LEX.predicates["dump"].preps["Destination"]))
+    assert Relation.of(LEX.predicates["dump"]) == Relation(
+        "Theme", "Destination", frozenset(LEX.predicates["dump"].preps["Destination"])
+    )
     # fill's object is the container, its Theme comes with 'with'; season's Instrument too
     assert Relation.of(LEX.predicates["fill"]) == Relation("Destination", "Theme", frozenset({"with"}))
     assert Relation.of(LEX.predicates["season"]) == Relation("Theme", "Instrument", frozenset({"with"}))
@@ -67,7 +82,9 @@ def test_neighbours_are_the_verbs_with_alike_fillers():
 
 def test_pooled_counts_rank_what_similar_verbs_do():
     model = SimilarVerbs.from_counts(LEX, GENERIC, ROBOT)
-    rice, pan, scissors = model.score_frames([Frame.of("dump", {"Theme": t, "Destination": "bowl"}) for t in ("rice", "pan", "scissors")])
+    rice, pan, scissors = model.score_frames(
+        [Frame.of("dump", {"Theme": t, "Destination": "bowl"}) for t in ("rice", "pan", "scissors")]
+    )
     assert rice > pan and rice > scissors
     pot, bowl = model.score_frames([Frame.of("dump", {"Theme": "pasta", "Destination": d}) for d in ("pot", "bowl")])
     assert pot > bowl  # dump saw no pasta at all: its neighbours did
@@ -86,8 +103,13 @@ def test_pair_table_smoothing_by_hand():
 
 
 def test_neighbour_weights_are_similarities_over_the_best():
-    pairs = {"dump": {("rice", "bowl"): 2}, "a": {("rice", "bowl"): 30, ("salt", "cup"): 30},
-             "b": {("rice", "bowl"): 25}, "c": {("salt", "cup"): 25}, "d": {("egg", "plate"): 200}}
+    pairs = {
+        "dump": {("rice", "bowl"): 2},
+        "a": {("rice", "bowl"): 30, ("salt", "cup"): 30},
+        "b": {("rice", "bowl"): 25},
+        "c": {("salt", "cup"): 25},
+        "d": {("egg", "plate"): 200},
+    }
     pairs = {v: Counter(c) for v, c in pairs.items()}
     near = neighbours(pairs, "dump", k=5, min_pairs=20)
     # b does what dump does and nothing else; a half of the time; c and d never: no neighbours
@@ -111,9 +133,14 @@ def store(tmp_path):
             roles += [(corpus, f"d{n}", 0, 0, "Theme", theme), (corpus, f"d{n}", 0, 0, prep, value)]
     frames.append(("recipes", "r1", 0, 0, "dump", True))
     roles += [("recipes", "r1", 0, 0, "Theme", "rice"), ("recipes", "r1", 0, 0, "Destination", "bowl")]
-    con.executemany("insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
-                    "values (?, ?, ?, ?, ?, ?, 0, 1)", frames)
-    con.executemany("insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles)
+    con.executemany(
+        "insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
+        "values (?, ?, ?, ?, ?, ?, 0, 1)",
+        frames,
+    )
+    con.executemany(
+        "insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles
+    )
     con.close()
     return db, sql_dir
 
@@ -122,9 +149,14 @@ def test_counts_come_from_the_stores_frames_weighted_by_the_mixture(store):
     db, sql_dir = store
     model = SimilarVerbs.count(db, sql_dir, LEX)
     assert set(model.near["dump"]) == {"transfer", "tip"}  # wash shares nothing with dump's one frame
-    assert model.tables["dump"].pairs[("rice", "bowl")] == pytest.approx(sum(w * n for (v, a, p, o, n) in GENERIC
-                                                                             for u, w in model.near["dump"].items()
-                                                                             if v == u and (a, o) == ("rice", "bowl")))
+    assert model.tables["dump"].pairs[("rice", "bowl")] == pytest.approx(
+        sum(
+            w * n
+            for (v, a, p, o, n) in GENERIC
+            for u, w in model.near["dump"].items()
+            if v == u and (a, o) == ("rice", "bowl")
+        )
+    )
     # tip's frames are the household's: a mixture that weighs them 3 times pools them 3 times (water into
     # the sink is tip's alone)
     mixed = SimilarVerbs.count(db, sql_dir, LEX, "all", Mixture.of({"household": 3}))

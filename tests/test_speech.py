@@ -37,11 +37,17 @@ def _wav_bytes(channels: int = 1, width: int = 2, rate: int = 16000, frames: int
     return buf.getvalue()
 
 
-@pytest.mark.parametrize("data, reason", [
-    (_wav_bytes(channels=2), "2 channels; expected mono"), (_wav_bytes(width=1), "8-bit samples"),
-    (_wav_bytes(frames=10), "empty or truncated"), (_wav_bytes(rate=8000, frames=8000 * 61), "61 s long"),
-    (b"", "not a PCM WAV"), (b"ID3\x03\x00 an mp3", "not a PCM WAV"),
-])
+@pytest.mark.parametrize(
+    "data, reason",
+    [
+        (_wav_bytes(channels=2), "2 channels; expected mono"),
+        (_wav_bytes(width=1), "8-bit samples"),
+        (_wav_bytes(frames=10), "empty or truncated"),
+        (_wav_bytes(rate=8000, frames=8000 * 61), "61 s long"),
+        (b"", "not a PCM WAV"),
+        (b"ID3\x03\x00 an mp3", "not a PCM WAV"),
+    ],
+)
 def test_bad_audio_is_one_clear_error(tmp_path, data, reason):
     path = tmp_path / "bad.wav"
     path.write_bytes(data)
@@ -51,8 +57,10 @@ def test_bad_audio_is_one_clear_error(tmp_path, data, reason):
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=st.binary(max_size=400) | st.builds(lambda head, tail: _wav_bytes()[:head] + tail,
-                                                st.integers(0, 60), st.binary(max_size=80)))
+@given(
+    data=st.binary(max_size=400)
+    | st.builds(lambda head, tail: _wav_bytes()[:head] + tail, st.integers(0, 60), st.binary(max_size=80))
+)
 def test_any_bytes_read_or_fail_as_audio_error(tmp_path, data):
     path = tmp_path / "fuzz.wav"
     path.write_bytes(data)
@@ -74,15 +82,22 @@ def test_other_rates_are_resampled_to_16k(tmp_path):
 
 
 def test_domain_lm_is_a_proper_distribution():
-    sentences = [tokenize(s) for s in ("pour the water into the cup", "pour the milk into the glass",
-                                       "fill the cup with water", "pour me some water")]
+    sentences = [
+        tokenize(s)
+        for s in (
+            "pour the water into the cup",
+            "pour the milk into the glass",
+            "fill the cup with water",
+            "pour me some water",
+        )
+    ]
     vocab = {w for s in sentences for w in s}
     entries = estimate(count_ngrams([(s, 1.0) for s in sentences], vocab), discount=0.7, min_trigram=1.0)
-    unigram = {g[0]: 10 ** p for g, (p, _) in entries[0].items()}
+    unigram = {g[0]: 10**p for g, (p, _) in entries[0].items()}
     assert math.isclose(sum(p for w, p in unigram.items() if w != "<s>"), 1.0, rel_tol=1e-3)
     bigram = defaultdict(dict)
     for (h, w), (p, _) in entries[1].items():
-        bigram[h][w] = 10 ** p
+        bigram[h][w] = 10**p
     for h, seen in bigram.items():
         bow = 10 ** entries[0][(h,)][1]
         total = sum(seen.values()) + bow * sum(p for w, p in unigram.items() if w not in seen and w != "<s>")
@@ -108,23 +123,39 @@ def speech_workspace(tmp_path_factory):
     from lmcr.lexicon import load_lexicon
     from lmcr.lm.hyperparams import LMConfig, TrainConfig
     from lmcr.lm.run import train_setting
+    from lmcr.setting import Setting
     from lmcr.speech.domain_lm import SpeechLMConfig, build_speech_lm
     from lmcr.speech.recognize import cmudict_path
     from lmcr.workspace import Workspace
 
     ws = Workspace.from_env(data_dir=tmp_path_factory.mktemp("speech"))
     with ws.connect() as con:
-        ingest_sources(con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), ws.staging,
-                       workers=1)
-        train_setting(lambda: nullcontext(con), ws.checkpoints, "sentence", "youcook2", LMConfig(0, 16, 1),
-                      TrainConfig(max_epochs=1))
+        ingest_sources(
+            con, expand_inputs([REPO_ROOT / "data" / "sample" / "youcook2"], "youcook2"), ws.staging, workers=1
+        )
+        train_setting(
+            lambda: nullcontext(con),
+            ws.checkpoints,
+            Setting("sentence", "youcook2"),
+            LMConfig(0, 16, 1),
+            TrainConfig(max_epochs=1),
+        )
         build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech, SpeechLMConfig(), log=lambda m: None)
     return ws
 
 
 def _lmcr(ws, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([str(Path(shutil.which("lmcr") or REPO_ROOT / ".venv" / "bin" / "lmcr")),
-                           "--data-dir", str(ws.data_dir), *args], capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [
+            str(Path(shutil.which("lmcr") or REPO_ROOT / ".venv" / "bin" / "lmcr")),
+            "--data-dir",
+            str(ws.data_dir),
+            *args,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 @pytest.mark.parametrize("asr", ["whisper", "sphinx"])
@@ -132,11 +163,24 @@ def test_listen_batch_hears_the_frames_and_reports_bad_lines(speech_workspace, t
     shutil.copy(FIXTURES / "pour_me_some_water.wav", tmp_path / "pour.wav")
     (tmp_path / "stereo.wav").write_bytes(_wav_bytes(channels=2))
     write_wav(tmp_path / "quiet.wav", np.zeros(16000, dtype=np.int16))
-    lines = [{"id": "a", "audio": "pour.wav"}, {"id": "b", "audio": str(FIXTURES / "fry_the_egg.wav")},
-             {"id": "c", "audio": "stereo.wav"}, {"id": "d", "audio": "missing.wav"}, {"id": "e", "audio": "quiet.wav"}]
+    lines = [
+        {"id": "a", "audio": "pour.wav"},
+        {"id": "b", "audio": str(FIXTURES / "fry_the_egg.wav")},
+        {"id": "c", "audio": "stereo.wav"},
+        {"id": "d", "audio": "missing.wav"},
+        {"id": "e", "audio": "quiet.wav"},
+    ]
     (tmp_path / "in.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
-    done = _lmcr(speech_workspace, "listen", "--input", str(tmp_path / "in.jsonl"), "--output", str(tmp_path / "o.jsonl"),
-                 "--asr", asr)
+    done = _lmcr(
+        speech_workspace,
+        "listen",
+        "--input",
+        str(tmp_path / "in.jsonl"),
+        "--output",
+        str(tmp_path / "o.jsonl"),
+        "--asr",
+        asr,
+    )
     assert done.returncode == 0, done.stderr + done.stdout
     out = {r["id"]: r for r in map(json.loads, (tmp_path / "o.jsonl").read_text().splitlines())}
     assert out["a"]["frames"][0] == {"predicate": "pour", "roles": {"Theme": "water", "Destination": None}}
@@ -150,8 +194,19 @@ def test_listen_batch_hears_the_frames_and_reports_bad_lines(speech_workspace, t
 def test_execute_audio_hears_completes_and_executes(speech_workspace, tmp_path):
     scene = {"objects": [{"label": "water", "xy": [0.0, -0.1]}, {"label": "cup", "xy": [0.1, 0.2]}]}
     (tmp_path / "scene.json").write_text(json.dumps(scene))
-    done = _lmcr(speech_workspace, "execute", "--audio", str(FIXTURES / "pour_me_some_water.wav"), "--scene",
-                 str(tmp_path / "scene.json"), "--method", "sentence_lm", "--corpus", "youcook2", "--json")
+    done = _lmcr(
+        speech_workspace,
+        "execute",
+        "--audio",
+        str(FIXTURES / "pour_me_some_water.wav"),
+        "--scene",
+        str(tmp_path / "scene.json"),
+        "--method",
+        "sentence_lm",
+        "--corpus",
+        "youcook2",
+        "--json",
+    )
     assert done.returncode == 0, done.stderr + done.stdout
     result = json.loads(done.stdout.strip().splitlines()[-1])
     assert {"pour", "water"} <= set(result["text"].split()) and result["chosen_object"] == "cup"
@@ -173,8 +228,19 @@ def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
     (tmp_path / "scene.json").write_text(json.dumps(scene))
     (tmp_path / "turns").mkdir()
     shutil.copy(FIXTURES / "pour_me_some_water.wav", tmp_path / "turns" / "01.wav")
-    done = _lmcr(speech_workspace, "robot", "--scene", str(tmp_path / "scene.json"), "--audio-dir",
-                 str(tmp_path / "turns"), "--method", "sentence_lm", "--corpus", "youcook2", "--json")
+    done = _lmcr(
+        speech_workspace,
+        "robot",
+        "--scene",
+        str(tmp_path / "scene.json"),
+        "--audio-dir",
+        str(tmp_path / "turns"),
+        "--method",
+        "sentence_lm",
+        "--corpus",
+        "youcook2",
+        "--json",
+    )
     assert done.returncode == 0, done.stderr + done.stdout
     outcome = json.loads(done.stdout.strip().splitlines()[-1])
     assert outcome["frame"]["roles"] == {"Theme": "water", "Destination": "cup"} and outcome["success"]

@@ -13,11 +13,18 @@ def frame(pred: str, a: str | None, b: str | None, roles=("Theme", "Destination"
 
 
 def test_every_error_has_its_class():
-    gold = [[frame("pour", "water", "cup")], [frame("pour", "peanut butter", "cookie")],
-            [frame("dip", "bread", None), frame("pour", "oil", "bowl")], [frame("pour", "milk", "glass")]]
-    pred = [[frame("pour", "cup", "water")], [frame("pour", "butter", "cooky")],
-            [frame("dip", "bread", "soup"), frame("fry", "egg", None, ("Theme", "Instrument"))],
-            [frame("pour", "leftover milk", None)]]
+    gold = [
+        [frame("pour", "water", "cup")],
+        [frame("pour", "peanut butter", "cookie")],
+        [frame("dip", "bread", None), frame("pour", "oil", "bowl")],
+        [frame("pour", "milk", "glass")],
+    ]
+    pred = [
+        [frame("pour", "cup", "water")],
+        [frame("pour", "butter", "cooky")],
+        [frame("dip", "bread", "soup"), frame("fry", "egg", None, ("Theme", "Instrument"))],
+        [frame("pour", "leftover milk", None)],
+    ]
     errors = classify_errors(gold, pred, {"pour", "dip", "fry"})
     assert errors[0] == [("role", "pour.Theme"), ("role", "pour.Destination")]
     assert errors[1] == [("boundary", "pour.Theme"), ("lemma", "pour.Destination")]
@@ -40,10 +47,16 @@ def test_an_instruction_parse_is_right_with_the_open_role_open_and_a_pronoun_for
 def test_lexical_statistics_are_learned_from_sentences():
     con = duckdb.connect()
     con.execute("create table sentences (text varchar, kind varchar, corpus varchar)")
-    rows = (["heat the sesame oil in a large bowl."] * 30 + ["add sesame seeds to a large pan."] * 20
-            + ["add a large egg."] * 60 + ["cook until hot."] * 30 + ["pour hot oil over a cookie."] * 40
-            + ["serve with a spring roll."] * 10 + ["Serve with French toast and Dijon mustard."] * 20
-            + ["Dijon is best."] * 5)
+    rows = (
+        ["heat the sesame oil in a large bowl."] * 30
+        + ["add sesame seeds to a large pan."] * 20
+        + ["add a large egg."] * 60
+        + ["cook until hot."] * 30
+        + ["pour hot oil over a cookie."] * 40
+        + ["serve with a spring roll."] * 10
+        + ["Serve with French toast and Dijon mustard."] * 20
+        + ["Dijon is best."] * 5
+    )
     con.executemany("insert into sentences values (?, 'instruction', 'recipes')", [[r] for r in rows])
     learned = learn_compounds(con)
     assert "sesame oil" in learned.strong_bigrams  # sesame comes with oil 60% of the time

@@ -70,8 +70,10 @@ def test_misread_imperatives_are_repaired(parser):
 def test_dev_set_targets(parser, shared_dir):
     gold = [r for _, r in read_jsonl(shared_dir / "eval" / "srl_dev.jsonl", {"text": str, "frames": list})]
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in gold)]
-    table = {row["predicate"]: row for row in score_frames([r["frames"] for r in gold], predicted,
-                                                           set(parser.lex.predicates)).table()}
+    table = {
+        row["predicate"]: row
+        for row in score_frames([r["frames"] for r in gold], predicted, set(parser.lex.predicates)).table()
+    }
     # without the corpus-learned compounds ("olive oil") and priors: the targets hold even so
     assert table["all"]["role_f1"] >= 0.95 and table["all"]["pred_r"] >= 0.98
 
@@ -80,10 +82,15 @@ def test_dev_set_targets(parser, shared_dir):
 def test_dev_instructions_without_lone_alternating_objects(parser, shared_dir):
     tasks = [r for _, r in read_jsonl(shared_dir / "eval" / "instructions_dev.jsonl", {"instruction": str})]
     # Lone objects of rub/brush/sprinkle need the role priors learned from the full frame corpus.
-    syntactic = [t for t in tasks if not (parser.lex.predicates[t["expected"]["predicate"]].alternating
-                                          and t["missing"] is not None)]
-    right = [instruction_correct(parse_instruction(parser, t["instruction"]).to_json(), t["expected"], t["missing"])
-             for t in syntactic]
+    syntactic = [
+        t
+        for t in tasks
+        if not (parser.lex.predicates[t["expected"]["predicate"]].alternating and t["missing"] is not None)
+    ]
+    right = [
+        instruction_correct(parse_instruction(parser, t["instruction"]).to_json(), t["expected"], t["missing"])
+        for t in syntactic
+    ]
     assert len(syntactic) >= 45 and sum(right) / len(right) >= 0.95
 
 
@@ -95,8 +102,11 @@ def test_srl_batch_contract(tmp_path, monkeypatch):
     assert result.exit_code == 0, result.output
     rows = [json.loads(line) for line in out.read_text().splitlines()]
     assert rows == [
-        {"id": "a", "text": "pour the milk into the pot",
-         "frames": [{"predicate": "pour", "roles": {"Theme": "milk", "Destination": "pot"}}]},
+        {
+            "id": "a",
+            "text": "pour the milk into the pot",
+            "frames": [{"predicate": "pour", "roles": {"Theme": "milk", "Destination": "pot"}}],
+        },
         {"id": 2, "text": "wash the dishes", "frames": []},
     ]
     src.write_text('{"id": "a", "text": "pour it"}\n{"id": "b"}\n')
@@ -111,15 +121,20 @@ def test_srl_batch_contract(tmp_path, monkeypatch):
 def test_frame_corpus_on_sample(con, paths, sample_dir, tmp_path):
     sources = expand_inputs([sample_dir / "youcook2"], "youcook2") + expand_inputs(
         [sample_dir / "nyc", sample_dir / "recipes_json" / "recipes_sample.jsonl", sample_dir / "feeding_america"],
-        "recipes")
+        "recipes",
+    )
     ingest_sources(con, sources, paths.staging, workers=1)
     config = FrameCorpusConfig(shard_size=40)
     build = build_frame_corpus(con, paths.staging, paths.srl_dir, config, process_pool(2))
-    assert build["sentences"] == con.execute(
-        "select count(*) from sentences where kind in ('instruction', 'comment')").fetchone()[0]
+    assert (
+        build["sentences"]
+        == con.execute("select count(*) from sentences where kind in ('instruction', 'comment')").fetchone()[0]
+    )
     check_contracts(con, paths.sql_dir)
-    pours = con.execute("select r.value from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
-                        "where f.predicate = 'pour' and r.role = 'Destination' and r.value is not null").fetchall()
+    pours = con.execute(
+        "select r.value from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
+        "where f.predicate = 'pour' and r.role = 'Destination' and r.value is not null"
+    ).fetchall()
     assert ("blender",) in pours and ("glass",) in pours
     assert (paths.srl_dir / "compounds.json").exists() and (paths.srl_dir / "role_priors.json").exists()
     assert read_first_words(paths.srl_dir / FIRST_WORDS_FILE)  # the table the shards started from, published
@@ -134,9 +149,14 @@ def test_frame_corpus_on_sample(con, paths, sample_dir, tmp_path):
 
 
 # Each needs the imperative repair: "sprinkle" is learned, even after a text where it was not read as a verb.
-WARM_UP = [f"Sprinkle {what} over the {where}." for what in ("salt", "cheese", "parsley", "sugar")
-           for where in ("fish", "soup", "berries")]
-LONG_SPRINKLE = "Sprinkle sugar over butter in skillet, then place apple slices and pear slices in single layer atop sugar."
+WARM_UP = [
+    f"Sprinkle {what} over the {where}."
+    for what in ("salt", "cheese", "parsley", "sugar")
+    for where in ("fish", "soup", "berries")
+]
+LONG_SPRINKLE = (
+    "Sprinkle sugar over butter in skillet, then place apple slices and pear slices in single layer atop sugar."
+)
 
 
 def _predicates(frames):
@@ -174,9 +194,12 @@ def test_the_builds_first_words_let_a_parser_reread_a_command_taken_for_a_subjec
     assert "heat" in _predicates(informed.parse(text))
     assert not informed.learn_first_words and informed.first_words["heat"] == (5, 5, 5)  # frozen: read, not learned
     assert _predicates(informed.parse("Sugar is added according to taste.")) == _predicates(
-        parser.parse("Sugar is added according to taste."))  # not a command word: a declarative stays one
+        parser.parse("Sugar is added according to taste.")
+    )  # not a command word: a declarative stays one
     (tmp_path / FIRST_WORDS_FILE).write_text('{"heat": [5, 5]}')
-    with pytest.raises(ResourceError, match="first_words.json: cannot read the first-word table .not a first-word table"):
+    with pytest.raises(
+        ResourceError, match="first_words.json: cannot read the first-word table .not a first-word table"
+    ):
         load_parser(resources=tmp_path)
 
 
@@ -224,7 +247,8 @@ def test_lemmas_are_chosen_by_the_corpus_and_stable(parser):
     # several candidates: the least stripped one (the rules return them in set order, which varies by run)
     assert [lemma(t) for t in plain] == ["cookie", "leave", "pancake", "glass"]
     counted = LazyLemmas(parser.nlp, {"leaf": 40, "leave": 1, "pancake": 9}).fill(
-        _tagged(parser, "cookies/NNS/dobj/0 leaves/NNS/dobj/1 pancakes/NN/dobj/2 glass/NN/dobj/3"))
+        _tagged(parser, "cookies/NNS/dobj/0 leaves/NNS/dobj/1 pancakes/NN/dobj/2 glass/NN/dobj/3")
+    )
     assert [lemma(t) for t in counted] == ["cookie", "leaf", "pancake", "glass"]
 
 
@@ -232,14 +256,18 @@ def test_a_words_lemma_does_not_depend_on_the_texts_before_it(parser):
     def lemmas(*texts):
         filler = LazyLemmas(parser.nlp)
         return [[lemma(t) for t in filler.fill(_tagged(parser, text))] for text in texts]
+
     name, plural = "Apples/NNPS/ROOT/0", "blend/VB/ROOT/0 apples/NNPS/dobj/0"  # a name; a misread plural
     assert lemmas(name, plural)[1] == lemmas(plural)[0] == ["blend", "apple"]
     assert lemmas(plural, name)[1] == lemmas(name)[0]
 
 
 def test_participle_modifiers_are_marked(parser):
-    doc = LazyLemmas(parser.nlp).fill(_tagged(
-        parser, "chopped/JJ/amod/3 frying/NN/amod/3 frozen/JJ/amod/3 peas/NNS/ROOT/3 red/JJ/amod/5 wine/NN/dobj/3"))
+    doc = LazyLemmas(parser.nlp).fill(
+        _tagged(
+            parser, "chopped/JJ/amod/3 frying/NN/amod/3 frozen/JJ/amod/3 peas/NNS/ROOT/3 red/JJ/amod/5 wine/NN/dobj/3"
+        )
+    )
     assert [t._.participle for t in doc] == [True, False, True, False, False, False]
 
 
@@ -249,16 +277,27 @@ def test_own_srl_set_without_learned_resources(parser):
     gold = [r for _, r in read_jsonl(REPO_ROOT / "data" / "eval" / "srl_own.jsonl", {"text": str, "frames": list})]
     assert len(gold) >= 150
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in gold)]
-    table = {row["predicate"]: row for row in score_frames([r["frames"] for r in gold], predicted,
-                                                           set(parser.lex.predicates)).table()}
+    table = {
+        row["predicate"]: row
+        for row in score_frames([r["frames"] for r in gold], predicted, set(parser.lex.predicates)).table()
+    }
     assert table["all"]["pred_f1"] == 1.0 and table["all"]["role_f1"] >= 0.91
 
 
 def test_srl_eval_prints_the_error_classes(tmp_path, monkeypatch):
     monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
     gold = tmp_path / "gold.jsonl"
-    gold.write_text(json.dumps({"id": "1", "text": "pour the water into the cups", "frames": [
-        {"predicate": "pour", "roles": {"Theme": "peanut water", "Destination": "cup"}}]}) + "\n", encoding="utf-8")
+    gold.write_text(
+        json.dumps(
+            {
+                "id": "1",
+                "text": "pour the water into the cups",
+                "frames": [{"predicate": "pour", "roles": {"Theme": "peanut water", "Destination": "cup"}}],
+            }
+        )
+        + "\n",
+        encoding="utf-8",
+    )
     result = runner.invoke(app, ["srl-eval", "--gold", str(gold), "--show"])
     assert result.exit_code == 0, result.output
     assert "boundary 1" in result.output and "missed predicate 0" in result.output

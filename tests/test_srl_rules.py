@@ -39,66 +39,89 @@ def test_with_alternation_gives_the_same_frame():
 
 def test_fill_and_season_with_phrases():
     assert frames("fill/VB/ROOT/0 the/DT/det/2 glass/NN/dobj/0 with/IN/prep/0 ice/NN/pobj/3") == [
-        ("fill", {"Destination": "glass", "Theme": "ice"})]
+        ("fill", {"Destination": "glass", "Theme": "ice"})
+    ]
     assert frames("fill/VB/ROOT/0 water/NN/dobj/0 into/IN/prep/0 the/DT/det/4 pot/NN/pobj/2") == [
-        ("fill", {"Destination": "pot", "Theme": "water"})]
+        ("fill", {"Destination": "pot", "Theme": "water"})
+    ]
     assert frames("season/VB/ROOT/0 with/IN/prep/0 salt/NN/pobj/1") == [
-        ("season", {"Theme": None, "Instrument": "salt"})]
+        ("season", {"Theme": None, "Instrument": "salt"})
+    ]
 
 
 def test_particles_are_not_destinations():
     assert frames("pour/VB/ROOT/0 in/IN/prep/0 the/DT/det/3 milk/NN/pobj/1") == [
-        ("pour", {"Theme": "milk", "Destination": None})]
+        ("pour", {"Theme": "milk", "Destination": None})
+    ]
     assert frames("dip/VB/ROOT/0 it/PRP/dobj/0 in/RP/prt/0") == [("dip", {"Theme": "it", "Destination": None})]
     # ...but a role preposition the parser called a particle still introduces its role
     assert frames("sprinkle/VB/ROOT/0 over/RP/prt/0 the/DT/det/3 salad/NN/dobj/0") == [
-        ("sprinkle", {"Theme": None, "Destination": "salad"})]
+        ("sprinkle", {"Theme": None, "Destination": "salad"})
+    ]
     # and an instrument verb's "in" is never a particle
     assert frames("fry/VB/ROOT/0 in/IN/prep/0 a/DT/det/4 hot/JJ/amod/4 skillet/NN/pobj/1") == [
-        ("fry", {"Theme": None, "Instrument": "skillet"})]
+        ("fry", {"Theme": None, "Instrument": "skillet"})
+    ]
 
 
 def test_coordination():
     # "heat and stir the milk": the object-less first verb shares the next verb's object
     assert frames("heat/VB/ROOT/0 and/CC/cc/0 stir/VB/conj/0 the/DT/det/4 milk/NN/dobj/2")[0] == (
-        "heat", {"Theme": "milk", "Instrument": None})
+        "heat",
+        {"Theme": "milk", "Instrument": None},
+    )
     # coordinated objects: the first conjunct fills the role
-    doc = ("pour/VB/ROOT/0 the/DT/det/2 milk/NN/dobj/0 and/CC/cc/2 the/DT/det/5 cream/NN/conj/2 "
-           "into/IN/prep/0 the/DT/det/8 pot/NN/pobj/6")
+    doc = (
+        "pour/VB/ROOT/0 the/DT/det/2 milk/NN/dobj/0 and/CC/cc/2 the/DT/det/5 cream/NN/conj/2 "
+        "into/IN/prep/0 the/DT/det/8 pot/NN/pobj/6"
+    )
     assert frames(doc) == [("pour", {"Theme": "milk", "Destination": "pot"})]
 
 
 def test_argument_values():
-    doc = ("heat/VB/ROOT/0 3/CD/nummod/2 tablespoons/NNS/dobj/0/tablespoon of/IN/prep/2 olive/NN/compound/5 "
-           "oil/NN/pobj/3 in/IN/prep/0 a/DT/det/9 large/JJ/amod/9 skillet/NN/pobj/6")
+    doc = (
+        "heat/VB/ROOT/0 3/CD/nummod/2 tablespoons/NNS/dobj/0/tablespoon of/IN/prep/2 olive/NN/compound/5 "
+        "oil/NN/pobj/3 in/IN/prep/0 a/DT/det/9 large/JJ/amod/9 skillet/NN/pobj/6"
+    )
     assert frames(doc) == [("heat", {"Theme": "olive oil", "Instrument": "skillet"})]
     # measure nouns stand alone without an of-phrase, quantity words do not
     assert frames("fill/VB/ROOT/0 each/DT/det/2 cup/NN/dobj/0") == [("fill", {"Destination": "cup", "Theme": None})]
     assert frames("dip/VB/ROOT/0 a/DT/det/2 few/JJ/dobj/0 in/IN/prep/0 the/DT/det/5 chocolate/NN/pobj/3") == [
-        ("dip", {"Theme": None, "Destination": "chocolate"})]
+        ("dip", {"Theme": None, "Destination": "chocolate"})
+    ]
     # a number gives way to its of-phrase too, and names nothing alone
     assert frames("sprinkle/VB/ROOT/0 3/CD/dobj/0 of/IN/prep/1 the/DT/det/4 pepper/NN/pobj/2 over/RP/prt/0") == [
-        ("sprinkle", {"Theme": "pepper", "Destination": None})]
+        ("sprinkle", {"Theme": "pepper", "Destination": None})
+    ]
     assert frames("heat/VB/ROOT/0 350/CD/dobj/0") == [("heat", {"Theme": None, "Instrument": None})]
     # adjectives and determiners go, plurals become singular, noun-tagged modifiers stay
-    doc = ("pour/VB/ROOT/0 the/DT/det/3 melted/JJ/amod/3 chocolate/NN/dobj/0 into/IN/prep/0 "
-           "the/DT/det/7 frying/NN/amod/7 pans/NNS/pobj/4/pan")
+    doc = (
+        "pour/VB/ROOT/0 the/DT/det/3 melted/JJ/amod/3 chocolate/NN/dobj/0 into/IN/prep/0 "
+        "the/DT/det/7 frying/NN/amod/7 pans/NNS/pobj/4/pan"
+    )
     assert frames(doc) == [("pour", {"Theme": "chocolate", "Destination": "frying pan"})]
     assert frames("fry/VB/ROOT/0 them/PRP/dobj/0 in/IN/prep/0 oil/NN/pobj/2") == [
-        ("fry", {"Theme": "them", "Instrument": "oil"})]
+        ("fry", {"Theme": "them", "Instrument": "oil"})
+    ]
 
 
-@pytest.mark.parametrize(("before", "expected"), [
-    ("2/CD/nummod/2 tablespoons/NNS/compound/3/tablespoon", "oil"),  # counted: a quantity, not a name
-    ("1/CD/nummod/2 tablespoon/NN/compound/3", "oil"),
-    ("tablespoons/NNS/compound/2/tablespoon", "oil"),  # a plural unit before a noun is counted too
-    ("a/DT/det/3 tablespoon/NN/compound/3", "tablespoon oil"),  # uncounted: the parse's compound stands
-])
+@pytest.mark.parametrize(
+    ("before", "expected"),
+    [
+        ("2/CD/nummod/2 tablespoons/NNS/compound/3/tablespoon", "oil"),  # counted: a quantity, not a name
+        ("1/CD/nummod/2 tablespoon/NN/compound/3", "oil"),
+        ("tablespoons/NNS/compound/2/tablespoon", "oil"),  # a plural unit before a noun is counted too
+        ("a/DT/det/3 tablespoon/NN/compound/3", "tablespoon oil"),  # uncounted: the parse's compound stands
+    ],
+)
 def test_a_counted_measure_is_no_part_of_a_name(before, expected):
     n = len(before.split())
     doc = f"heat/VB/ROOT/0 {before} oil/NN/dobj/0 in/IN/prep/0 a/DT/det/{n + 4} pan/NN/pobj/{n + 2}"
     assert frames(doc) == [("heat", {"Theme": expected, "Instrument": "pan"})]
-    loaf = "pour/VB/ROOT/0 into/IN/prep/0 a/DT/det/7 9/CD/nummod/5 -/HYPH/punct/5 inch/NN/compound/7 loaf/NN/compound/7 pan/NN/pobj/1"
+    loaf = (
+        "pour/VB/ROOT/0 into/IN/prep/0 a/DT/det/7 9/CD/nummod/5 -/HYPH/punct/5 inch/NN/compound/7 "
+        "loaf/NN/compound/7 pan/NN/pobj/1"
+    )
     assert frames(loaf) == [("pour", {"Theme": None, "Destination": "loaf pan"})]
 
 
@@ -112,8 +135,10 @@ def test_a_closing_please_is_no_part_of_a_name():
 
 
 def test_passive_subject_is_the_theme():
-    doc = ("the/DT/det/1 steak/NN/nsubjpass/4 should/MD/aux/4 be/VB/auxpass/4 seasoned/VBN/ROOT/4/season "
-           "with/IN/prep/4 salt/NN/pobj/5")
+    doc = (
+        "the/DT/det/1 steak/NN/nsubjpass/4 should/MD/aux/4 be/VB/auxpass/4 seasoned/VBN/ROOT/4/season "
+        "with/IN/prep/4 salt/NN/pobj/5"
+    )
     assert frames(doc) == [("season", {"Theme": "steak", "Instrument": "salt"})]
 
 
@@ -126,23 +151,33 @@ def test_a_participles_object_stands_elsewhere():
     described = "serve/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 fried/VBN/acl/2/fry in/IN/prep/3 butter/NN/pobj/4"
     assert ("fry", {"Theme": "fish", "Instrument": "butter"}) in frames(described)
     assert ("fry", {"Theme": "it", "Instrument": None}) in frames("get/VB/ROOT/0 it/PRP/nsubj/2 fried/VBN/ccomp/0/fry")
-    coordinated = ("the/DT/det/1 chicken/NN/nsubjpass/3 is/VBZ/auxpass/3 seasoned/VBN/ROOT/3/season and/CC/cc/3 "
-                   "fried/VBN/conj/3/fry")
-    assert frames(coordinated) == [("season", {"Theme": "chicken", "Instrument": None}),
-                                   ("fry", {"Theme": "chicken", "Instrument": None})]
+    coordinated = (
+        "the/DT/det/1 chicken/NN/nsubjpass/3 is/VBZ/auxpass/3 seasoned/VBN/ROOT/3/season and/CC/cc/3 "
+        "fried/VBN/conj/3/fry"
+    )
+    assert frames(coordinated) == [
+        ("season", {"Theme": "chicken", "Instrument": None}),
+        ("fry", {"Theme": "chicken", "Instrument": None}),
+    ]
     # the participle's preposition right after it is a role's, not a particle, when its object stands elsewhere
-    sprinkled = ("I/PRP/nsubj/2 'd/MD/aux/2 like/VB/ROOT/2 some/DT/det/4 cheese/NN/nsubj/5 sprinkled/VBD/ccomp/2/sprinkle "
-                 "on/IN/prep/5 my/PRP$/poss/8 pasta/NN/pobj/6")
+    sprinkled = (
+        "I/PRP/nsubj/2 'd/MD/aux/2 like/VB/ROOT/2 some/DT/det/4 cheese/NN/nsubj/5 sprinkled/VBD/ccomp/2/sprinkle "
+        "on/IN/prep/5 my/PRP$/poss/8 pasta/NN/pobj/6"
+    )
     assert ("sprinkle", {"Theme": "cheese", "Destination": "pasta"}) in frames(sprinkled)
-    assert frames("pour/VB/ROOT/0 in/IN/prep/0 the/DT/det/3 milk/NN/pobj/1") == [("pour", {"Theme": "milk", "Destination": None})]
+    assert frames("pour/VB/ROOT/0 in/IN/prep/0 the/DT/det/3 milk/NN/pobj/1") == [
+        ("pour", {"Theme": "milk", "Destination": None})
+    ]
     # a person does the frying; a participle with its own object needs nothing from elsewhere
-    assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [("fry", {"Theme": None, "Instrument": None})]
+    assert frames("we/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry") == [
+        ("fry", {"Theme": None, "Instrument": None})
+    ]
     own = "I/PRP/nsubj/2 have/VBP/aux/2 fried/VBN/ROOT/2/fry the/DT/det/4 fish/NN/dobj/2"
     assert frames(own) == [("fry", {"Theme": "fish", "Instrument": None})]
 
 
 def test_a_gerund_after_a_thing_is_done_to_it():
-    """"the chicken needs frying" means it needs to be fried; a person with a gerund does the frying."""
+    """ "the chicken needs frying" means it needs to be fried; a person with a gerund does the frying."""
     needs = "the/DT/det/1 chicken/NN/nsubj/2 needs/VBZ/ROOT/2/need frying/VBG/xcomp/2/fry in/IN/prep/3 oil/NN/pobj/4"
     assert ("fry", {"Theme": "chicken", "Instrument": "oil"}) in frames(needs)
     up = "the/DT/det/1 soup/NN/nsubj/2 needs/VBZ/ROOT/2/need heating/VBG/xcomp/2/heat up/RP/prt/3"
@@ -156,7 +191,9 @@ def test_a_gerund_after_a_thing_is_done_to_it():
 def test_adjectival_participles_and_nouns_are_not_predicates():
     doc = "add/VB/ROOT/0 the/DT/det/3 fried/VBN/amod/3/fry onions/NNS/dobj/0/onion"
     assert frames(doc) == [("add", {"Theme": "onion"})]
-    assert frames("use/VB/ROOT/0 a/DT/det/3 pastry/NN/compound/3 brush/NN/dobj/0") == [("use", {"Theme": "pastry brush"})]
+    assert frames("use/VB/ROOT/0 a/DT/det/3 pastry/NN/compound/3 brush/NN/dobj/0") == [
+        ("use", {"Theme": "pastry brush"})
+    ]
 
 
 def test_generic_frames_keep_object_and_prepositions():
@@ -206,8 +243,9 @@ def test_imperative_repair_triggers():
     preposition_root = make_doc("fry/IN/ROOT/0 the/DT/det/2 chicken/NN/dobj/0")
     assert needs_reparse(preposition_root[:])
     # "pour milk, I'm making tea": tagged a verb, parsed as a modifier of the noun after it
-    modifier = make_doc("pour/VB/compound/1 milk/NN/dep/5 ,/,/punct/5 I/PRP/nsubj/5 'm/VBP/aux/5 making/VBG/ROOT/5 "
-                        "tea/NN/dobj/5")
+    modifier = make_doc(
+        "pour/VB/compound/1 milk/NN/dep/5 ,/,/punct/5 I/PRP/nsubj/5 'm/VBP/aux/5 making/VBG/ROOT/5 tea/NN/dobj/5"
+    )
     assert needs_reparse(modifier[:])
     assert not needs_reparse(make_doc("boiling/VB/amod/1 water/NN/nsubj/2 hisses/VBZ/ROOT/2")[:])  # a subject
     leading_prep = make_doc("In/IN/prep/3 a/DT/det/2 bowl/NN/pobj/0 mix/VB/ROOT/3 flour/NN/dobj/3")
@@ -225,8 +263,9 @@ def _participles(doc_spec: str, words: set[str]):
 
 
 def test_participles_and_predicative_adjectives_are_never_name_parts():
-    strong = Compounds(strong_bigrams=frozenset({"grated parmesan", "hot sauce", "sesame oil"}),
-                       predicative=frozenset({"hot"}))
+    strong = Compounds(
+        strong_bigrams=frozenset({"grated parmesan", "hot sauce", "sesame oil"}), predicative=frozenset({"hot"})
+    )
     doc = _participles("sprinkle/VB/ROOT/0 the/DT/det/3 grated/JJ/amod/3 parmesan/NN/dobj/0", {"grated"})
     assert extract_frames(doc, LEX, strong)[0].roles["Theme"] == "parmesan"  # strong bigram, still a participle
     assert frames("pour/VB/ROOT/0 the/DT/det/3 boiled/VBN/amod/3 water/NN/dobj/0", strong)[0][1]["Theme"] == "water"
@@ -243,19 +282,34 @@ def test_proper_noun_tagged_modifiers_are_judged_by_the_corpus():
     assert frames(doc)[0][1]["Destination"] == "ice cube tray"
 
 
-@pytest.mark.parametrize("doc, expected", [
-    # the quantity read as an adverbial noun phrase is still the object
-    ("fry/VB/ROOT/0 a/DT/det/2 couple/NN/npadvmod/0 of/IN/prep/2 eggs/NNS/pobj/3/egg in/IN/prep/0 "
-     "the/DT/det/7 skillet/NN/pobj/5", ("fry", {"Theme": "egg", "Instrument": "skillet"})),
-    # a destination hung on the of-object of a quantity
-    ("pour/VB/ROOT/0 some/DT/dobj/0 of/IN/prep/1 the/DT/det/4 sauce/NN/pobj/2 over/IN/prep/4 "
-     "the/DT/det/7 meatballs/NNS/pobj/5/meatball", ("pour", {"Theme": "sauce", "Destination": "meatball"})),
-    # a role phrase hung on the object of a time phrase
-    ("fry/VB/ROOT/0 the/DT/det/2 onions/NNS/dobj/0/onion for/IN/prep/0 five/CD/nummod/5 "
-     "minutes/NNS/pobj/3/minute in/IN/prep/5 the/DT/det/8 butter/NN/pobj/6", ("fry", {"Theme": "onion", "Instrument": "butter"})),
-    # two phrases for one role: the more usual preposition names it ("in" before "on" for fry)
-    ("fry/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 on/IN/prep/0 both/DT/det/5 sides/NNS/pobj/3/side "
-     "in/IN/prep/5 hot/JJ/amod/8 oil/NN/pobj/6", ("fry", {"Theme": "fish", "Instrument": "oil"})),
-])
+@pytest.mark.parametrize(
+    "doc, expected",
+    [
+        # the quantity read as an adverbial noun phrase is still the object
+        (
+            "fry/VB/ROOT/0 a/DT/det/2 couple/NN/npadvmod/0 of/IN/prep/2 eggs/NNS/pobj/3/egg in/IN/prep/0 "
+            "the/DT/det/7 skillet/NN/pobj/5",
+            ("fry", {"Theme": "egg", "Instrument": "skillet"}),
+        ),
+        # a destination hung on the of-object of a quantity
+        (
+            "pour/VB/ROOT/0 some/DT/dobj/0 of/IN/prep/1 the/DT/det/4 sauce/NN/pobj/2 over/IN/prep/4 "
+            "the/DT/det/7 meatballs/NNS/pobj/5/meatball",
+            ("pour", {"Theme": "sauce", "Destination": "meatball"}),
+        ),
+        # a role phrase hung on the object of a time phrase
+        (
+            "fry/VB/ROOT/0 the/DT/det/2 onions/NNS/dobj/0/onion for/IN/prep/0 five/CD/nummod/5 "
+            "minutes/NNS/pobj/3/minute in/IN/prep/5 the/DT/det/8 butter/NN/pobj/6",
+            ("fry", {"Theme": "onion", "Instrument": "butter"}),
+        ),
+        # two phrases for one role: the more usual preposition names it ("in" before "on" for fry)
+        (
+            "fry/VB/ROOT/0 the/DT/det/2 fish/NN/dobj/0 on/IN/prep/0 both/DT/det/5 sides/NNS/pobj/3/side "
+            "in/IN/prep/5 hot/JJ/amod/8 oil/NN/pobj/6",
+            ("fry", {"Theme": "fish", "Instrument": "oil"}),
+        ),
+    ],
+)
 def test_quantities_and_phrases_hung_on_other_phrases(doc, expected):
     assert frames(doc) == [expected]

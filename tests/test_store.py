@@ -58,7 +58,9 @@ def test_duplicate_version_is_refused(sql_dir):
 def test_contract_violation_is_reported(sql_dir):
     con = duckdb.connect(":memory:")
     migrate(con, sql_dir)
-    con.execute("insert into documents values ('recipes','s','d1',null,null,null,null,'f',1),"
-                "('recipes','s','d1',null,null,null,null,'g',1)")
+    con.execute(
+        "insert into documents values ('recipes','s','d1',null,null,null,null,'f',1),"
+        "('recipes','s','d1',null,null,null,null,'g',1)"
+    )
     with pytest.raises(ContractViolation, match="ingest_documents_unique"):
         check_contracts(con, sql_dir, prefix="ingest_")

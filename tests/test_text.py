@@ -18,7 +18,9 @@ def test_normalize_fractions_quotes_dashes_spaces():
 def test_split_keeps_quantities_and_abbreviations():
     text = "Preheat oven to 350 F. Mix 1/2 cup flour with 1 1/2 tsp. salt. Bake 2.5 hrs."
     assert split_sentences(text) == [
-        "Preheat oven to 350 F.", "Mix 1/2 cup flour with 1 1/2 tsp. salt.", "Bake 2.5 hrs.",
+        "Preheat oven to 350 F.",
+        "Mix 1/2 cup flour with 1 1/2 tsp. salt.",
+        "Bake 2.5 hrs.",
     ]
     assert split_sentences("Mrs. A. Smith says: stir") == ["Mrs. A. Smith says: stir"]
     assert split_sentences("Add 2 T. Butter. Mix.") == ["Add 2 T. Butter.", "Mix."]

@@ -25,7 +25,8 @@ def test_defaults_without_environment(clean_env):
     assert ws.data_dir == Path("data") and ws.db == Path("data/lmcr.duckdb")
     assert ws.spacy_model == SPACY_MODEL and ws.vectors is None and ws.conceptnet is None and ws.paper is None
     assert (ws.srl_dir, ws.checkpoints, ws.calibration, ws.report, ws.robot, ws.baselines, ws.staging) == tuple(
-        Path("data") / name for name in ("srl", "checkpoints", "calibration", "report", "robot", "baselines", "staging"))
+        Path("data") / name for name in ("srl", "checkpoints", "calibration", "report", "robot", "baselines", "staging")
+    )
 
 
 def test_environment_then_arguments(clean_env, tmp_path):
@@ -63,8 +64,15 @@ def test_insert_rows_by_name_with_key_and_conversion():
     con = duckdb.connect()
     con.execute("create table t (id varchar primary key, n integer default 7, ts timestamp)")
     insert_rows(con, "t", [{"id": "a", "ts": "2026-01-02 03:04:05", "extra": 1}])
-    insert_rows(con, "t", [{"id": "a", "ts": None}, {"id": "b", "ts": "x"}], key="id",
-                convert={"ts": "try_cast(ts as timestamp)"})
+    insert_rows(
+        con,
+        "t",
+        [{"id": "a", "ts": None}, {"id": "b", "ts": "x"}],
+        key="id",
+        convert={"ts": "try_cast(ts as timestamp)"},
+    )
     insert_rows(con, "t", [])
     assert con.execute("select id, n, ts::varchar from t order by id").fetchall() == [
-        ("a", 7, "2026-01-02 03:04:05"), ("b", 7, None)]
+        ("a", 7, "2026-01-02 03:04:05"),
+        ("b", 7, None),
+    ]

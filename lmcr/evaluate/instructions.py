@@ -41,10 +41,14 @@ class InstructionAccuracy:
 
     def summary(self) -> str:
         """One line of counts, then one line per wrong completion."""
-        return "\n".join([f"dev instructions: {self.right}/{self.total} = {self.accuracy:.3f} right "
-                          f"({self.answered_right} answered right, {self.asked} questions of which "
-                          f"{self.asked_right} guess right)",
-                          *(f"  {text!r}: {roles} (context {context!r})" for text, roles, context in self.wrong)])
+        return "\n".join(
+            [
+                f"dev instructions: {self.right}/{self.total} = {self.accuracy:.3f} right "
+                f"({self.answered_right} answered right, {self.asked} questions of which "
+                f"{self.asked_right} guess right)",
+                *(f"  {text!r}: {roles} (context {context!r})" for text, roles, context in self.wrong),
+            ]
+        )
 
 
 def load_instructions(path: Path) -> list[dict]:
@@ -57,7 +61,9 @@ def load_instructions(path: Path) -> list[dict]:
     return records
 
 
-def instruction_accuracy(parser, scorer: Callable, config: CompletionConfig, records: Iterable[dict]) -> InstructionAccuracy:
+def instruction_accuracy(
+    parser, scorer: Callable, config: CompletionConfig, records: Iterable[dict]
+) -> InstructionAccuracy:
     """Complete each record's instruction among its objects with `scorer` and count the right ones."""
     total = answered_right = asked = asked_right = 0
     wrong = []
@@ -68,10 +74,10 @@ def instruction_accuracy(parser, scorer: Callable, config: CompletionConfig, rec
         except LMCRError as exc:  # no predicate found, nothing to fill with: no answer, so a wrong one
             wrong.append((record["instruction"], {"error": str(exc)}, ""))
             continue
-        guessed = out["frame"] == record["expected"]
-        asked += bool(out["question"])
-        asked_right += bool(out["question"]) and guessed
-        answered_right += not out["question"] and guessed
+        guessed = out.frame.to_json() == record["expected"]
+        asked += bool(out.question)
+        asked_right += bool(out.question) and guessed
+        answered_right += not out.question and guessed
         if not guessed:
-            wrong.append((record["instruction"], out["frame"]["roles"], out["context"]))
+            wrong.append((record["instruction"], out.frame.role_map, out.context))
     return InstructionAccuracy(total, answered_right, asked, asked_right, wrong)

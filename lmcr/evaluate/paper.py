@@ -11,8 +11,13 @@ from lmcr.jsonl import decode_utf8, read_bytes
 
 # The paper's column headings -> our method names. The paper's LMCR column is its language model over
 # sentence-linearised frames trained on all corpora: our sentence_lm.
-PAPER_METHODS = {"random": "random", "cooccur": "cooccur", "word2vec": "word2vec", "conceptnet": "conceptnet",
-                 "lmcr": "sentence_lm"}
+PAPER_METHODS = {
+    "random": "random",
+    "cooccur": "cooccur",
+    "word2vec": "word2vec",
+    "conceptnet": "conceptnet",
+    "lmcr": "sentence_lm",
+}
 
 
 ACCURACY = re.compile(r"\d*\.\d+")  # a table cell holding a figure, '0.88' or '.88'

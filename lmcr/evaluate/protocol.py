@@ -35,11 +35,15 @@ class Results:
     skipped_k: dict[int, str] = field(default_factory=dict)
 
     def to_json(self) -> dict:
-        return {"config": self.config.__dict__, "table1": self.table1,
-                "vs_lambda": {m: {f"{x:g}": a for x, a in v.items()} for m, v in self.vs_lambda.items()},
-                "vs_k": {m: {str(x): a for x, a in v.items()} for m, v in self.vs_k.items()},
-                "scenarios": self.scenarios, "skipped": self.skipped,
-                "skipped_k": {str(k): why for k, why in self.skipped_k.items()}}
+        return {
+            "config": self.config.__dict__,
+            "table1": self.table1,
+            "vs_lambda": {m: {f"{x:g}": a for x, a in v.items()} for m, v in self.vs_lambda.items()},
+            "vs_k": {m: {str(x): a for x, a in v.items()} for m, v in self.vs_k.items()},
+            "scenarios": self.scenarios,
+            "skipped": self.skipped,
+            "skipped_k": {str(k): why for k, why in self.skipped_k.items()},
+        }
 
 
 def score_rated(rated: list[RatedFrame], scorers: dict[str, Callable]) -> dict[str, dict[tuple, float]]:
@@ -69,7 +73,9 @@ def evaluate(rated: list[RatedFrame], scores: dict[str, dict[tuple, float]], con
         scenarios = point(config.lam, k)
         verbs = {sc.verb for sc in scenarios}
         if len(verbs) < config.min_verbs:
-            results.skipped_k[k] = f"only {len(verbs)} verbs have a positive and {k - 1} negatives at lambda={config.lam:g}"
+            results.skipped_k[k] = (
+                f"only {len(verbs)} verbs have a positive and {k - 1} negatives at lambda={config.lam:g}"
+            )
             continue
         for m, s in scores.items():
             results.vs_k.setdefault(m, {})[k] = accuracy(scenarios, s)["all"]

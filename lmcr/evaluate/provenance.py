@@ -44,8 +44,11 @@ def recorded_files(db: Path | None, table: str) -> list[dict]:
 def collect(ratings: Path, db: Path | None, checkpoints: dict[str, Path]) -> dict:
     """The provenance of one evaluation; `checkpoints` maps each evaluated LM setting to its version folder."""
     corpus_files = recorded_files(db, "ingested_files")
-    rating_files = ([{"file": str(ratings), "sha256": file_sha256(Path(ratings))}] if Path(ratings).suffix == ".csv"
-                    else recorded_files(ratings, "rating_files"))
+    rating_files = (
+        [{"file": str(ratings), "sha256": file_sha256(Path(ratings))}]
+        if Path(ratings).suffix == ".csv"
+        else recorded_files(ratings, "rating_files")
+    )
     sample = sample_hashes()
     from_sample = [f["file"] for f in rating_files + corpus_files if f["sha256"] in sample]
     return {
@@ -55,7 +58,9 @@ def collect(ratings: Path, db: Path | None, checkpoints: dict[str, Path]) -> dic
         "machine": machine(),
         "ratings": rating_files,
         "corpus": corpus_files,
-        "checkpoints": [{"setting": s, "version": p.name, "manifest_sha256": file_sha256(p / "manifest.json")}
-                        for s, p in sorted(checkpoints.items())],
+        "checkpoints": [
+            {"setting": s, "version": p.name, "manifest_sha256": file_sha256(p / "manifest.json")}
+            for s, p in sorted(checkpoints.items())
+        ],
         "sample_files": from_sample,
     }

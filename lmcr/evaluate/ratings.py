@@ -11,6 +11,7 @@ import duckdb
 from lmcr import store
 from lmcr.annotate.results import ingest_ratings
 from lmcr.frame import Frame
+from lmcr.jsonl import InputError
 
 
 @dataclass(frozen=True)
@@ -51,6 +52,6 @@ def load_ratings(source: Path, sql_dir: Path, verbs: set[str] | None = None) -> 
     try:
         return rated_frames(con, verbs)
     except duckdb.CatalogException as exc:
-        raise ValueError(f"{source}: neither an MTurk results .csv nor an LMCR store with ratings") from exc
+        raise InputError(f"{source}: neither an MTurk results .csv nor an LMCR store with ratings") from exc
     finally:
         con.close()

@@ -27,8 +27,16 @@ FIGURES = {
 
 # One look per series, so that series with identical values stay visible: nested markers of falling
 # size and different dash patterns (no offsets: every point sits at its true x).
-STYLES = [("o", "-", 9), ("s", "--", 7.5), ("^", "-.", 6.5), ("D", ":", 5.5), ("v", "-", 4.5), ("P", "--", 4),
-          ("X", "-.", 3.5), ("*", ":", 3)]
+STYLES = [
+    ("o", "-", 9),
+    ("s", "--", 7.5),
+    ("^", "-.", 6.5),
+    ("D", ":", 5.5),
+    ("v", "-", 4.5),
+    ("P", "--", 4),
+    ("X", "-.", 3.5),
+    ("*", ":", 3),
+]
 
 
 def _fmt(x: float | None) -> str:
@@ -41,8 +49,14 @@ def table1_markdown(results: Results, methods: list[str], paper: dict[str, dict[
     published = [m for m in methods if m in paper]
     head = "| verb | " + " | ".join(methods + [f"paper {m}" for m in published]) + " |"
     rule = "|" + "---|" + "---:|" * (len(methods) + len(published))
-    rows = [f"| {v} | " + " | ".join([_fmt(results.table1.get(m, {}).get(v)) for m in methods]
-                                     + [_fmt(paper[m].get(v)) for m in published]) + " |" for v in verbs]
+    rows = [
+        f"| {v} | "
+        + " | ".join(
+            [_fmt(results.table1.get(m, {}).get(v)) for m in methods] + [_fmt(paper[m].get(v)) for m in published]
+        )
+        + " |"
+        for v in verbs
+    ]
     return "\n".join([head, rule] + rows)
 
 
@@ -54,8 +68,16 @@ def plot(results: Results, series: list[str], key: str, xlabel: str, title: str,
         if points:
             marker, dash, size = STYLES[i % len(STYLES)]
             xs = sorted(points)
-            ax.plot(xs, [points[x] for x in xs], marker=marker, linestyle=dash, markersize=size, linewidth=1.4,
-                    markerfacecolor="none" if i % 2 else None, label=m)
+            ax.plot(
+                xs,
+                [points[x] for x in xs],
+                marker=marker,
+                linestyle=dash,
+                markersize=size,
+                linewidth=1.4,
+                markerfacecolor="none" if i % 2 else None,
+                label=m,
+            )
     ax.set_xlabel(xlabel)
     ax.set_ylabel("accuracy")
     ax.set_ylim(0, 1.02)
@@ -72,8 +94,11 @@ def plot(results: Results, series: list[str], key: str, xlabel: str, title: str,
 def distinct_settings(results: Results, methods: list[str], settings: list[str]) -> list[str]:
     """The LM settings that add a column to Table I: not a method already there under its own name
     ('sentence_lm/all' when Table I's sentence_lm is the all-corpora model: same figures)."""
-    return [s for s in settings if s not in methods
-            and results.table1.get(s) != results.table1.get(s.partition("/")[0], object())]
+    return [
+        s
+        for s in settings
+        if s not in methods and results.table1.get(s) != results.table1.get(s.partition("/")[0], object())
+    ]
 
 
 def _grouped(reasons: dict[str, str]) -> str:
@@ -84,8 +109,15 @@ def _grouped(reasons: dict[str, str]) -> str:
     return "; ".join(f"{why} ({', '.join(verbs)})" for why, verbs in by_reason.items())
 
 
-def write_report(results: Results, methods: list[str], settings: list[str], out_dir: Path, notes: list[str],
-                 provenance: dict | None = None, paper: dict[str, dict[str, float]] | None = None) -> Path:
+def write_report(
+    results: Results,
+    methods: list[str],
+    settings: list[str],
+    out_dir: Path,
+    notes: list[str],
+    provenance: dict | None = None,
+    paper: dict[str, dict[str, float]] | None = None,
+) -> Path:
     """Write report.md, report.html, fig4{a,b,c,d}.png and figures.json into `out_dir` (replaced whole)."""
     with atomic_dir(out_dir) as tmp:
         _write_files(results, methods, settings, tmp, notes, provenance or {}, paper or {})
@@ -96,23 +128,31 @@ def sample_banner(provenance: dict) -> list[str]:
     files = provenance.get("sample_files") or []
     if not files:
         return []
-    return [f"> **Sample data.** This report was built from LMCR's embedded sample ({len(files)} input files, "
-            "e.g. `" + files[0] + "`): it shows the report's layout, not LMCR's accuracy. The README's Results "
-            "give the figures on the full corpora and ratings.\n"]
+    return [
+        f"> **Sample data.** This report was built from LMCR's embedded sample ({len(files)} input files, "
+        "e.g. `" + files[0] + "`): it shows the report's layout, not LMCR's accuracy. The README's Results "
+        "give the figures on the full corpora and ratings.\n"
+    ]
 
 
 def provenance_markdown(provenance: dict) -> list[str]:
     if not provenance:
         return []
-    lines = [f"- Built {provenance['date']} by lmcr {provenance['lmcr']}, commit `{provenance['git_commit']}`, "
-             f"on {provenance['machine']}."]
+    lines = [
+        f"- Built {provenance['date']} by lmcr {provenance['lmcr']}, commit `{provenance['git_commit']}`, "
+        f"on {provenance['machine']}."
+    ]
     lines += [f"- Ratings `{f['file']}` sha256 `{f['sha256'][:16]}`" for f in provenance["ratings"]]
     if "mixture" in provenance:
-        lines.append(f"- Corpus mixture of the bare method names: {provenance['mixture']}; weight of the context term "
-                     f"in completion: {provenance.get('context_weight', 1):g} (`lmcr mixture`; the rated frames have "
-                     "no context)")
-    lines += [f"- Checkpoint {c['setting']}: `{c['version']}`, manifest sha256 `{c['manifest_sha256'][:16]}`"
-              for c in provenance["checkpoints"]]
+        lines.append(
+            f"- Corpus mixture of the bare method names: {provenance['mixture']}; weight of the context term "
+            f"in completion: {provenance.get('context_weight', 1):g} (`lmcr mixture`; the rated frames have "
+            "no context)"
+        )
+    lines += [
+        f"- Checkpoint {c['setting']}: `{c['version']}`, manifest sha256 `{c['manifest_sha256'][:16]}`"
+        for c in provenance["checkpoints"]
+    ]
     corpus = provenance["corpus"]
     lines += [f"- Corpus file `{f['file']}` sha256 `{f['sha256'][:16]}`" for f in corpus[:20]]
     if len(corpus) > 20:
@@ -120,36 +160,58 @@ def provenance_markdown(provenance: dict) -> list[str]:
     return ["## Provenance\n", "\n".join(lines), ""]
 
 
-def _write_files(results: Results, methods: list[str], settings: list[str], tmp: Path, notes: list[str],
-                 provenance: dict, paper: dict[str, dict[str, float]]) -> None:
+def _write_files(
+    results: Results,
+    methods: list[str],
+    settings: list[str],
+    tmp: Path,
+    notes: list[str],
+    provenance: dict,
+    paper: dict[str, dict[str, float]],
+) -> None:
     cfg = results.config
     groups = {"methods": methods, "settings": settings}
     figures = {"table1": results.table1, "paper_table1": paper, **results.to_json(), "provenance": provenance}
-    sections = ["# LMCR evaluation\n", *sample_banner(provenance),
-                f"Scenarios per verb: {cfg.per_verb}, seed {cfg.seed}. Table I at "
-                f"lambda={cfg.lam:g}, k={cfg.k}: {results.scenarios.get(f'lambda={cfg.lam:g},k={cfg.k}', 0)} scenarios.\n",
-                "## Table I: accuracy per verb\n",
-                table1_markdown(results, methods + distinct_settings(results, methods, settings), paper), ""]
+    sections = [
+        "# LMCR evaluation\n",
+        *sample_banner(provenance),
+        f"Scenarios per verb: {cfg.per_verb}, seed {cfg.seed}. Table I at "
+        f"lambda={cfg.lam:g}, k={cfg.k}: {results.scenarios.get(f'lambda={cfg.lam:g},k={cfg.k}', 0)} scenarios.\n",
+        "## Table I: accuracy per verb\n",
+        table1_markdown(results, methods + distinct_settings(results, methods, settings), paper),
+        "",
+    ]
     if paper:
         sections += ["Columns *paper X* are the paper's published Table I (its LMCR column beside our sentence_lm).\n"]
     for name, (group, key, xlabel, title) in FIGURES.items():
-        figures[name] = plot(results, groups[group], key, xlabel, title.format(k=cfg.k, lam=cfg.lam), tmp / f"{name}.png")
+        figures[name] = plot(
+            results, groups[group], key, xlabel, title.format(k=cfg.k, lam=cfg.lam), tmp / f"{name}.png"
+        )
         sections += [f"## Fig. 4{name[-1].upper()}\n", f"![{name}]({name}.png)\n"]
     skipped = [f"- {point}: {_grouped(verbs)}" for point, verbs in results.skipped.items()]
     skipped += [f"- k={k} left out of the k sweep: {why}" for k, why in results.skipped_k.items()]
-    sections += ["## Skipped\n", "\n".join(skipped) or "nothing", "", "## Notes and deviations from the paper\n",
-                 "\n".join(f"- {n}" for n in notes), "", *provenance_markdown(provenance)]
+    sections += [
+        "## Skipped\n",
+        "\n".join(skipped) or "nothing",
+        "",
+        "## Notes and deviations from the paper\n",
+        "\n".join(f"- {n}" for n in notes),
+        "",
+        *provenance_markdown(provenance),
+    ]
     markdown = "\n".join(sections)
     (tmp / "report.md").write_text(markdown, encoding="utf-8")
     (tmp / "figures.json").write_text(json.dumps(figures, indent=2, default=str), encoding="utf-8")
     (tmp / "report.html").write_text(render_html(markdown, tmp), encoding="utf-8")
 
 
-STYLE = ("body{font-family:sans-serif;max-width:62em;margin:auto;padding:0 1em}"
-         ".scroll{overflow-x:auto;max-width:100%;border:1px solid #eee}"
-         "table{border-collapse:collapse;font-variant-numeric:tabular-nums}td,th{border:1px solid #ccc;padding:2px 6px}"
-         "blockquote{background:#fff4d6;border-left:4px solid #e0a800;margin:1em 0;padding:.5em 1em}"
-         "img{max-width:100%}")
+STYLE = (
+    "body{font-family:sans-serif;max-width:62em;margin:auto;padding:0 1em}"
+    ".scroll{overflow-x:auto;max-width:100%;border:1px solid #eee}"
+    "table{border-collapse:collapse;font-variant-numeric:tabular-nums}td,th{border:1px solid #ccc;padding:2px 6px}"
+    "blockquote{background:#fff4d6;border-left:4px solid #e0a800;margin:1em 0;padding:.5em 1em}"
+    "img{max-width:100%}"
+)
 
 
 def render_html(markdown: str, folder: Path) -> str:
@@ -165,5 +227,7 @@ def render_html(markdown: str, folder: Path) -> str:
         return f'src="data:image/png;base64,{data}"'
 
     body = re.sub(r'src="(fig4[a-d]\.png)"', embed, body)
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>LMCR evaluation</title>"
-            f"<style>{STYLE}</style></head><body>{body}</body></html>")
+    return (
+        f"<!doctype html><html><head><meta charset='utf-8'><title>LMCR evaluation</title>"
+        f"<style>{STYLE}</style></head><body>{body}</body></html>"
+    )

@@ -20,7 +20,7 @@ from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir
 from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.rarity import WEIGHT
 from lmcr.scorers.registry import COMPLETION_METHOD, make_scorer
-from lmcr.scorers.resources import MethodResources
+from lmcr.scorers.resources import MethodResources, MethodUnavailable
 from lmcr.scorers.similar_verbs import NEIGHBOURS
 from lmcr.setting import ALL_SETTINGS, LM_METHODS, Setting
 
@@ -47,7 +47,8 @@ DEVIATIONS = [
     "when one is given (--paper or $LMCR_PAPER); its ratings are not ours, so its figures are a reference, "
     "not a like-for-like comparison.",
     "frame_counts is not in the paper: smoothed counts of the SRL frames of the robot predicates, "
-    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/scorers/frame_counts.py). similar_verbs is not in the paper either: the same "
+    "log P(a2 | v, a1) + log P(a1 | v, a2) (lmcr/scorers/frame_counts.py). "
+    "similar_verbs is not in the paper either: the same "
     f"two conditionals from the pair counts of the {NEIGHBOURS} verbs whose fillers are most like the predicate's "
     "(similarity-based smoothing, lmcr/scorers/similar_verbs.py). 'a+b' sums two methods' log-probabilities "
     f"(a product of experts); rarity is the term -{WEIGHT:g} log P(fillers) from the fillers' corpus frequencies "
@@ -68,12 +69,9 @@ def named_method(name: str, res: MethodResources) -> tuple[str, MethodResources]
     return method, replace(named, mixture=Mixture.parse(mixture)) if at else named
 
 
-class MethodUnavailable(LMCRError, ValueError):
-    """A method the user asked for that cannot be built (no checkpoint, a bad vector or edge file, ...)."""
-
-
-def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], None],
-                  optional: Collection[str] = ()) -> tuple[dict, list[str]]:
+def build_scorers(
+    names: list[str], res: MethodResources, log: Callable[[str], None], optional: Collection[str] = ()
+) -> tuple[dict, list[str]]:
     """Scorers by name ('sentence_lm', 'sentence_lm/youcook2', 'cooccur', ...). A name in `optional` (a
     default the user did not ask for) that cannot be built is skipped with a note; any other name that
     cannot be built is a MethodUnavailable error: a requested method is never silently left out."""
@@ -89,9 +87,15 @@ def build_scorers(names: list[str], res: MethodResources, log: Callable[[str], N
     return scorers, notes
 
 
-def calibrate_completion(rated: list[RatedFrame], scores: dict, methods: list[str], res: MethodResources,
-                         config: EvalConfig, out_dir: Path, log: Callable[[str], None]
-                         ) -> dict[str, tuple[Path, str, CompletionConfig]]:
+def calibrate_completion(
+    rated: list[RatedFrame],
+    scores: dict,
+    methods: list[str],
+    res: MethodResources,
+    config: EvalConfig,
+    out_dir: Path,
+    log: Callable[[str], None],
+) -> dict[str, tuple[Path, str, CompletionConfig]]:
     """Completion temperature and conformal threshold of each calibrated method (LMs, frame_counts and
     their sums), from the headline scenarios; saved, and returned as method -> (file, fingerprint,
     calibration)."""
@@ -109,8 +113,10 @@ def calibrate_completion(rated: list[RatedFrame], scores: dict, methods: list[st
 
 
 def calibration_note(method: str, cal: CompletionConfig) -> str:
-    return (f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
-            f"threshold p >= {cal.set_threshold:.3f} ({cal.source})")
+    return (
+        f"{method} completion calibration: temperature {cal.temperature:.3g}, prediction-set "
+        f"threshold p >= {cal.set_threshold:.3f} ({cal.source})"
+    )
 
 
 def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, Path]:
@@ -124,10 +130,19 @@ def evaluated_checkpoints(names: list[str], res: MethodResources) -> dict[str, P
     return found
 
 
-def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[str], settings: list[str],
-                   config: EvalConfig, out_dir: Path, calibration_dir: Path | None = None,
-                   log: Callable[[str], None] = print, ratings_source: Path | None = None,
-                   paper: Path | None = None, optional: Collection[str] = ()) -> Results:
+def run_evaluation(
+    rated: list[RatedFrame],
+    res: MethodResources,
+    methods: list[str],
+    settings: list[str],
+    config: EvalConfig,
+    out_dir: Path,
+    calibration_dir: Path | None = None,
+    log: Callable[[str], None] = print,
+    ratings_source: Path | None = None,
+    paper: Path | None = None,
+    optional: Collection[str] = (),
+) -> Results:
     """Score, sweep, calibrate and write the report; `ratings_source` (CSV or store) goes into its
     provenance and `paper` (the paper's LaTeX source) gives its published Table I columns. Methods and
     settings in `optional` (defaults, not asked for) may be skipped with a note; the others must build."""
@@ -144,11 +159,20 @@ def run_evaluation(rated: list[RatedFrame], res: MethodResources, methods: list[
         saved = calibrate_completion(rated, scores, methods, res, config, calibration_dir, log)
         notes += [calibration_note(method, cal) for method, (_, _, cal) in saved.items()]
     if published:
-        notes.append("The paper's Fig. 4 (accuracy against lambda and k) is drawn without its values in the LaTeX "
-                     "source, so only Table I is set beside ours; our Fig. 4 has no paper series.")
+        notes.append(
+            "The paper's Fig. 4 (accuracy against lambda and k) is drawn without its values in the LaTeX "
+            "source, so only Table I is set beside ours; our Fig. 4 has no paper series."
+        )
     notes += DEVIATIONS + [f"{len(rated):,} rated frames; evaluation took {time.perf_counter() - started:.0f}s."]
     evaluated = [m for m in methods if m in scores], [s for s in settings if s in scores]
-    origin = ({**provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res)),
-               "mixture": res.mixture.label, "context_weight": res.context_weight} if ratings_source is not None else {})
+    origin = (
+        {
+            **provenance.collect(ratings_source, res.db, evaluated_checkpoints(evaluated[0] + evaluated[1], res)),
+            "mixture": res.mixture.label,
+            "context_weight": res.context_weight,
+        }
+        if ratings_source is not None
+        else {}
+    )
     write_report(results, *evaluated, out_dir, notes, origin, published)
     return results

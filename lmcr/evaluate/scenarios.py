@@ -14,7 +14,12 @@ import random
 from collections import defaultdict
 from dataclasses import dataclass
 
+from lmcr.errors import LMCRError
 from lmcr.evaluate.ratings import RatedFrame
+
+
+class ScenarioError(LMCRError, ValueError):
+    """Ratings that give no scenarios under the settings asked for (lambda, k)."""
 
 
 @dataclass(frozen=True)
@@ -52,8 +57,9 @@ def verb_seed(seed: int, verb: str) -> int:
     return int.from_bytes(hashlib.sha256(f"{seed}:{verb}".encode()).digest()[:8], "big")
 
 
-def build_scenarios(frames: list[RatedFrame], lam: float, k: int, per_verb: int = 50,
-                    seed: int = 0) -> tuple[list[Scenario], dict[str, str]]:
+def build_scenarios(
+    frames: list[RatedFrame], lam: float, k: int, per_verb: int = 50, seed: int = 0
+) -> tuple[list[Scenario], dict[str, str]]:
     """Up to `per_verb` scenarios per verb, and for each verb with none the reason.
 
     Each scenario picks, with the verb's seed, a (group, positive) pair uniformly among all pairs whose

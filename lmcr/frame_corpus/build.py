@@ -51,14 +51,21 @@ def prepare_build(
 def summarize_build(fingerprint: str, config: FrameCorpusConfig, results: list[ShardResult], wall: float) -> dict:
     """The build record: sizes, re-parse counts, and words/s over the shards parsed (not cached)."""
     parsed_words = sum(r.shard.words for r in results if not r.cached)
-    return {"fingerprint": fingerprint, "kinds": config.kinds, "sentences": sum(r.shard.sentences for r in results),
-            "words": sum(r.shard.words for r in results), "reparsed": sum(r.reparsed for r in results),
-            "kept": sum(r.kept for r in results), "wall_s": round(wall, 2),
-            "words_per_s": round(parsed_words / wall, 1) if parsed_words else 0.0}
+    return {
+        "fingerprint": fingerprint,
+        "kinds": config.kinds,
+        "sentences": sum(r.shard.sentences for r in results),
+        "words": sum(r.shard.words for r in results),
+        "reparsed": sum(r.reparsed for r in results),
+        "kept": sum(r.kept for r in results),
+        "wall_s": round(wall, 2),
+        "words_per_s": round(parsed_words / wall, 1) if parsed_words else 0.0,
+    }
 
 
-def finish_build(con: duckdb.DuckDBPyConnection, srl_dir: Path, results: list[ShardResult], build: dict,
-                 job: ShardJob) -> None:
+def finish_build(
+    con: duckdb.DuckDBPyConnection, srl_dir: Path, results: list[ShardResult], build: dict, job: ShardJob
+) -> None:
     """Load the shards (one transaction) and publish the learned role priors and the first-word table
     the shards started from beside the compounds (`load_parser` reads all three)."""
     results = sorted(results, key=lambda r: r.shard.number)
@@ -76,18 +83,25 @@ def shard_job(staging: Path, srl_dir: Path, config: FrameCorpusConfig) -> ShardJ
 
 def process_pool(workers: int = 2, on_shard: Callable[[ShardResult], None] | None = None) -> ParseAll:
     """Parse shards on `workers` local processes, calling `on_shard` as each one finishes."""
+
     def parse_all(shards: list[Shard], job: ShardJob) -> Iterable[ShardResult]:
         with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
             for future in as_completed([pool.submit(parse_shard, s, job) for s in shards]):
                 if on_shard:
                     on_shard(future.result())
                 yield future.result()
+
     return parse_all
 
 
-def build_frame_corpus(con: duckdb.DuckDBPyConnection, staging: Path, srl_dir: Path,
-                       config: FrameCorpusConfig = FrameCorpusConfig(), parse_all: ParseAll | None = None,
-                       log: Callable[[str], None] = lambda message: None) -> dict | None:
+def build_frame_corpus(
+    con: duckdb.DuckDBPyConnection,
+    staging: Path,
+    srl_dir: Path,
+    config: FrameCorpusConfig = FrameCorpusConfig(),
+    parse_all: ParseAll | None = None,
+    log: Callable[[str], None] = lambda message: None,
+) -> dict | None:
     """Build (or skip, when unchanged) the frame corpus; return the build record, None if skipped.
     Shards are parsed by `parse_all` (default: two local processes)."""
     prepared = prepare_build(con, staging, srl_dir, config)

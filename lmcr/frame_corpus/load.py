@@ -41,7 +41,9 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
     ).fetchall()
     frames: dict[tuple, FrameMention] = {}
     for corpus, doc_id, sent_id, frame_no, predicate, ambiguous, role, value in rows:
-        frame = frames.setdefault((corpus, doc_id, sent_id, frame_no), FrameMention(predicate, {}, True, 0, 0, {}, ambiguous))
+        frame = frames.setdefault(
+            (corpus, doc_id, sent_id, frame_no), FrameMention(predicate, {}, True, 0, 0, {}, ambiguous)
+        )
         frame.roles[role] = value
     lex = load_lexicon()
     flipped = []
@@ -51,17 +53,22 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
         if priors.resolve(frame).roles != frame.roles:
             flipped.append((*key, frame.ambiguous_object, next(r for r in roles if r != frame.ambiguous_object)))
     if flipped:
-        con.execute("create or replace temp table _flipped (corpus varchar, doc_id varchar, sent_id integer, "
-                    "frame_no integer, default_role varchar, other_role varchar)")
+        con.execute(
+            "create or replace temp table _flipped (corpus varchar, doc_id varchar, sent_id integer, "
+            "frame_no integer, default_role varchar, other_role varchar)"
+        )
         con.executemany("insert into _flipped values (?, ?, ?, ?, ?, ?)", flipped)
         # Both role rows swap names: the value moves to the other role, the null to the default one.
         con.execute(
             "update frame_roles set role = case when frame_roles.role = x.default_role then x.other_role "
             "else x.default_role end from _flipped x where frame_roles.corpus = x.corpus "
-            "and frame_roles.doc_id = x.doc_id and frame_roles.sent_id = x.sent_id and frame_roles.frame_no = x.frame_no"
+            "and frame_roles.doc_id = x.doc_id and frame_roles.sent_id = x.sent_id "
+            "and frame_roles.frame_no = x.frame_no"
         )
-        con.execute("update frames set resolved_by_prior = true from _flipped x where frames.corpus = x.corpus "
-                    "and frames.doc_id = x.doc_id and frames.sent_id = x.sent_id and frames.frame_no = x.frame_no")
+        con.execute(
+            "update frames set resolved_by_prior = true from _flipped x where frames.corpus = x.corpus "
+            "and frames.doc_id = x.doc_id and frames.sent_id = x.sent_id and frames.frame_no = x.frame_no"
+        )
         con.execute("drop table _flipped")
     return len(flipped)
 
@@ -79,10 +86,20 @@ def load_frames(con: duckdb.DuckDBPyConnection, results: list[ShardResult], buil
         resolve_ambiguous(con, priors)
         known = con.execute("select count(*) filter (where known), count(*) from frames").fetchone()
         con.execute("delete from frame_builds where fingerprint = ?", [build["fingerprint"]])
-        insert_rows(con, "frame_builds", [{
-            **{k: build[k] for k in ("fingerprint", "sentences", "words", "reparsed", "wall_s", "words_per_s")},
-            "kinds": ",".join(build["kinds"]), "shards": len(results), "frames": known[1], "known_frames": known[0],
-            "reparse_kept": build["kept"]}])
+        insert_rows(
+            con,
+            "frame_builds",
+            [
+                {
+                    **{k: build[k] for k in ("fingerprint", "sentences", "words", "reparsed", "wall_s", "words_per_s")},
+                    "kinds": ",".join(build["kinds"]),
+                    "shards": len(results),
+                    "frames": known[1],
+                    "known_frames": known[0],
+                    "reparse_kept": build["kept"],
+                }
+            ],
+        )
     return priors
 
 

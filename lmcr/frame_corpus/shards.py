@@ -25,15 +25,32 @@ from lmcr.srl.mentions import FrameMention
 from lmcr.srl.parser import FrameParser, is_first_word_table, load_nlp, read_first_words
 
 SRL_CODE = Path(__file__).parent.parent / "srl"
-FRAME_SCHEMA = pa.schema([
-    ("corpus", pa.string()), ("doc_id", pa.string()), ("sent_id", pa.int32()), ("frame_no", pa.int32()),
-    ("predicate", pa.string()), ("known", pa.bool_()), ("pred_start", pa.int32()), ("pred_end", pa.int32()),
-    ("ambiguous_role", pa.string()), ("resolved_by_prior", pa.bool_()),
-])
-ROLE_SCHEMA = pa.schema([
-    ("corpus", pa.string()), ("doc_id", pa.string()), ("sent_id", pa.int32()), ("frame_no", pa.int32()),
-    ("role", pa.string()), ("value", pa.string()), ("span_start", pa.int32()), ("span_end", pa.int32()),
-])
+FRAME_SCHEMA = pa.schema(
+    [
+        ("corpus", pa.string()),
+        ("doc_id", pa.string()),
+        ("sent_id", pa.int32()),
+        ("frame_no", pa.int32()),
+        ("predicate", pa.string()),
+        ("known", pa.bool_()),
+        ("pred_start", pa.int32()),
+        ("pred_end", pa.int32()),
+        ("ambiguous_role", pa.string()),
+        ("resolved_by_prior", pa.bool_()),
+    ]
+)
+ROLE_SCHEMA = pa.schema(
+    [
+        ("corpus", pa.string()),
+        ("doc_id", pa.string()),
+        ("sent_id", pa.int32()),
+        ("frame_no", pa.int32()),
+        ("role", pa.string()),
+        ("value", pa.string()),
+        ("span_start", pa.int32()),
+        ("span_end", pa.int32()),
+    ]
+)
 
 
 @dataclass(frozen=True)
@@ -89,7 +106,9 @@ def _parser_setup(job: ShardJob) -> str:
 def build_fingerprint(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, compounds_path: Path) -> str:
     """Everything a frame corpus depends on: ingested files, settings, SRL code, learned compounds."""
     files = con.execute("select source_file, sha256, corpus from ingested_files order by all").fetchall()
-    digest = hashlib.sha256(repr((files, config.kinds, config.shard_size, config.model, config.first_word_sample)).encode())
+    digest = hashlib.sha256(
+        repr((files, config.kinds, config.shard_size, config.model, config.first_word_sample)).encode()
+    )
     digest.update(code_fingerprint().encode())
     digest.update(_file_hash(compounds_path).encode())
     return digest.hexdigest()
@@ -105,11 +124,14 @@ def export_shards(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, out
         "                  order by corpus, doc_id, sent_id) as occurrences, "
         "       min(corpus || '/' || doc_id || '/' || lpad(sent_id::varchar, 6, '0')) as first_key, "
         "       sum(n_words)::bigint as words "
-        "from sentences where list_contains(?, kind) group by text", [list(config.kinds)],
+        "from sentences where list_contains(?, kind) group by text",
+        [list(config.kinds)],
     )
-    con.execute("create or replace temp table _frame_input as select *, "
-                "(row_number() over (order by first_key, text) - 1) // ? as shard from _frame_texts",
-                [config.shard_size])
+    con.execute(
+        "create or replace temp table _frame_input as select *, "
+        "(row_number() over (order by first_key, text) - 1) // ? as shard from _frame_texts",
+        [config.shard_size],
+    )
     stats = con.execute(
         "select shard, sum(len(occurrences)), sum(words), md5(string_agg(first_key || '#' || text, '\n' "
         "order by first_key, text)) from _frame_input group by shard order by shard"
@@ -119,8 +141,10 @@ def export_shards(con: duckdb.DuckDBPyConnection, config: FrameCorpusConfig, out
         path = out_dir / f"texts-{md5}.parquet"
         if not path.exists():
             with atomic_path(path) as tmp:
-                con.execute(f"copy (select text, occurrences from _frame_input where shard = {int(number)} "
-                            f"order by first_key, text) to '{tmp}' (format parquet)")
+                con.execute(
+                    f"copy (select text, occurrences from _frame_input where shard = {int(number)} "
+                    f"order by first_key, text) to '{tmp}' (format parquet)"
+                )
         shards.append(Shard(int(number), str(path), md5, int(count), int(words)))
     con.execute("drop table _frame_input")
     con.execute("drop table _frame_texts")
@@ -142,7 +166,7 @@ def learn_first_words(shards: list[Shard], job: ShardJob, sample: int) -> ShardJ
     table from shard to shard made each shard's frames depend on the shards it happened to parse before
     (two builds of the same corpus differed by about 55 frames)."""
     texts = [t for shard in shards for t in pq.read_table(shard.path, columns=["text"]).column("text").to_pylist()]
-    chosen = texts[::max(1, -(-len(texts) // max(1, sample)))]
+    chosen = texts[:: max(1, -(-len(texts) // max(1, sample)))]
     key = hashlib.sha256("\n".join([_parser_setup(job), *chosen]).encode())
     path = Path(job.out_dir) / f"first-words-{key.hexdigest()[:24]}.json"
 
@@ -162,9 +186,17 @@ def frame_rows(corpus: str, doc_id: str, sent_id: int, frames: list[FrameMention
     frame_rows, role_rows = [], []
     for number, frame in enumerate(frames):
         key = {"corpus": corpus, "doc_id": doc_id, "sent_id": sent_id, "frame_no": number}
-        frame_rows.append({**key, "predicate": frame.predicate, "known": frame.known, "pred_start": frame.start,
-                           "pred_end": frame.end, "ambiguous_role": frame.ambiguous_object,
-                           "resolved_by_prior": False})
+        frame_rows.append(
+            {
+                **key,
+                "predicate": frame.predicate,
+                "known": frame.known,
+                "pred_start": frame.start,
+                "pred_end": frame.end,
+                "ambiguous_role": frame.ambiguous_object,
+                "resolved_by_prior": False,
+            }
+        )
         for role, value in frame.roles.items():
             start, end = frame.spans.get(role, (None, None))
             role_rows.append({**key, "role": role, "value": value, "span_start": start, "span_end": end})
@@ -195,7 +227,12 @@ def parse_shard(shard: Shard, job: ShardJob) -> ShardResult:
             all_roles += r_rows
     write_parquet_atomic(all_roles, ROLE_SCHEMA, roles_path)
     write_parquet_atomic(all_frames, FRAME_SCHEMA, frames_path)
-    return ShardResult(shard, str(frames_path), str(roles_path), len(all_frames),
-                       parser.stats.reparsed - before[0], parser.stats.accepted - before[1], cached=False)
-
-
+    return ShardResult(
+        shard,
+        str(frames_path),
+        str(roles_path),
+        len(all_frames),
+        parser.stats.reparsed - before[0],
+        parser.stats.accepted - before[1],
+        cached=False,
+    )

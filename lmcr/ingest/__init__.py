@@ -12,6 +12,16 @@ from lmcr.ingest.sources import FORMATS, Source, detect_format, expand_corpora, 
 from lmcr.ingest.stage import StagedFile, already_loaded, load_staged, stage
 
 __all__ = [
-    "FORMATS", "IngestError", "ParsedFile", "Source", "StagedFile", "already_loaded", "detect_format",
-    "expand_corpora", "expand_inputs", "load_staged", "parse_source", "stage",
+    "FORMATS",
+    "IngestError",
+    "ParsedFile",
+    "Source",
+    "StagedFile",
+    "already_loaded",
+    "detect_format",
+    "expand_corpora",
+    "expand_inputs",
+    "load_staged",
+    "parse_source",
+    "stage",
 ]

@@ -101,7 +101,13 @@ def parse_epic_kitchens(path: Path, corpus: str = "household") -> ParsedFile:
         videos[match["video"]].append((int(match["n"]), text, subset))
     for position, video in enumerate(sorted(videos), start=1):
         narrations = sorted(videos[video])
-        parsed.add_document(f"epic:{video}", "epic_kitchens", position,
-                            [("instruction", text) for _, text, _ in narrations],
-                            category=video.split("_")[0], subset=narrations[0][2], records=len(narrations))
+        parsed.add_document(
+            f"epic:{video}",
+            "epic_kitchens",
+            position,
+            [("instruction", text) for _, text, _ in narrations],
+            category=video.split("_")[0],
+            subset=narrations[0][2],
+            records=len(narrations),
+        )
     return parsed

@@ -65,8 +65,11 @@ def parse_feeding_america(path: Path, corpus: str = "recipes") -> ParsedFile:
         _collect(recipe, "instruction", parts)
         titles = [text for kind, text, _ in parts if kind == "title"]
         parsed.add_document(
-            f"{book}:{ordinal}", f"feeding_america:{book}", line or ordinal,
+            f"{book}:{ordinal}",
+            f"feeding_america:{book}",
+            line or ordinal,
             [(kind, text) for kind, text, _ in parts],
-            title=" ".join(titles) or None, category=recipe.get("class1"),
+            title=" ".join(titles) or None,
+            category=recipe.get("class1"),
         )
     return parsed

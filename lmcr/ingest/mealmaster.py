@@ -113,7 +113,7 @@ def _ingredient(column: str) -> str:
     return " ".join(column.split())
 
 
-def parse_mealmaster(path: Path, corpus: str = "recipes", encoding: str | None = None) -> ParsedFile:
+def parse_mealmaster(path: Path, corpus: str = "recipes", encoding: str | None = None) -> ParsedFile:  # noqa: C901 - the format's grammar: a branch per kind of line
     """Read every recipe block; untitled or unterminated blocks and stray text are quarantined."""
     try:
         text = decode(path.read_bytes(), str(path), encoding)
@@ -135,12 +135,19 @@ def parse_mealmaster(path: Path, corpus: str = "recipes", encoding: str | None =
         elif not b.header.get("title"):
             parsed.reject(b.line, "recipe block has no Title: line", "")
         else:
-            parsed.add_document(f"{stem}:{ordinal}", f"mealmaster:{stem}", b.line, b.parts(),
-                                title=b.header["title"], category=b.header.get("categories"))
+            parsed.add_document(
+                f"{stem}:{ordinal}",
+                f"mealmaster:{stem}",
+                b.line,
+                b.parts(),
+                title=b.header["title"],
+                category=b.header.get("categories"),
+            )
 
     for line_no, line in enumerate(text.splitlines(), start=1):
-        starts = START_RE.match(line) or (block is None and HEADER_RE.match(line)
-                                          and HEADER_RE.match(line).group(1).lower() == "title")
+        starts = START_RE.match(line) or (
+            block is None and HEADER_RE.match(line) and HEADER_RE.match(line).group(1).lower() == "title"
+        )
         if starts:
             if block is not None:
                 close(block, f"recipe block has no end marker before the next recipe at line {line_no}")

@@ -46,11 +46,16 @@ class ParsedFile:
     def reject(self, position: int | None, reason: str, record: object = "") -> None:
         """Quarantine one input record with the reason it failed validation."""
         self.records_in += 1
-        self.rejects.append({
-            "stage": "ingest", "corpus": self.corpus, "source_file": self.source_file,
-            "position": position, "reason": reason,
-            "record": str(record)[:2000].encode("utf-8", "backslashreplace").decode("utf-8"),
-        })
+        self.rejects.append(
+            {
+                "stage": "ingest",
+                "corpus": self.corpus,
+                "source_file": self.source_file,
+                "position": position,
+                "reason": reason,
+                "record": str(record)[:2000].encode("utf-8", "backslashreplace").decode("utf-8"),
+            }
+        )
 
     def add_document(
         self,
@@ -77,27 +82,43 @@ class ParsedFile:
             return
         self.records_in += records
         self.records_loaded += records
-        self.documents.append({
-            "corpus": self.corpus, "source": source, "doc_id": doc_id,
-            "title": normalize(title) if title else None, "category": category, "subset": subset,
-            "url": url, "source_file": self.source_file, "position": position,
-        })
+        self.documents.append(
+            {
+                "corpus": self.corpus,
+                "source": source,
+                "doc_id": doc_id,
+                "title": normalize(title) if title else None,
+                "category": category,
+                "subset": subset,
+                "url": url,
+                "source_file": self.source_file,
+                "position": position,
+            }
+        )
         self.sentences.extend(sentences)
 
     def _sentences(self, doc_id: str, source: str, position: int, parts: Iterable[tuple]):
         sent_id = 0
         for kind, raw, *extra in parts:
-            if kind not in KINDS:
+            if kind not in KINDS:  # a bug in a format's parser, not in its input
                 raise ValueError(f"unknown sentence kind {kind!r}")
             pieces = split_sentences(raw) if kind in PROSE_KINDS else [normalize(raw)]
             for text in pieces:
                 if not text:
                     continue
                 yield {
-                    "corpus": self.corpus, "source": source, "doc_id": doc_id, "sent_id": sent_id,
-                    "kind": kind, "text": text, "n_words": count_words(text),
-                    "source_file": self.source_file, "position": position,
-                    "seg_start": None, "seg_end": None, **(extra[0] if extra else {}),
+                    "corpus": self.corpus,
+                    "source": source,
+                    "doc_id": doc_id,
+                    "sent_id": sent_id,
+                    "kind": kind,
+                    "text": text,
+                    "n_words": count_words(text),
+                    "source_file": self.source_file,
+                    "position": position,
+                    "seg_start": None,
+                    "seg_end": None,
+                    **(extra[0] if extra else {}),
                 }
                 sent_id += 1
 

@@ -16,7 +16,9 @@ from lmcr.ingest.recipe_json import parse_recipe_json
 from lmcr.ingest.records import IngestError, ParsedFile
 from lmcr.ingest.virtualhome import parse_virtualhome
 from lmcr.ingest.youcook2 import parse_youcook2
+from lmcr.jsonl import InputError
 from lmcr.setting import SOURCE_CORPORA as CORPORA
+from lmcr.setting import SettingError
 
 FORMATS: dict[str, Callable[..., ParsedFile]] = {
     "youcook2": parse_youcook2,
@@ -54,7 +56,6 @@ class Source:
             except OSError as exc:
                 raise unreadable(file, exc) from exc
         return digest.hexdigest()
-
 
     def files(self) -> list[Path]:
         """The files the source's adapter reads."""
@@ -104,53 +105,59 @@ def detect_format(path: Path) -> str:
     return _sniff(path)
 
 
-def expand_inputs(
-    paths: list[Path], corpus: str, fmt: str | None = None, encoding: str | None = None
-) -> list[Source]:
+def expand_inputs(paths: list[Path], corpus: str, fmt: str | None = None, encoding: str | None = None) -> list[Source]:
     """Sources for user paths: a folder of XML or text exports gives one source per file (so they
     parse in parallel); a folder of JSON files is one source; missing paths fail clearly."""
     if corpus not in CORPORA:
-        raise ValueError(f"corpus must be one of {CORPORA}, not {corpus!r}")
+        raise SettingError(f"corpus must be one of {CORPORA}, not {corpus!r}")
     if fmt is not None and fmt not in FORMATS:
-        raise ValueError(f"format must be one of {sorted(FORMATS)}, not {fmt!r}")
+        raise InputError(f"format must be one of {sorted(FORMATS)}, not {fmt!r}")
     sources: list[Source] = []
     for path in (Path(p).resolve() for p in paths):
         if not path.exists():
             raise IngestError(str(path), None, "no such file or folder")
-        if path.is_dir() and corpus == "household" and fmt is None:
-            sources += _household_sources(path, encoding)
-            continue
-        if path.is_dir() and corpus == "youcook2":
-            files = sorted(path.glob("*.json"))
-            if not files:
-                raise IngestError(str(path), None, "folder holds no YouCook2 .json annotation files")
-            sources += [Source(f, fmt or "youcook2", corpus, encoding) for f in files]
-            continue
-        if path.is_dir():
-            files = sorted(p for p in path.iterdir() if p.suffix.lower() in (".xml", *TEXT_SUFFIXES))
-            if files and not any(path.rglob("*.json")):
-                sources += [Source(f, fmt or detect_format(f), corpus, encoding) for f in files]
-                continue
-            if not any(path.rglob("*.json")):
-                raise IngestError(str(path), None, "folder holds no .json, .xml or recipe text files")
-        sources.append(Source(path, fmt or detect_format(path), corpus, encoding))
+        sources += _path_sources(path, corpus, fmt, encoding)
     return sources
+
+
+def _path_sources(path: Path, corpus: str, fmt: str | None, encoding: str | None) -> list[Source]:
+    """The sources of one existing user path: a file, or a folder as `expand_inputs` describes."""
+    if path.is_dir() and corpus == "household" and fmt is None:
+        return _household_sources(path, encoding)
+    if path.is_dir() and corpus == "youcook2":
+        files = sorted(path.glob("*.json"))
+        if not files:
+            raise IngestError(str(path), None, "folder holds no YouCook2 .json annotation files")
+        return [Source(f, fmt or "youcook2", corpus, encoding) for f in files]
+    if path.is_dir() and not any(path.rglob("*.json")):
+        files = sorted(p for p in path.iterdir() if p.suffix.lower() in (".xml", *TEXT_SUFFIXES))
+        if not files:
+            raise IngestError(str(path), None, "folder holds no .json, .xml or recipe text files")
+        return [Source(f, fmt or detect_format(f), corpus, encoding) for f in files]
+    return [Source(path, fmt or detect_format(path), corpus, encoding)]
 
 
 def expand_corpora(paths: dict[str, list], fmt: str | None = None, encoding: str | None = None) -> list[Source]:
     """Sources for each corpus's user paths ({"recipes": [...], "household": [...]}), corpus by corpus."""
     unknown = set(paths) - set(CORPORA)
     if unknown:
-        raise ValueError(f"corpus must be one of {CORPORA}, not {sorted(unknown)[0]!r}")
-    return [s for corpus in CORPORA for s in expand_inputs([Path(p) for p in paths.get(corpus) or []], corpus, fmt, encoding)]
+        raise SettingError(f"corpus must be one of {CORPORA}, not {sorted(unknown)[0]!r}")
+    return [
+        s
+        for corpus in CORPORA
+        for s in expand_inputs([Path(p) for p in paths.get(corpus) or []], corpus, fmt, encoding)
+    ]
 
 
 def _household_sources(path: Path, encoding: str | None) -> list[Source]:
     """A household folder: its EPIC-KITCHENS narration CSVs as one source (their overlap is settled
     together), each VirtualHome program file as its own."""
     sources = [Source(path, "epic_kitchens", "household", encoding)] if narration_files(path) else []
-    sources += [Source(f, "virtualhome", "household", encoding) for f in sorted(path.rglob("*.json"))
-                if _sniff_or_none(f) == "virtualhome"]
+    sources += [
+        Source(f, "virtualhome", "household", encoding)
+        for f in sorted(path.rglob("*.json"))
+        if _sniff_or_none(f) == "virtualhome"
+    ]
     if not sources:
         raise IngestError(str(path), None, "folder holds no EPIC-KITCHENS narration CSV or VirtualHome program file")
     return sources

@@ -14,20 +14,44 @@ from lmcr.ingest.records import IngestError, ParsedFile
 from lmcr.ingest.sources import Source
 from lmcr.store import insert_rows, transaction
 
-DOCUMENT_SCHEMA = pa.schema([
-    ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("title", pa.string()),
-    ("category", pa.string()), ("subset", pa.string()), ("url", pa.string()),
-    ("source_file", pa.string()), ("position", pa.int32()),
-])
-SENTENCE_SCHEMA = pa.schema([
-    ("corpus", pa.string()), ("source", pa.string()), ("doc_id", pa.string()), ("sent_id", pa.int32()),
-    ("kind", pa.string()), ("text", pa.string()), ("n_words", pa.int32()), ("source_file", pa.string()),
-    ("position", pa.int32()), ("seg_start", pa.float64()), ("seg_end", pa.float64()),
-])
-QUARANTINE_SCHEMA = pa.schema([
-    ("stage", pa.string()), ("corpus", pa.string()), ("source_file", pa.string()),
-    ("position", pa.int32()), ("reason", pa.string()), ("record", pa.string()),
-])
+DOCUMENT_SCHEMA = pa.schema(
+    [
+        ("corpus", pa.string()),
+        ("source", pa.string()),
+        ("doc_id", pa.string()),
+        ("title", pa.string()),
+        ("category", pa.string()),
+        ("subset", pa.string()),
+        ("url", pa.string()),
+        ("source_file", pa.string()),
+        ("position", pa.int32()),
+    ]
+)
+SENTENCE_SCHEMA = pa.schema(
+    [
+        ("corpus", pa.string()),
+        ("source", pa.string()),
+        ("doc_id", pa.string()),
+        ("sent_id", pa.int32()),
+        ("kind", pa.string()),
+        ("text", pa.string()),
+        ("n_words", pa.int32()),
+        ("source_file", pa.string()),
+        ("position", pa.int32()),
+        ("seg_start", pa.float64()),
+        ("seg_end", pa.float64()),
+    ]
+)
+QUARANTINE_SCHEMA = pa.schema(
+    [
+        ("stage", pa.string()),
+        ("corpus", pa.string()),
+        ("source_file", pa.string()),
+        ("position", pa.int32()),
+        ("reason", pa.string()),
+        ("record", pa.string()),
+    ]
+)
 TABLES = {"documents": DOCUMENT_SCHEMA, "sentences": SENTENCE_SCHEMA, "quarantine": QUARANTINE_SCHEMA}
 
 
@@ -64,11 +88,18 @@ def stage(source: Source, parsed: ParsedFile, sha256: str, staging_dir: Path) ->
         write_parquet_atomic(rows[table], schema, path)
         paths[table] = str(path)
     return StagedFile(
-        source_file=source.key, sha256=sha256, format=source.format, corpus=source.corpus,
-        encoding=source.encoding or "", parquet=paths,
-        records_in=parsed.records_in, records_loaded=parsed.records_loaded,
-        records_quarantined=len(parsed.rejects), documents=len(parsed.documents),
-        sentences=len(parsed.sentences), words=parsed.words,
+        source_file=source.key,
+        sha256=sha256,
+        format=source.format,
+        corpus=source.corpus,
+        encoding=source.encoding or "",
+        parquet=paths,
+        records_in=parsed.records_in,
+        records_loaded=parsed.records_loaded,
+        records_quarantined=len(parsed.rejects),
+        documents=len(parsed.documents),
+        sentences=len(parsed.sentences),
+        words=parsed.words,
     )
 
 
@@ -76,13 +107,20 @@ def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) 
     """True when this exact content (same bytes, adapter and encoding) is loaded, from this path (a
     re-ingest is a no-op) or another (a copy: loading it again would count every sentence twice). A path
     already loaded into another corpus is an IngestError: re-ingesting it must not move its rows."""
-    other = con.execute("select corpus from ingested_files where source_file = ? and corpus <> ?",
-                        [source.key, source.corpus]).fetchone()
+    other = con.execute(
+        "select corpus from ingested_files where source_file = ? and corpus <> ?", [source.key, source.corpus]
+    ).fetchone()
     if other:
-        raise IngestError(source.key, None, f"already loaded into corpus {other[0]!r}, not {source.corpus!r}; "
-                                            "its rows stay there (ingest it with the same flag)")
-    row = con.execute("select 1 from ingested_files where sha256 = ? and format = ? and encoding = ?",
-                      [sha256, source.format, source.encoding or ""]).fetchone()
+        raise IngestError(
+            source.key,
+            None,
+            f"already loaded into corpus {other[0]!r}, not {source.corpus!r}; "
+            "its rows stay there (ingest it with the same flag)",
+        )
+    row = con.execute(
+        "select 1 from ingested_files where sha256 = ? and format = ? and encoding = ?",
+        [sha256, source.format, source.encoding or ""],
+    ).fetchone()
     return row is not None
 
 
@@ -96,15 +134,34 @@ def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
         [staged.parquet["documents"]],
     ).fetchone()
     if clash:
-        raise IngestError(staged.source_file, None,
-                          f"document id {clash[0]!r} is already loaded from {clash[1]}; rename one file")
+        raise IngestError(
+            staged.source_file, None, f"document id {clash[0]!r} is already loaded from {clash[1]}; rename one file"
+        )
     for table, schema in TABLES.items():
         columns = ", ".join(schema.names)
-        con.execute(f"insert into {table} ({columns}) select {columns} from read_parquet(?)",
-                    [staged.parquet[table]])
-    insert_rows(con, "ingested_files", [{k: getattr(staged, k) for k in (
-        "source_file", "sha256", "format", "corpus", "encoding", "records_in", "records_loaded", "records_quarantined",
-        "documents", "sentences", "words")}])
+        con.execute(f"insert into {table} ({columns}) select {columns} from read_parquet(?)", [staged.parquet[table]])
+    insert_rows(
+        con,
+        "ingested_files",
+        [
+            {
+                k: getattr(staged, k)
+                for k in (
+                    "source_file",
+                    "sha256",
+                    "format",
+                    "corpus",
+                    "encoding",
+                    "records_in",
+                    "records_loaded",
+                    "records_quarantined",
+                    "documents",
+                    "sentences",
+                    "words",
+                )
+            }
+        ],
+    )
 
 
 def load_staged(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:

@@ -58,6 +58,12 @@ def parse_virtualhome(path: Path, corpus: str = "household") -> ParsedFile:
             continue
         task, steps = read
         doc_id = "virtualhome:" + hashlib.sha256(program.encode()).hexdigest()[:12]
-        parsed.add_document(doc_id, "virtualhome", position, [("title", task)] + [("instruction", s) for s in steps],
-                            title=task, records=1)
+        parsed.add_document(
+            doc_id,
+            "virtualhome",
+            position,
+            [("title", task)] + [("instruction", s) for s in steps],
+            title=task,
+            records=1,
+        )
     return parsed

@@ -33,7 +33,7 @@ def _annotation_problem(annotation: object) -> str | None:
     return None
 
 
-def parse_youcook2(path: Path, corpus: str = "youcook2") -> ParsedFile:
+def parse_youcook2(path: Path, corpus: str = "youcook2") -> ParsedFile:  # noqa: C901 - the annotation schema: a check per field that can be malformed
     """Read the annotations file; a malformed annotation is quarantined, its video's other steps kept."""
     parsed = ParsedFile(str(path), "youcook2", corpus)
     try:
@@ -48,8 +48,9 @@ def parse_youcook2(path: Path, corpus: str = "youcook2") -> ParsedFile:
         raise IngestError(str(path), None, f'"database" is a {type(database).__name__}, not an object of videos')
     for ordinal, (video_id, video) in enumerate(database.items(), start=1):
         annotations = video.get("annotations") if isinstance(video, dict) else None
-        if has_surrogates([video_id, {k: v for k, v in video.items() if k != "annotations"}]
-                          if isinstance(video, dict) else video_id):
+        if has_surrogates(
+            [video_id, {k: v for k, v in video.items() if k != "annotations"}] if isinstance(video, dict) else video_id
+        ):
             parsed.reject(ordinal, "video id or metadata has an unpaired surrogate", video_id)
             continue
         if not isinstance(annotations, list) or not annotations:
@@ -65,7 +66,13 @@ def parse_youcook2(path: Path, corpus: str = "youcook2") -> ParsedFile:
             parts.append(("instruction", annotation["sentence"], {"seg_start": start, "seg_end": end}))
         if parts:
             parsed.add_document(
-                video_id, "youcook2", ordinal, parts, category=_text(video.get("recipe_type")),
-                subset=_text(video.get("subset")), url=_text(video.get("video_url")), records=len(parts),
+                video_id,
+                "youcook2",
+                ordinal,
+                parts,
+                category=_text(video.get("recipe_type")),
+                subset=_text(video.get("subset")),
+                url=_text(video.get("video_url")),
+                records=len(parts),
             )
     return parsed

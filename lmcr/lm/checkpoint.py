@@ -18,14 +18,15 @@ import torch
 from lmcr.errors import one_line
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
+from lmcr.setting import Setting
 from lmcr.versions import (  # noqa: F401 - the checkpoint API callers use
     CheckpointError,
     publish_version,
     remove_stale_tmp,
     resolve,
-    set_latest,
     write_json,
 )
+from lmcr.versions import set_latest as set_latest_version
 from lmcr.versions import verify as verify_version
 
 FILES = ("model.pt", "model.json", "vocab.json", "linearization.json", "metrics.json", "provenance.json")
@@ -42,18 +43,34 @@ class Checkpoint:
     articles: bool = True  # whether its text kept a/an/the (`lm.linearize`); checkpoints before the key did
 
 
-def publish(root: Path, setting: str, model: RecurrentLM, vocab: Vocab, linearization: str,
-            metrics: dict, provenance: dict, promote: bool = True, articles: bool = True) -> Path:
-    """Write a new version of `setting` atomically; point LATEST at it when `promote` (callers that
-    record the run first publish with promote=False and call `set_latest` after recording)."""
+def publish(
+    root: Path,
+    setting: Setting,
+    model: RecurrentLM,
+    vocab: Vocab,
+    metrics: dict,
+    provenance: dict,
+    promote: bool = True,
+    articles: bool = True,
+) -> Path:
+    """Write a new version of `setting` (a model of its linearisation) atomically; point LATEST at it when
+    `promote` (callers that record the run first publish with promote=False and call `set_latest` after
+    recording)."""
+
     def write(folder: Path) -> None:
         torch.save({k: v.cpu() for k, v in model.state_dict().items()}, folder / "model.pt")
         write_json(folder / "model.json", model.config.to_json())
         write_json(folder / "vocab.json", vocab.to_json())
-        write_json(folder / "linearization.json", {"linearization": linearization, "articles": articles})
+        write_json(folder / "linearization.json", {"linearization": setting.linearization, "articles": articles})
         write_json(folder / "metrics.json", metrics)
         write_json(folder / "provenance.json", provenance)
-    return publish_version(root, setting, FILES, write, promote)
+
+    return publish_version(root, setting.name, FILES, write, promote)
+
+
+def set_latest(root: Path, setting: Setting, version: str) -> None:
+    """Point `setting`'s LATEST under the checkpoints `root` at `version`."""
+    set_latest_version(root, setting.name, version)
 
 
 def verify(path: Path) -> dict:
@@ -72,10 +89,12 @@ def read_weights(file: Path, device: str = "cpu") -> dict[str, torch.Tensor]:
     except pickle.UnpicklingError:
         raise CheckpointError(f"{file}: not a weights-only state dict; refusing to load it") from None
     except (EOFError, KeyError, ValueError, RuntimeError, OSError) as exc:  # cut short, not a torch file
-        raise CheckpointError(f"{file}: not a torch weights file ({type(exc).__name__}: "
-                              f"{one_line(exc, 200) or 'no reason given'})") from exc
-    if not isinstance(state, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
-                                              for k, v in state.items()):
+        raise CheckpointError(
+            f"{file}: not a torch weights file ({type(exc).__name__}: {one_line(exc, 200) or 'no reason given'})"
+        ) from exc
+    if not isinstance(state, dict) or not all(
+        isinstance(k, str) and isinstance(v, torch.Tensor) for k, v in state.items()
+    ):
         raise CheckpointError(f"{file}: not a state dict of named tensors; refusing to load it")
     return state
 
@@ -93,8 +112,15 @@ def load(path: Path, device: str = "cpu") -> Checkpoint:
         model = RecurrentLM(LMConfig(**read("model.json")))
         model.load_state_dict(weights)
         text = read("linearization.json")
-        checkpoint = Checkpoint(path, model.eval(), Vocab.from_json(read("vocab.json")), text["linearization"],
-                                read("metrics.json"), read("provenance.json"), bool(text.get("articles", True)))
+        checkpoint = Checkpoint(
+            path,
+            model.eval(),
+            Vocab.from_json(read("vocab.json")),
+            text["linearization"],
+            read("metrics.json"),
+            read("provenance.json"),
+            bool(text.get("articles", True)),
+        )
     except (ValueError, KeyError, TypeError, RuntimeError, EOFError, OSError) as exc:
         raise CheckpointError(f"{path}: cannot load: {one_line(exc, 200) or type(exc).__name__}") from exc
     if not path.parent.name.startswith(f"{checkpoint.linearization}-"):

@@ -27,22 +27,27 @@ def _corpus_filter(corpus: str) -> str:
     return "" if corpus == "all" else f"and s.corpus = '{corpus}'"
 
 
-def sentence_sequences(con: duckdb.DuckDBPyConnection, setting: str, kinds: tuple[str, ...],
-                       articles: bool = True) -> list[tuple[str, list[str]]]:
+def sentence_sequences(
+    con: duckdb.DuckDBPyConnection, corpus: str, kinds: tuple[str, ...], articles: bool = True
+) -> list[tuple[str, list[str]]]:
+    """The tokens of every sentence of `kinds` in `corpus` (`all`: every corpus), with its document."""
     rows = con.execute(
-        f"select s.doc_id, s.text from sentences s where list_contains(?, s.kind) {_corpus_filter(setting)} "
-        "order by s.corpus, s.doc_id, s.sent_id", [list(kinds)]).fetchall()
+        f"select s.doc_id, s.text from sentences s where list_contains(?, s.kind) {_corpus_filter(corpus)} "
+        "order by s.corpus, s.doc_id, s.sent_id",
+        [list(kinds)],
+    ).fetchall()
     return [(doc, tokens(text, articles)) for doc, text in rows]
 
 
-def frame_sequences(con: duckdb.DuckDBPyConnection, setting: str) -> list[tuple[str, list[str]]]:
+def frame_sequences(con: duckdb.DuckDBPyConnection, corpus: str) -> list[tuple[str, list[str]]]:
     """Every frame with at least one role value, linearised: robot predicates in lexicon role order,
     generic frames in the order their arguments appear in the sentence."""
     rows = con.execute(
         "select s.doc_id, s.predicate, list(r.role order by r.span_start), list(r.value order by r.span_start) "
         "from frames s join frame_roles r using (corpus, doc_id, sent_id, frame_no) "
-        f"where r.value is not null {_corpus_filter(setting)} "
-        "group by s.corpus, s.doc_id, s.sent_id, s.frame_no, s.predicate order by s.corpus, s.doc_id, s.sent_id, s.frame_no"
+        f"where r.value is not null {_corpus_filter(corpus)} "
+        "group by s.corpus, s.doc_id, s.sent_id, s.frame_no, s.predicate "
+        "order by s.corpus, s.doc_id, s.sent_id, s.frame_no"
     ).fetchall()
     lex = load_lexicon()
     return [(doc, tokens(frame_text(pred, dict(zip(roles, values)), lex))) for doc, pred, roles, values in rows]
@@ -55,19 +60,29 @@ def corpus_hash(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
     return hashlib.sha256(repr((files, build if linearization == "frame" else None)).encode()).hexdigest()
 
 
-def training_text(con: duckdb.DuckDBPyConnection, linearization: str, setting: str,
-                  kinds: tuple[str, ...] = ("instruction",), articles: bool = True) -> TrainingText:
-    """The setting's sequences for a linearisation, split by document (5% held out); without
+def training_text(
+    con: duckdb.DuckDBPyConnection,
+    setting: Setting,
+    kinds: tuple[str, ...] = ("instruction",),
+    articles: bool = True,
+) -> TrainingText:
+    """The setting's sequences (its linearisation of its corpus), split by document (5% held out); without
     `articles`, sentences lose a/an/the (frames have none)."""
-    Setting(linearization, setting)  # validates both
-    pairs = (sentence_sequences(con, setting, kinds, articles) if linearization == "sentence"
-             else frame_sequences(con, setting))
+    linearization = setting.linearization
+    pairs = (
+        sentence_sequences(con, setting.corpus, kinds, articles)
+        if linearization == "sentence"
+        else frame_sequences(con, setting.corpus)
+    )
     pairs = [(doc, seq) for doc, seq in pairs if len(seq) >= 2]
     held = split_by_document([doc for doc, _ in pairs])
     return TrainingText(
         train=[seq for (_, seq), h in zip(pairs, held) if not h],
         val=[seq for (_, seq), h in zip(pairs, held) if h],
-        provenance={"linearization": linearization, "corpus": setting,
-                    "kinds": list(kinds) if linearization == "sentence" else "frames",
-                    "corpus_sha256": corpus_hash(con, linearization)},
+        provenance={
+            "linearization": linearization,
+            "corpus": setting.corpus,
+            "kinds": list(kinds) if linearization == "sentence" else "frames",
+            "corpus_sha256": corpus_hash(con, linearization),
+        },
     )

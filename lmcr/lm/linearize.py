@@ -17,7 +17,7 @@ from __future__ import annotations
 import re
 
 from lmcr.lexicon import Lexicon, load_lexicon
-from lmcr.setting import LINEARIZATIONS
+from lmcr.setting import LINEARIZATIONS, SettingError
 
 _TOKEN = re.compile(r"[a-z]+(?:'[a-z]+)?|\d+(?:[./]\d+)?")
 NUMBER = "<num>"
@@ -45,7 +45,7 @@ def sentence_text(predicate: str, roles: dict[str, str], lex: Lexicon | None = N
     if spec is None:
         raise KeyError(f"no sentence template for predicate {predicate!r}")
     missing = [r for r in spec.roles if not roles.get(r)]
-    if missing:
+    if missing:  # a bug: scorers are only given complete frames
         raise ValueError(f"cannot linearise {predicate} with {missing} unfilled")
     return spec.sentence.format(**roles)
 
@@ -56,4 +56,4 @@ def linearize(linearization: str, predicate: str, roles: dict[str, str], lex: Le
         return frame_text(predicate, roles, lex)
     if linearization == "sentence":
         return sentence_text(predicate, roles, lex)
-    raise ValueError(f"linearization must be one of {LINEARIZATIONS}, not {linearization!r}")
+    raise SettingError(f"linearization must be one of {LINEARIZATIONS}, not {linearization!r}")

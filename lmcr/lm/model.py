@@ -18,8 +18,13 @@ class RecurrentLM(nn.Module):
         super().__init__()
         self.config = config
         self.embed = nn.Embedding(config.vocab_size, config.embedding, padding_idx=0)
-        self.rnn = nn.LSTM(config.embedding, config.embedding, config.layers, batch_first=True,
-                           dropout=config.dropout if config.layers > 1 else 0.0)
+        self.rnn = nn.LSTM(
+            config.embedding,
+            config.embedding,
+            config.layers,
+            batch_first=True,
+            dropout=config.dropout if config.layers > 1 else 0.0,
+        )
         self.drop = nn.Dropout(config.dropout)
         self.decoder = nn.Linear(config.embedding, config.vocab_size)
         self.decoder.weight = self.embed.weight  # tied: fewer parameters, better perplexity

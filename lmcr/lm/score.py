@@ -69,7 +69,8 @@ def _prepacked(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Callab
     no bf16 on this CPU. The same numbers as `F.linear` (tests/test_lm.py)."""
     try:
         usable = torch.backends.mkldnn.is_available() and (
-            weight.dtype != torch.bfloat16 or torch.ops.mkldnn._is_mkldnn_bf16_supported())
+            weight.dtype != torch.bfloat16 or torch.ops.mkldnn._is_mkldnn_bf16_supported()
+        )
         packed = torch.ops.mkldnn._reorder_linear_weight(weight, None) if usable else None
     except (AttributeError, RuntimeError):  # a build without these oneDNN ops
         packed = None
@@ -86,9 +87,13 @@ class _OneStep:
 
     def __init__(self, rnn: torch.nn.LSTM):
         self.dtype = rnn.weight_ih_l0.dtype
-        self.layers = [_prepacked(torch.cat([getattr(rnn, f"weight_ih_l{k}"), getattr(rnn, f"weight_hh_l{k}")], 1).detach(),
-                                  (getattr(rnn, f"bias_ih_l{k}") + getattr(rnn, f"bias_hh_l{k}")).detach().float())
-                       for k in range(rnn.num_layers)]
+        self.layers = [
+            _prepacked(
+                torch.cat([getattr(rnn, f"weight_ih_l{k}"), getattr(rnn, f"weight_hh_l{k}")], 1).detach(),
+                (getattr(rnn, f"bias_ih_l{k}") + getattr(rnn, f"bias_hh_l{k}")).detach().float(),
+            )
+            for k in range(rnn.num_layers)
+        ]
 
     def __call__(self, x: torch.Tensor, state: tuple[torch.Tensor, torch.Tensor]):
         """x (B, 1, E) and state ((layers, B, H) twice), fp32, as `nn.LSTM` takes and gives them."""
@@ -169,23 +174,25 @@ class LMScorer:
         """(total log-probability, number of scored tokens) for each text."""
         out: list[tuple[float, int]] = []
         for start in range(0, len(texts), self.chunk):
-            seqs = [self.encode(t) for t in texts[start:start + self.chunk]]
+            seqs = [self.encode(t) for t in texts[start : start + self.chunk]]
             totals = self._score(seqs)
             out += [(totals[i], len(seq) - 1) for i, seq in enumerate(seqs)]
         return out
 
     def score(self, texts: list[str], norm: str = "sum") -> list[float]:
-        if norm not in NORMS:
+        if norm not in NORMS:  # a bug: no command or configuration sets `norm`
             raise ValueError(f"norm must be one of {NORMS}")
         return [_normed(total, n, norm) for total, n in self.logprobs(texts)]
 
-    def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum") -> list[float]:
+    def score_frames(
+        self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum"
+    ) -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
         `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"): the score
         adds log P(context | frame), how well the frame serves what was said around it (`add_context`:
         read after the CONTEXT_TOP best frames). The context continues the LSTM from where each frame's
         text ended (`_Walk`), so the frames are not read twice."""
-        if norm not in NORMS:
+        if norm not in NORMS:  # a bug: no command or configuration sets `norm`
             raise ValueError(f"norm must be one of {NORMS}")
         ctx = self.context_ids(context)
         if not frames or not ctx:
@@ -197,6 +204,7 @@ class LMScorer:
         def gains(top: list[int]) -> list[float]:
             extra = self.context_logprobs(walk, top, ctx)
             return [_normed(walk.totals[i] + x, lengths[i] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)]
+
         return add_context(scores, gains)
 
     def frame_texts(self, frames: list[tuple[str, dict[str, str]]]) -> list[str]:
@@ -231,7 +239,7 @@ class LMScorer:
             return F.log_softmax(self._logits(rows), dim=-1)[picks, tokens_] - unknown
         edge = torch.empty(len(picks))
         for start in range(0, len(rows), DECODER_BLOCK):
-            logp = F.log_softmax(self._logits(rows[start:start + DECODER_BLOCK]), dim=-1)
+            logp = F.log_softmax(self._logits(rows[start : start + DECODER_BLOCK]), dim=-1)
             mine = (picks >= start) & (picks < start + DECODER_BLOCK)
             edge[mine] = logp[picks[mine] - start, tokens_[mine]]
         return edge - unknown
@@ -283,8 +291,11 @@ class LMScorer:
         children = list(range(1, len(trie.parent)))
         edge = torch.zeros(len(trie.parent))
         if children:
-            edge[1:] = self._edge_logprobs(torch.cat(rows), torch.tensor([row_of[trie.parent[n]] for n in children]),
-                                           torch.tensor([trie.token[n] for n in children]))
+            edge[1:] = self._edge_logprobs(
+                torch.cat(rows),
+                torch.tensor([row_of[trie.parent[n]] for n in children]),
+                torch.tensor([trie.token[n] for n in children]),
+            )
         total = edge.tolist()
         for node in range(1, len(total)):  # parents precede children: cumulative sums in one pass
             total[node] += total[trie.parent[node]]
@@ -342,7 +353,7 @@ class MixedLM:
     beyond its own text. And each LM that reads the context costs a decoder pass over its rows."""
 
     def __init__(self, experts: list[tuple[float, LMScorer]]):
-        if not experts or any(w <= 0 for w, _ in experts):
+        if not experts or any(w <= 0 for w, _ in experts):  # a bug: lm_experts keeps positive weights only
             raise ValueError("a mixture needs LMs with positive weights")
         self.experts = [(math.log(w), lm) for w, lm in experts]
 

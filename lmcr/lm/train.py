@@ -127,9 +127,16 @@ def train_lm(
         seconds = time.perf_counter() - started
         val_ppl = perplexity(model, val, config.batch_tokens, device)
         # Under the sampled softmax the training number is the sampled objective's, not a perplexity.
-        row = {"epoch": epoch, "train_ppl": math.exp(total / max(count, 1)), "val_ppl": val_ppl,
-               "tokens_per_s": count / seconds, "seconds": seconds, "device": device.type, "precision": precision,
-               "objective": "sampled" if model.config.uses_sampling else "full"}
+        row = {
+            "epoch": epoch,
+            "train_ppl": math.exp(total / max(count, 1)),
+            "val_ppl": val_ppl,
+            "tokens_per_s": count / seconds,
+            "seconds": seconds,
+            "device": device.type,
+            "precision": precision,
+            "objective": "sampled" if model.config.uses_sampling else "full",
+        }
         history.append(row)
         if on_epoch:
             on_epoch(row)

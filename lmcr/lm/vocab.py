@@ -29,8 +29,9 @@ class Vocab:
     def build(cls, sequences: Iterable[list[str]], min_freq: int = 3, max_size: int = 30_000) -> Vocab:
         """Words seen at least `min_freq` times, the `max_size` most frequent (ties broken alphabetically)."""
         counts = Counter(w for seq in sequences for w in seq)
-        kept = sorted((w for w, n in counts.items() if n >= min_freq and w not in SPECIALS),
-                      key=lambda w: (-counts[w], w))[: max_size - len(SPECIALS)]
+        kept = sorted(
+            (w for w, n in counts.items() if n >= min_freq and w not in SPECIALS), key=lambda w: (-counts[w], w)
+        )[: max_size - len(SPECIALS)]
         return cls(SPECIALS + tuple(kept), max(1, len(counts) - len(kept)))
 
     def __len__(self) -> int:

@@ -19,8 +19,9 @@ GRAIN_RADIUS = 0.003
 FINGERS_SET = 60  # simulation steps (1/4 s) for the fingers to take their shape before the arm moves
 
 
-def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject],
-             planner: Planner | None = None) -> dict:
+def run_plan(
+    plan: Plan, held: SceneObject, target: SceneObject, others: list[SceneObject], planner: Planner | None = None
+) -> dict:
     """Execute `plan` (its task); the result's `checks` hold the task's checks (and `knocked`: the ids of the
     `others`, the objects not in the task, that did not stay where they were) and `success` whether all
     passed. With the `planner`, a grasp that left the object in the hand otherwise than planned has the
@@ -46,63 +47,103 @@ def run_plan(plan: Plan, held: SceneObject, target: SceneObject, others: list[Sc
     # how far the target was pushed: not a check of its own (the task's checks fail when it matters),
     # but the reason to name when they do
     pushed = float(np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(target.body)[0], target_at)))
-    return {"success": bool(checks["ok"] and within and grasped and not moved), "waypoints": log,
-            "target_moved_m": round(pushed, 3), "replanned_after_grasp": out.replanned,
-            "checks": {**{k: v for k, v in checks.items() if k != "ok"}, "verb_check": bool(checks["ok"]),
-                       "grasped": grasped, "waypoints_within_tolerance": within, "knocked": moved},
-            **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {})}
+    return {
+        "success": bool(checks["ok"] and within and grasped and not moved),
+        "waypoints": log,
+        "target_moved_m": round(pushed, 3),
+        "replanned_after_grasp": out.replanned,
+        "checks": {
+            **{k: v for k, v in checks.items() if k != "ok"},
+            "verb_check": bool(checks["ok"]),
+            "grasped": grasped,
+            "waypoints_within_tolerance": within,
+            "knocked": moved,
+        },
+        **({"knocked_during": {k: knocked_during.get(k, "settling") for k in moved}} if moved else {}),
+    }
 
 
-def _act(plan: Plan, held: SceneObject, out: Outcome, others: list[SceneObject] = (),
-         before: dict[str, tuple] | None = None, planner: Planner | None = None) -> tuple[bool, bool, dict[str, str]]:
+def _act(
+    plan: Plan,
+    held: SceneObject,
+    out: Outcome,
+    others: list[SceneObject] = (),
+    before: dict[str, tuple] | None = None,
+    planner: Planner | None = None,
+) -> tuple[bool, bool, dict[str, str]]:
     """Follow the plan's segments: move, grasp, let go and pour where it says. Returns whether the grasp
     held, whether the object was let go, and for each of the `others` found moved (from `before`) the
     step during which it was first seen moved. Once the object is picked up, when it sits in the hand
     otherwise than planned, the rest is planned afresh (kept as planned when no new plan is found)."""
     arm = plan.arm
-    if plan.carried is not None:  # handed over: the fingers are closed on it from the start
-        arm.shape_fingers(arm.finger_targets(plan.half_width), now=True)
-        plan.carried.place(arm)
-        arm.attach(held.body)
-    else:  # the hand takes the shape it was planned to approach in before it moves
-        arm.shape_fingers(plan.fingers)
-        if not arm.fingers_at(plan.fingers):
-            settle(FINGERS_SET)
+    _ready_hand(arm, plan, held)
     grasped, released = True, False
     knocked_during: dict[str, str] = {}
     segments, picked = list(plan.segments), pick_steps([s.step for s in plan.segments])
     k = 0
     while k < len(segments):
-        step = segments[k].step
-        if step.moves:
-            arm.follow(segments[k].path)
-            arm.record(step.name, segments[k].goal)
-            if step.probe:
-                out.probes[step.probe] = (p.getBasePositionAndOrientation(held.body)[0], p.getAABB(held.body))
-        elif step.kind == "grasp":
-            grasped = arm.grasp(held.body, plan.half_width)
-            if not grasped:
-                break  # nothing in the hand: the rest of the program would act out nothing
-        elif step.kind == "release":
-            arm.release(plan.fingers)
-            released = True
-        elif step.kind == "spill":
-            out.particles += spill(held, plan.geometry.opening, step.particles)
+        grasped, let_go = _take_step(arm, segments[k], plan, held, out)
+        if not grasped:
+            break  # nothing in the hand: the rest of the program would act out nothing
+        released = released or let_go
         for ident in _moved(others, before or {}):
-            knocked_during.setdefault(ident, step.name)
+            knocked_during.setdefault(ident, segments[k].step.name)
         k += 1
         if k == picked and planner is not None:
-            in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
-            again = planner.replan_in_hand(plan, in_hand) if shifted(plan.geometry.in_hand(plan.variant), in_hand) else None
+            again = _replan_if_shifted(arm, plan, held, planner)
             if again is not None:
                 plan, segments[k:], out.replanned = again, again.segments, True
     return grasped, released, knocked_during
 
 
+def _ready_hand(arm, plan: Plan, held: SceneObject) -> None:
+    """Shape the hand before it moves: closed on the object when it is handed over, else in the shape
+    the plan approaches in."""
+    if plan.carried is not None:
+        arm.shape_fingers(arm.finger_targets(plan.half_width), now=True)
+        plan.carried.place(arm)
+        arm.attach(held.body)
+    else:
+        arm.shape_fingers(plan.fingers)
+        if not arm.fingers_at(plan.fingers):
+            settle(FINGERS_SET)
+
+
+def _take_step(arm, segment, plan: Plan, held: SceneObject, out: Outcome) -> tuple[bool, bool]:
+    """Act out one segment: move, grasp, let go or pour. Returns whether the hand still holds what it
+    should (False only when a grasp failed) and whether the object was let go."""
+    step = segment.step
+    if step.moves:
+        arm.follow(segment.path)
+        arm.record(step.name, segment.goal)
+        if step.probe:
+            out.probes[step.probe] = (p.getBasePositionAndOrientation(held.body)[0], p.getAABB(held.body))
+    elif step.kind == "grasp":
+        return arm.grasp(held.body, plan.half_width), False
+    elif step.kind == "release":
+        arm.release(plan.fingers)
+        return True, True
+    elif step.kind == "spill":
+        out.particles += spill(held, plan.geometry.opening, step.particles)
+    return True, False
+
+
+def _replan_if_shifted(arm, plan: Plan, held: SceneObject, planner: Planner) -> Plan | None:
+    """A new plan for the rest when the picked-up object sits in the hand otherwise than planned (None
+    when it sits as planned, or when no new plan is found)."""
+    in_hand = relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+    if not shifted(plan.geometry.in_hand(plan.variant), in_hand):
+        return None
+    return planner.replan_in_hand(plan, in_hand)
+
+
 def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
     """The ids of the objects (not in the task) that are now more than MOVED from where they stood."""
-    return sorted(o.id for o in others
-                  if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.id])) > MOVED)
+    return sorted(
+        o.id
+        for o in others
+        if np.linalg.norm(np.subtract(p.getBasePositionAndOrientation(o.body)[0], before[o.id])) > MOVED
+    )
 
 
 def spill(held: SceneObject, opening: float, n: int) -> list[int]:

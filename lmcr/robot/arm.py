@@ -69,10 +69,14 @@ class Arm:
         names = joint_index(self.robot)
         self.joints = [names[f"{self.side}_{j}"] for j in JOINTS]
         # ours: left_gripper_l_finger_joint; the official electric gripper's: l_gripper_l_finger_joint
-        self.fingers = [names.get(f"{self.side}_gripper_{f}_finger_joint", names.get(f"{self.side[0]}_gripper_{f}_finger_joint"))
-                        for f in "lr"]
+        self.fingers = [
+            names.get(f"{self.side}_gripper_{f}_finger_joint", names.get(f"{self.side[0]}_gripper_{f}_finger_joint"))
+            for f in "lr"
+        ]
         self.ee = names[f"{self.side}_endpoint"]
-        self.movable = [i for i in range(p.getNumJoints(self.robot)) if p.getJointInfo(self.robot, i)[2] != p.JOINT_FIXED]
+        self.movable = [
+            i for i in range(p.getNumJoints(self.robot)) if p.getJointInfo(self.robot, i)[2] != p.JOINT_FIXED
+        ]
         self.columns = [self.movable.index(j) for j in self.joints]  # this arm's columns of the Jacobian
         self.limits = np.array([p.getJointInfo(self.robot, j)[8:10] for j in self.joints])
         sign = 1 if self.side == "left" else -1
@@ -180,15 +184,21 @@ class Arm:
             lin, ang = p.calculateJacobian(self.robot, self.ee, [0, 0, 0], all_q, zeros, zeros)
             jac = np.vstack([np.asarray(lin)[:, self.columns], ORIENTATION_WEIGHT * np.asarray(ang)[:, self.columns]])
             err = np.concatenate([err_pos, ORIENTATION_WEIGHT * err_rot])
-            step = jac.T @ np.linalg.solve(jac @ jac.T + 0.03 ** 2 * np.eye(6), err)
+            step = jac.T @ np.linalg.solve(jac @ jac.T + 0.03**2 * np.eye(6), err)
             q = np.clip(q + np.clip(step, -0.3, 0.3), lo, hi)
         return q, float(np.linalg.norm(err_pos)), float(np.linalg.norm(err_rot))
 
     # control (execution)
     def hold(self, q) -> None:
         """Position-control the joints to `q` (no stepping)."""
-        p.setJointMotorControlArray(self.robot, self.joints, p.POSITION_CONTROL, targetPositions=list(map(float, q)),
-                                    forces=[150.0] * 7, positionGains=[0.3] * 7)
+        p.setJointMotorControlArray(
+            self.robot,
+            self.joints,
+            p.POSITION_CONTROL,
+            targetPositions=list(map(float, q)),
+            forces=[150.0] * 7,
+            positionGains=[0.3] * 7,
+        )
 
     def follow(self, path: list[np.ndarray]) -> None:
         """Drive through a joint-space path at a steady joint speed, then wait for the joints to arrive."""
@@ -221,8 +231,9 @@ class Arm:
 
     def close_on(self, body: int, half_width: float) -> bool:
         """Close the fingers on an object `half_width` wide; whether it is under the fingertips then."""
-        p.setJointMotorControlArray(self.robot, self.fingers, p.POSITION_CONTROL,
-                                    targetPositions=self.finger_targets(half_width))
+        p.setJointMotorControlArray(
+            self.robot, self.fingers, p.POSITION_CONTROL, targetPositions=self.finger_targets(half_width)
+        )
         for _ in range(60):
             p.stepSimulation()
         ee_pos, _ = self.ee_pose()
@@ -256,8 +267,9 @@ class Arm:
     def attach(self, body: int) -> None:
         """Hold `body` rigidly where it is relative to the gripper."""
         rel_pos, rel_orn = relative_pose(*self.ee_pose(), *p.getBasePositionAndOrientation(body))
-        self.constraint = p.createConstraint(self.robot, self.ee, body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos,
-                                             [0, 0, 0], rel_orn)
+        self.constraint = p.createConstraint(
+            self.robot, self.ee, body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn
+        )
         p.changeConstraint(self.constraint, maxForce=500)
         robot_collisions(self.robot, body, False)  # held in the hand, it must not push the arm around
         self.held = body

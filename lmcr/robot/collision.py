@@ -40,20 +40,37 @@ class Clearance:
         """Links of this arm beyond the elbow against the torso, the pedestal and the other arm, less the
         pairs that touch in the home pose (the simple link shapes overlap at some joints)."""
         robot, arm = self.arm.robot, self.arm
-        distal = [link for link in range(arm.joints[3], p.getNumJoints(robot))
-                  if p.getJointInfo(robot, link)[12].decode().startswith(arm.side)]
+        distal = [
+            link
+            for link in range(arm.joints[3], p.getNumJoints(robot))
+            if p.getJointInfo(robot, link)[12].decode().startswith(arm.side)
+        ]
         ours = set(range(arm.joints[0], distal[-1] + 1))
-        others = [link for link in range(-1, p.getNumJoints(robot)) if link not in ours
-                  and not (link >= 0 and p.getJointInfo(robot, link)[12].decode() == f"{arm.side}_arm_mount")]
+        others = [
+            link
+            for link in range(-1, p.getNumJoints(robot))
+            if link not in ours
+            and not (link >= 0 and p.getJointInfo(robot, link)[12].decode() == f"{arm.side}_arm_mount")
+        ]
         saved = arm.config()
         arm.set_config(arm.home)
-        pairs = [(a, b) for a in distal for b in others
-                 if not p.getClosestPoints(robot, robot, 0.0, linkIndexA=a, linkIndexB=b)]
+        pairs = [
+            (a, b)
+            for a in distal
+            for b in others
+            if not p.getClosestPoints(robot, robot, 0.0, linkIndexA=a, linkIndexB=b)
+        ]
         arm.set_config(saved)
         return pairs
 
-    def clash(self, q, carried: Carried | None = None, ignore: frozenset[int] = frozenset(),
-              margin: float = CLEARANCE, tight: frozenset[int] = frozenset()) -> str | None:
+    def clash(
+        self,
+        q,
+        carried: Carried | None = None,
+        ignore: frozenset[int] = frozenset(),
+        margin: float = CLEARANCE,
+        tight: frozenset[int] = frozenset(),
+    ) -> str | None:
         """What the arm at `q` is within `margin` of (None: clear). `ignore`: bodies allowed to touch
         (the object about to be grasped, the target the motion goes into); `tight`: bodies it may come
         within CONTACT_CLEARANCE of (the table under a grasp)."""

@@ -51,8 +51,9 @@ def capture(camera: Camera = Camera(), shaded: bool = False) -> tuple[np.ndarray
     `shaded`: lit from the side with shadows, for pictures a person looks at."""
     view, proj = camera.matrices()
     light = {"lightDirection": [1.0, 0.6, 2.0], "shadow": 1} if shaded else {}
-    _, _, rgb, depth, seg = p.getCameraImage(camera.width, camera.height, view, proj,
-                                             renderer=p.ER_TINY_RENDERER, **light)
+    _, _, rgb, depth, seg = p.getCameraImage(
+        camera.width, camera.height, view, proj, renderer=p.ER_TINY_RENDERER, **light
+    )
     rgb = np.reshape(rgb, (camera.height, camera.width, 4))[:, :, :3].astype(np.uint8)
     return rgb, np.reshape(depth, (camera.height, camera.width)), np.reshape(seg, (camera.height, camera.width))
 
@@ -60,9 +61,10 @@ def capture(camera: Camera = Camera(), shaded: bool = False) -> tuple[np.ndarray
 def back_project(depth: np.ndarray, camera: Camera) -> np.ndarray:
     """World coordinates (H, W, 3) of every pixel from the depth buffer."""
     inverse = np.linalg.inv(camera.world_to_clip())
-    ys, xs = np.mgrid[0:camera.height, 0:camera.width]
-    ndc = np.stack([(2 * xs + 1) / camera.width - 1, 1 - (2 * ys + 1) / camera.height, 2 * depth - 1,
-                    np.ones_like(depth)], axis=-1)
+    ys, xs = np.mgrid[0 : camera.height, 0 : camera.width]
+    ndc = np.stack(
+        [(2 * xs + 1) / camera.width - 1, 1 - (2 * ys + 1) / camera.height, 2 * depth - 1, np.ones_like(depth)], axis=-1
+    )
     world = ndc.reshape(-1, 4) @ inverse.T
     return (world[:, :3] / world[:, 3:]).reshape(camera.height, camera.width, 3)
 

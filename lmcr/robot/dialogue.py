@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from lmcr.complete import CompletionConfig, complete
+from lmcr.complete import Completion, CompletionConfig, complete
 from lmcr.errors import LMCRError
 from lmcr.robot.execute import execute
 from lmcr.robot.reply import error_outcome
@@ -44,8 +44,11 @@ def read_answer(answer: str, choices: list[str], on_table: list[str], vocabulary
     """Read one answer to a question offering `choices` (best first)."""
     text = " ".join(re.findall(r"[a-z]+", answer.lower()))
     words = set(text.split())
-    named = [label for label in sorted(set(vocabulary) | set(on_table), key=len, reverse=True)
-             if re.search(rf"\b{re.escape(label)}(?:e?s)?\b", text)]
+    named = [
+        label
+        for label in sorted(set(vocabulary) | set(on_table), key=len, reverse=True)
+        if re.search(rf"\b{re.escape(label)}(?:e?s)?\b", text)
+    ]
     for label in named:
         if label in on_table:
             return Reading(label)
@@ -66,8 +69,15 @@ def _a(word: str) -> str:
     return "an" if word[:1] in "aeiou" else "a"
 
 
-def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Callable, config: CompletionConfig,
-             cache_dir: Path, say: Callable[[str], None]) -> list[dict]:
+def converse(
+    turns: Iterator[str],
+    scene: Scene,
+    parser: FrameParser,
+    scorer: Callable,
+    config: CompletionConfig,
+    cache_dir: Path,
+    say: Callable[[str], None],
+) -> list[dict]:
     """Run the conversation until the turns run out; each instruction's outcome is one dict (executed
     result, left, or error) with what the robot said about it (`reply`)."""
     outcomes = []
@@ -83,10 +93,10 @@ def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Ca
         try:  # an instruction the robot cannot parse, complete or carry out is answered; the talk goes on
             completion = complete(parser, scorer, instruction, on_table, config)
             answer = None
-            if completion["question"]:
+            if completion.question:
                 answer = _ask(completion, turns, on_table, parser.lex.objects, say)
                 if answer is None:
-                    done({"instruction": instruction, "left": True, "question": completion["question"]})
+                    done({"instruction": instruction, "left": True, "question": completion.question})
                     continue
             result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
             if not result["feasible"] and result.get("suggestion"):  # "I can't reach the cup: should I ...?"
@@ -102,8 +112,9 @@ def converse(turns: Iterator[str], scene: Scene, parser: FrameParser, scorer: Ca
     return outcomes
 
 
-def _offer(result: dict, turns: Iterator[str], on_table: list[str], vocabulary: tuple[str, ...],
-           say: Callable[[str], None]) -> dict[str, str] | None:
+def _offer(
+    result: dict, turns: Iterator[str], on_table: list[str], vocabulary: tuple[str, ...], say: Callable[[str], None]
+) -> dict[str, str] | None:
     """Offer the feasible alternative the robot found; yes (or naming it) takes it, anything else leaves it."""
     role, offered = next(iter(result["suggestion"].items()))
     say(f"robot: {result['question']}")
@@ -117,21 +128,26 @@ def _offer(result: dict, turns: Iterator[str], on_table: list[str], vocabulary: 
     return {role: offered}
 
 
-def _ask(completion: dict, turns: Iterator[str], on_table: list[str], vocabulary: tuple[str, ...],
-         say: Callable[[str], None]) -> dict[str, str] | None:
+def _ask(
+    completion: Completion,
+    turns: Iterator[str],
+    on_table: list[str],
+    vocabulary: tuple[str, ...],
+    say: Callable[[str], None],
+) -> dict[str, str] | None:
     """Ask the completion's question until an answer picks an object (role -> object), at most three times."""
-    role = completion["missing"]
-    choices = [c["object"] for c in completion["candidates"]]
-    question = completion["question"]
+    role = completion.missing
+    choices = [c.object for c in completion.candidates]
+    question = completion.question
     for _ in range(MAX_TRIES):
         say(f"robot: {question}")
         reply = next(turns, None)
         if reply is None:
             return None
         say(f"you: {reply}")
-        stated = {v for r, v in completion["frame"]["roles"].items() if r != role}
+        stated = {v for r, v in completion.frame.roles if r != role}
         reading = read_answer(reply, choices, [o for o in on_table if o not in stated], vocabulary)
         if reading.choice:
             return {role: reading.choice}
-        question = f"{reading.problem} {completion['question']}"
+        question = f"{reading.problem} {completion.question}"
     return None

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pybullet as p
 
-from lmcr.complete import CompletionConfig, complete
+from lmcr.complete import Candidate, Completion, CompletionConfig, complete
 from lmcr.errors import LMCRError, one_line
+from lmcr.frame import Frame
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 from lmcr.robot.act import run_plan
 from lmcr.robot.detect import detect
@@ -45,8 +46,17 @@ def _connect() -> None:
         p.connect(p.DIRECT)
 
 
-def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: CompletionConfig, cache_dir: Path,
-            recorder: Recorder | None = None, answer: dict[str, str] | None = None, urdf: Path | None = None) -> dict:
+def execute(
+    instruction: str,
+    scene: Scene,
+    parser,
+    scorer: Callable,
+    config: CompletionConfig,
+    cache_dir: Path,
+    recorder: Recorder | None = None,
+    answer: dict[str, str] | None = None,
+    urdf: Path | None = None,
+) -> dict:
     """The CLI contract's result: frame, chosen object (`chosen_object` its label, `chosen_id` which of the
     objects with that label; `role_ids` the object of every role), waypoint errors, per-verb checks,
     success, whether the plan was feasible, and what the robot says (`reply`). The robot moves only when
@@ -75,62 +85,75 @@ def execute(instruction: str, scene: Scene, parser, scorer: Callable, config: Co
     first = [t for t in tried if t[0] is options[0][0]]
     frame, candidate, objects, result = next((t for t in first if isinstance(t[3], Plan)), first[0])
     role = _chosen_role(completion, candidate, answer)
-    out = {"frame": frame, "chosen_object": _chosen(candidate, answer),
-           "chosen_id": objects[role].id if role in objects else None,
-           "role_ids": {r: o.id for r, o in objects.items()}, "feasible": isinstance(result, Plan),
-           "success": False, "waypoints": [], "checks": {}, "missing": completion["missing"],
-           "question": completion["question"], "holding": scene.holding.label if scene.holding else None,
-           "ranking": _ranking(completion, tried),
-           "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]}
-                          for d in seen]}
+    out = {
+        "frame": frame.to_json(),
+        "chosen_object": _chosen(candidate, answer),
+        "chosen_id": objects[role].id if role in objects else None,
+        "role_ids": {r: o.id for r, o in objects.items()},
+        "feasible": isinstance(result, Plan),
+        "success": False,
+        "waypoints": [],
+        "checks": {},
+        "missing": completion.missing,
+        "question": completion.question,
+        "holding": scene.holding.label if scene.holding else None,
+        "ranking": _ranking(completion, tried),
+        "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]} for d in seen],
+    }
     if isinstance(result, Infeasible):
         out.update(_refusal(out, result, tried))
     else:
-        task = TASKS[frame["predicate"]]
+        task = TASKS[frame.predicate]
         held, target = objects[task.held_role], objects[task.target_role]
         if recorder is not None:
             recorder.target, recorder.held = target.id, held.id
             for arm in result.moving_arms:
-                arm.on_waypoint = lambda log=arm.log: recorder.shot(f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)")
-            recorder.shot(f"{frame['predicate']} {held.id} -> {target.id}: start")
-        out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)],
-                            planner))
+                arm.on_waypoint = lambda log=arm.log: recorder.shot(
+                    f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)"
+                )
+            recorder.shot(f"{frame.predicate} {held.id} -> {target.id}: start")
+        out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)], planner))
         out["set_down_first"] = result.first.geometry.held.id if result.first else None
         if recorder is not None:  # what was poured or put down, once it has come to rest
             recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
         out["arm"] = result.arm.side
     out["reply"] = say(out, parser.lex)
     done = time.perf_counter()
-    out["seconds"] = {"perceive_and_complete": round(completed - started, 3), "plan": round(planned - completed, 3),
-                      "execute": round(done - planned, 3), "plan_and_execute": round(done - completed, 3)}
+    out["seconds"] = {
+        "perceive_and_complete": round(completed - started, 3),
+        "plan": round(planned - completed, 3),
+        "execute": round(done - planned, 3),
+        "plan_and_execute": round(done - completed, 3),
+    }
     return out
 
 
-def _options(completion: dict, answer: dict[str, str] | None) -> list[tuple[dict, dict | None]]:
+def _options(completion: Completion, answer: dict[str, str] | None) -> list[tuple[Frame, Candidate | None]]:
     """The frames worth planning, best first: the answered one, else one per candidate in the language
     model's order (just the completed frame when nothing was missing)."""
-    frame = completion["frame"]
+    frame = completion.frame
     if answer:
-        return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **answer}}, None)]
-    if not completion["candidates"]:
+        return [(Frame.of(frame.predicate, {**frame.role_map, **answer}), None)]
+    if not completion.candidates:
         return [(frame, None)]
-    return [({"predicate": frame["predicate"], "roles": {**frame["roles"], **c["objects"]}}, c)
-            for c in completion["candidates"]]
+    return [(Frame.of(frame.predicate, {**frame.role_map, **c.objects}), c) for c in completion.candidates]
 
 
-def _assignments(scene: Scene, frame: dict, seen: set[str]) -> list[dict[str, SceneObject]]:
+def _assignments(scene: Scene, frame: Frame, seen: set[str]) -> list[dict[str, SceneObject]]:
     """The objects the frame's two roles may be done with (role -> object; one per role, never one object
     for both), nearest first: the reach from the robot's edge to the held object (none when it is in the
     hand) plus its carry to the target. An object is one the camera saw or the one in the hand."""
-    task = TASKS[frame["predicate"]]
+    task = TASKS[frame.predicate]
+    roles = frame.role_map
     choices = []
     for role in (task.held_role, task.target_role):
-        label = frame["roles"][role]
+        label = roles[role]
         found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
         if not found:
             there = ", ".join(o.id for o in scene.objects)
-            raise ExecutionError(f"cannot {frame['predicate']} here: no {label!r} on the table (there are: {there})",
-                                 absent=label)
+            raise ExecutionError(
+                f"cannot {frame.predicate} here: no {label!r} on the table (there are: {there})", absent=label
+            )
         choices.append(found)
 
     def effort(pair: tuple[SceneObject, SceneObject]) -> float:
@@ -139,12 +162,12 @@ def _assignments(scene: Scene, frame: dict, seen: set[str]) -> list[dict[str, Sc
 
     pairs = sorted((pair for pair in itertools.product(*choices) if pair[0] is not pair[1]), key=effort)
     if not pairs:  # "pour the cup into the cup" with one cup
-        raise ExecutionError(f"cannot {frame['predicate']} here: there is one {choices[0][0].label}, not two")
+        raise ExecutionError(f"cannot {frame.predicate} here: there is one {choices[0][0].label}, not two")
     return [{task.held_role: held, task.target_role: target} for held, target in pairs]
 
 
-def _plan(planner: Planner, scene: Scene, frame: dict, objects: dict[str, SceneObject]) -> Plan | Infeasible:
-    task = TASKS[frame["predicate"]]
+def _plan(planner: Planner, scene: Scene, frame: Frame, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+    task = TASKS[frame.predicate]
     held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
@@ -163,29 +186,31 @@ def _plan(planner: Planner, scene: Scene, frame: dict, objects: dict[str, SceneO
     return rearranged if isinstance(rearranged, Plan) else direct
 
 
-def _chosen(candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+def _chosen(candidate: Candidate | None, answer: dict[str, str] | None) -> str | None:
     if answer:
         return next(iter(answer.values()))
-    return candidate["object"] if candidate else None
+    return candidate.object if candidate else None
 
 
-def _chosen_role(completion: dict, candidate: dict | None, answer: dict[str, str] | None) -> str | None:
+def _chosen_role(completion: Completion, candidate: Candidate | None, answer: dict[str, str] | None) -> str | None:
     """The role of the chosen object: the one answered, or the completion's missing one."""
     if answer:
         return next(iter(answer))
-    return completion["missing"] if candidate else None
+    return completion.missing if candidate else None
 
 
-def _ranking(completion: dict, tried: list) -> list[dict]:
+def _ranking(completion: Completion, tried: list) -> list[dict]:
     """The candidates by language-model probability x feasibility (1 planned feasible with one of its
     objects, 0 with none, unknown when not planned: those keep their probability and rank after the
     feasible ones)."""
     feasible: dict[str, bool] = {}
     for _, c, _, r in tried:
         if c is not None:
-            feasible[c["object"]] = feasible.get(c["object"], False) or isinstance(r, Plan)
-    rows = [{"object": c["object"], "probability": c["probability"], "feasible": feasible.get(c["object"])}
-            for c in completion["candidates"]]
+            feasible[c.object] = feasible.get(c.object, False) or isinstance(r, Plan)
+    rows = [
+        {"object": c.object, "probability": c.probability, "feasible": feasible.get(c.object)}
+        for c in completion.candidates
+    ]
     return sorted(rows, key=lambda r: -(r["probability"] * (r["feasible"] is not False)))
 
 
@@ -197,7 +222,7 @@ def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
     if alternative is None:
         return why
     c, objects = alternative
-    offer = {"suggestion": c["objects"], "suggestion_ids": {role: objects[role].id for role in c["objects"]}}
+    offer = {"suggestion": dict(c.objects), "suggestion_ids": {role: objects[role].id for role in c.objects}}
     return {**why, **offer, "question": say({**out, **why, **offer})}
 
 

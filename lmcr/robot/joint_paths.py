@@ -23,8 +23,9 @@ RESOLUTION = 0.04  # radians between checked states along a motion
 PLAN_CHECKS = 6000
 
 
-def joint_path(clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray,
-               budget: int = PLAN_CHECKS, seed: int = SEED) -> list[np.ndarray] | None:
+def joint_path(
+    clash: Callable[[np.ndarray], str | None], q0, q1, limits: np.ndarray, budget: int = PLAN_CHECKS, seed: int = SEED
+) -> list[np.ndarray] | None:
     """A clear path q0 -> q1 (a list of configurations, q0 first), or None when OMPL finds none within
     `budget` clearance checks (0: only the straight segment). `clash(q)` names what the configuration hits,
     None when it is clear. The search is seeded with `seed`."""

@@ -35,7 +35,20 @@ def official_urdf(urdf: Path, cache_dir: Path) -> Path:
     urdf = Path(urdf).resolve()
     if len(urdf.parents) < 3:
         raise RobotModelError(f"{urdf}: expected baxter_common/baxter_description/urdf/baxter.urdf")
-    root = urdf.parents[2]  # baxter_common/ holding baxter_description/ and rethink_ee_description/
+    robot = _loadable_robot(urdf, urdf.parents[2])
+    _add_missing_inertials(robot)
+    text = ET.tostring(robot, encoding="unicode")
+    path = Path(cache_dir) / f"baxter-official-{hashlib.sha256(text.encode()).hexdigest()[:12]}.urdf"
+    if not path.exists():
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    return path
+
+
+def _loadable_robot(urdf: Path, root: Path) -> ET.Element:
+    """The URDF's robot element with its meshes as STL files under `root` (baxter_common/, holding
+    baxter_description/ and rethink_ee_description/), no Gazebo or transmission tags, and the electric
+    grippers spelt out."""
     try:  # defusedxml refuses entity tricks with a ValueError; a missing xacro or number is a KeyError/OSError
         robot = SafeET.parse(urdf).getroot()
         for mesh in robot.iter("mesh"):
@@ -49,23 +62,26 @@ def official_urdf(urdf: Path, cache_dir: Path) -> Path:
         raise
     except (OSError, SafeET.ParseError, KeyError, ValueError) as exc:
         raise RobotModelError(f"{urdf}: cannot read the robot description ({exc!r:.120})") from exc
-    for link in robot.findall("link"):  # frames without mass: pybullet would warn and make them 1 kg
+    return robot
+
+
+def _add_missing_inertials(robot: ET.Element) -> None:
+    """A tiny mass for the frames without one: pybullet would warn and make them 1 kg."""
+    for link in robot.findall("link"):
         if link.find("inertial") is None:
-            link.append(ET.fromstring('<inertial><origin xyz="0 0 0"/><mass value="0.0001"/>'
-                                      '<inertia ixx="1e-8" ixy="0" ixz="0" iyy="1e-8" iyz="0" izz="1e-8"/></inertial>'))
-    text = ET.tostring(robot, encoding="unicode")
-    path = Path(cache_dir) / f"baxter-official-{hashlib.sha256(text.encode()).hexdigest()[:12]}.urdf"
-    if not path.exists():
-        with atomic_path(path) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    return path
+            link.append(
+                ET.fromstring(
+                    '<inertial><origin xyz="0 0 0"/><mass value="0.0001"/>'
+                    '<inertia ixx="1e-8" ixy="0" ixz="0" iyy="1e-8" iyz="0" izz="1e-8"/></inertial>'
+                )
+            )
 
 
 def _mesh_file(root: Path, name: str, urdf: Path) -> Path:
     """`package://PKG/a/b.DAE` -> root/PKG/a/b.STL (the STL twin of a COLLADA mesh)."""
     if not name.startswith("package://"):
         raise RobotModelError(f"{urdf}: mesh {name!r} is not a package:// path")
-    path = (root / name[len("package://"):]).resolve()
+    path = (root / name[len("package://") :]).resolve()
     if root.resolve() not in path.parents:
         raise RobotModelError(f"{urdf}: mesh {name!r} points outside {root}")
     stl = path.with_suffix(".STL")
@@ -91,8 +107,10 @@ def _gripper_parameters(root: Path, side: str) -> dict[str, str]:
 
 def _replace_gripper(robot: ET.Element, root: Path, side: str) -> None:
     """Drop the URDF's gripper placeholders of one arm and attach the configured electric gripper."""
-    for tag, names in (("link", (f"{side}_gripper_base", f"{side}_gripper")),
-                       ("joint", (f"{side}_gripper_base", f"{side}_endpoint"))):
+    for tag, names in (
+        ("link", (f"{side}_gripper_base", f"{side}_gripper")),
+        ("joint", (f"{side}_gripper_base", f"{side}_endpoint")),
+    ):
         for element in robot.findall(tag):
             if element.get("name") in names:
                 robot.remove(element)
@@ -127,7 +145,8 @@ def _replace_gripper(robot: ET.Element, root: Path, side: str) -> None:
             f'<mesh filename="{meshes / "fingers" / (params[f"{name}_finger"] + ".STL")}"/></geometry></visual>'
             f'<collision><origin rpy="{rpy}" xyz="0 {width * reflect} {sizes["finger_box_length"]}"/><geometry>'
             f'<box size="{box[0]} {box[1]} {box[2]}"/></geometry></collision><inertial><origin xyz="0 0 0"/>'
-            f'<mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>',
+            '<mass value="0.02"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/>'
+            "</inertial></link>",
             f'<joint name="{side[0]}_gripper_{name}_finger_joint" type="prismatic"><origin rpy="0 0 0" '
             f'xyz="0 {offset} 0.02"/><axis xyz="0 1 0"/><parent link="{side}_gripper_base"/><child link="{link}"/>'
             f'<limit effort="20" lower="{limits[0]}" upper="{limits[1]}" velocity="5"/></joint>',

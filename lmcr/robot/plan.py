@@ -86,8 +86,15 @@ class Planner:
     def __post_init__(self) -> None:
         self.arms = {side: Arm(self.robot, side) for side in SIDES}
 
-    def plan(self, task: Task, held: SceneObject, target: SceneObject, holding: bool,
-             arms: tuple[str, ...] = SIDES, start: str = "home") -> Plan | Infeasible:
+    def plan(
+        self,
+        task: Task,
+        held: SceneObject,
+        target: SceneObject,
+        holding: bool,
+        arms: tuple[str, ...] = SIDES,
+        start: str = "home",
+    ) -> Plan | Infeasible:
         """The first feasible plan over the `arms` (the nearer one first) and the task's variants, or the
         reason of the attempt that got furthest. The arm starts at its `start` configuration ("home",
         or "parked": then it first moves home), the other one parked."""
@@ -116,14 +123,17 @@ class Planner:
                     # the fingers as they will be on the way: collision checks see them so
                     arm.shape_fingers(approach_fingers(arm, variant, held.label), now=True)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
-                    steps = [*([Step("home", "to its start")] if start != "home" else []),
-                             *task.program(g, variant, holding)]
+                    steps = [
+                        *([Step("home", "to its start")] if start != "home" else []),
+                        *task.program(g, variant, holding),
+                    ]
                     result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
                     _restore(held, standing)  # the checks of carried motions left it in the hand
                     found = g
                     if isinstance(result, list) and not holding:
-                        result, found = self._as_grasped(arm, other, getattr(arm, start), result, steps, task, g,
-                                                         variant)
+                        result, found = self._as_grasped(
+                            arm, other, getattr(arm, start), result, steps, task, g, variant
+                        )
                         _restore(held, standing)
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, found, task)
@@ -137,8 +147,15 @@ class Planner:
                 _restore(held, saved)
         return best
 
-    def plan_via(self, task: Task, held: SceneObject, target: SceneObject, moved: SceneObject, holding: bool,
-                 spots: list[tuple[float, float]]) -> Plan | Infeasible:
+    def plan_via(
+        self,
+        task: Task,
+        held: SceneObject,
+        target: SceneObject,
+        moved: SceneObject,
+        holding: bool,
+        spots: list[tuple[float, float]],
+    ) -> Plan | Infeasible:
         """Set `moved` (in the hand when `holding`, else on the table) down at the first of the free `spots`
         where that works and park that arm, then do the task with either arm: what the hand holds is out
         of the way, or the held object is passed from one arm's reach to the other's. Both parts are
@@ -182,15 +199,33 @@ class Planner:
         carried = Carried(g.held.body, *in_hand)
         return replace(plan, segments=result, carried=carried, geometry=g) if isinstance(result, list) else None
 
-    def _rest_in_hand(self, arm: Arm, task: Task, variant: Variant, g: Geometry, start: np.ndarray) -> list[Segment] | Infeasible:
+    def _rest_in_hand(
+        self, arm: Arm, task: Task, variant: Variant, g: Geometry, start: np.ndarray
+    ) -> list[Segment] | Infeasible:
         """The task's steps after the pick-up, planned from joints `start` for the held object in the hand
         at `g`'s grasped pose."""
         held = g.held
-        return self._plan_variant(arm, Clearance(arm, self._obstacles(held)), task.program(g, variant, True),
-                                  held, g.target, Carried(held.body, *g.grasped), start)
+        return self._plan_variant(
+            arm,
+            Clearance(arm, self._obstacles(held)),
+            task.program(g, variant, True),
+            held,
+            g.target,
+            Carried(held.body, *g.grasped),
+            start,
+        )
 
-    def _as_grasped(self, arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], steps: list[Step],
-                    task: Task, g: Geometry, variant: Variant) -> tuple[list[Segment] | Infeasible, Geometry]:
+    def _as_grasped(
+        self,
+        arm: Arm,
+        other: Arm,
+        start: np.ndarray,
+        segments: list[Segment],
+        steps: list[Step],
+        task: Task,
+        g: Geometry,
+        variant: Variant,
+    ) -> tuple[list[Segment] | Infeasible, Geometry]:
         """A planned pick-up checked by simulating it as it will run (`_simulated_grasp`), and the
         geometry the rest of the plan holds for. A grasp that would leave the object outside the fingers
         is infeasible; one whose fingers would push it (more than `shifted` allows) has the rest planned
@@ -205,8 +240,11 @@ class Planner:
         found = replace(g, grasped=in_hand)
         rest = self._rest_in_hand(arm, task, variant, found, segments[picked - 1].path[-1])
         if isinstance(rest, Infeasible):
-            return replace(rest, reason=f"{rest.reason} (with {_named(g.held)} as the fingers would push it)",
-                           progress=picked + rest.progress), g
+            return replace(
+                rest,
+                reason=f"{rest.reason} (with {_named(g.held)} as the fingers would push it)",
+                progress=picked + rest.progress,
+            ), g
         return segments[:picked] + rest, found
 
     def on_table(self, name: str) -> SceneObject | None:
@@ -219,8 +257,16 @@ class Planner:
         things = {o.body: _named(o) for o in self.scene.present if o.body != held.body}
         return {self.table: "the table", **things, held.body: _named(held)}
 
-    def _plan_variant(self, arm: Arm, clearance: Clearance, steps: list[Step], held: SceneObject,
-                      target: SceneObject, carried: Carried | None, start: np.ndarray) -> list[Segment] | Infeasible:
+    def _plan_variant(  # noqa: C901 - a case per step kind, each failing its own way
+        self,
+        arm: Arm,
+        clearance: Clearance,
+        steps: list[Step],
+        held: SceneObject,
+        target: SceneObject,
+        carried: Carried | None,
+        start: np.ndarray,
+    ) -> list[Segment] | Infeasible:
         # a pose beyond the arm's reach fails the variant before any motion to the steps ahead of it is
         # planned (for an object out of reach, most of the search's time went into those)
         for i, step in enumerate(steps):
@@ -268,15 +314,21 @@ class Planner:
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
                 # object ignored could sweep through it
                 into = step.into and carried is not None
-                path = (_straight_line(arm, q, goal, position, step.orientation) if into
-                        else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS))
+                path = (
+                    _straight_line(arm, q, goal, position, step.orientation)
+                    if into
+                    else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
+                )
                 if into and path is None:
                     why, reach = f"the {arm.side} arm cannot go straight down to '{step.name}'", False
                     continue
                 blocker = _path_clash(clash, path) if into else None
                 if path is None or blocker:
                     blocker = blocker or segment_clash(clash, q, goal)
-                    why, reach = f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)", False
+                    why, reach = (
+                        f"no clear way for the {arm.side} arm to '{step.name}' ({blocker} is in the way)",
+                        False,
+                    )
                     continue
                 if into and not _fits_through(arm, path, carried, target):
                     why, reach, blocker = f"{_named(held)} would not fit into {_named(target)}", False, _named(target)
@@ -295,8 +347,9 @@ def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
     return f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)"
 
 
-def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject,
-                     variant: Variant) -> tuple | None:
+def _simulated_grasp(
+    arm: Arm, other: Arm, start: np.ndarray, segments: list[Segment], held: SceneObject, variant: Variant
+) -> tuple | None:
     """The held object's pose relative to the gripper once the planned pick-up, simulated as it will run
     (the arm from `start` along the planned paths, the other one parked, the fingers closing), has closed
     on it; None when it is then not under the fingertips. The paths keep clear of everything, but the
@@ -305,8 +358,10 @@ def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Seg
     the grasp. The simulation is left as it was, the fingers driven open (as `run_plan` starts them)."""
     state = p.saveState()
     try:
-        for a, q, fingers in ((other, other.parked, other.finger_open),
-                              (arm, start, approach_fingers(arm, variant, held.label))):
+        for a, q, fingers in (
+            (other, other.parked, other.finger_open),
+            (arm, start, approach_fingers(arm, variant, held.label)),
+        ):
             a.set_config(q)
             a.hold(q)
             a.shape_fingers(fingers, now=True)
@@ -317,7 +372,7 @@ def _simulated_grasp(arm: Arm, other: Arm, start: np.ndarray, segments: list[Seg
                 return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
             if segment.step.moves:
                 arm.follow(segment.path)
-        raise ValueError("a pick-up without a grasp")
+        raise ValueError("a pick-up without a grasp")  # a bug: every pick-up program grasps
     finally:
         p.restoreState(state)
         p.removeState(state)
@@ -347,8 +402,9 @@ def _straight_line(arm: Arm, start: np.ndarray, goal: np.ndarray, position, orie
     path = [np.asarray(start, dtype=float)]
     for k in range(1, n):
         f = k / n
-        q, err_pos, err_rot = arm.solve(here + (np.asarray(position) - here) * f,
-                                        p.getQuaternionSlerp(turned, orientation, f), [path[-1]])
+        q, err_pos, err_rot = arm.solve(
+            here + (np.asarray(position) - here) * f, p.getQuaternionSlerp(turned, orientation, f), [path[-1]]
+        )
         if err_pos > IK_POSITION or err_rot > IK_ROTATION:
             return None
         path.append(q)
@@ -364,10 +420,12 @@ def _fits_through(arm: Arm, path: list[np.ndarray], carried: Carried, target: Sc
     """Whether the carried object, moved along the joint-space `path`, stays FIT_MARGIN clear of the
     target (its walls, as it goes in through the opening), checked as every motion is: a 12 cm chicken
     turned off a 12.8 cm bowl's axes meets the wall, sticks and pushes the bowl."""
+
     def near_walls(q) -> str | None:
         arm.set_config(q)
         carried.place(arm)
         return _named(target) if p.getClosestPoints(carried.body, target.body, FIT_MARGIN) else None
+
     return _path_clash(near_walls, path) is None
 
 
@@ -435,4 +493,3 @@ def _save(obj: SceneObject) -> tuple:
 
 def _restore(obj: SceneObject, pose: tuple) -> None:
     p.resetBasePositionAndOrientation(obj.body, *pose)
-

@@ -19,9 +19,16 @@ from lmcr.files import atomic_path
 from lmcr.robot.detect import Camera, capture
 from lmcr.robot.scene import TABLE_CENTRE, TABLE_TOP, Scene
 
-VIEW = Camera(width=640, height=480, fov=44.0, near=0.05, far=5.0,
-              eye=(TABLE_CENTRE[0] + 0.95, TABLE_CENTRE[1] + 0.75, TABLE_TOP + 0.80),
-              target=(TABLE_CENTRE[0] - 0.10, TABLE_CENTRE[1] - 0.05, TABLE_TOP + 0.10), up=(0.0, 0.0, 1.0))
+VIEW = Camera(
+    width=640,
+    height=480,
+    fov=44.0,
+    near=0.05,
+    far=5.0,
+    eye=(TABLE_CENTRE[0] + 0.95, TABLE_CENTRE[1] + 0.75, TABLE_TOP + 0.80),
+    target=(TABLE_CENTRE[0] - 0.10, TABLE_CENTRE[1] - 0.05, TABLE_TOP + 0.10),
+    up=(0.0, 0.0, 1.0),
+)
 TARGET_COLOUR = (255, 196, 0)
 HELD_COLOUR = (80, 200, 255)
 OUTLINE = 3  # pixels
@@ -86,8 +93,7 @@ class Recorder:
                 continue
             low, high = p.getAABB(obj.body)
             top = ((low[0] + high[0]) / 2, (low[1] + high[1]) / 2, high[2])
-            colour = TARGET_COLOUR if obj.id == self.target else HELD_COLOUR if obj.id == self.held \
-                else (235, 235, 235)
+            colour = TARGET_COLOUR if obj.id == self.target else HELD_COLOUR if obj.id == self.held else (235, 235, 235)
             _label(draw, _project(top, self.camera), obj.id, colour)
         self.pictures.append(image)
         self.captions.append(caption)
@@ -98,14 +104,17 @@ class Recorder:
         with atomic_path(path) as tmp:
             if path.suffix.lower() == ".gif":
                 captioned = [_captioned(im, c, 1.0) for im, c in zip(self.pictures, self.captions)]
-                captioned[0].save(tmp, format="GIF", save_all=True, append_images=captioned[1:],
-                                  duration=FRAME_MS, loop=0)
+                captioned[0].save(
+                    tmp, format="GIF", save_all=True, append_images=captioned[1:], duration=FRAME_MS, loop=0
+                )
             else:
                 self.sheet().save(tmp, format="PNG")
         return path
 
     def sheet(self) -> Image.Image:
-        tiles = [_captioned(im, f"{i}. {c}", SHEET_SCALE) for i, (im, c) in enumerate(zip(self.pictures, self.captions))]
+        tiles = [
+            _captioned(im, f"{i}. {c}", SHEET_SCALE) for i, (im, c) in enumerate(zip(self.pictures, self.captions))
+        ]
         w, h = tiles[0].size
         rows = -(-len(tiles) // SHEET_COLUMNS)
         sheet = Image.new("RGB", (SHEET_COLUMNS * w, rows * h), (255, 255, 255))

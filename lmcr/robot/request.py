@@ -30,16 +30,23 @@ class Executor:
 
     def run(self, instruction: str, scene: Scene, recorder: Recorder | None = None) -> dict:
         """One instruction executed in `scene`: the CLI contract's result (see `execute`)."""
-        return execute(instruction, scene, self.parser, self.scorer, self.config, self.cache_dir, recorder,
-                       urdf=self.urdf)
+        return execute(
+            instruction, scene, self.parser, self.scorer, self.config, self.cache_dir, recorder, urdf=self.urdf
+        )
 
     def run_batch(self, path: Path) -> Iterator[dict]:
         """The batch of the JSONL file `path`, one result per line as each is done (see `execute_batch`)."""
         return execute_batch(path, self.run)
 
 
-def execute_request(executor: Executor, scene: Scene, instruction: str | None = None, audio: Path | None = None,
-                    recognizer=None, render: Sequence[Path] = ()) -> dict:
+def execute_request(
+    executor: Executor,
+    scene: Scene,
+    instruction: str | None = None,
+    audio: Path | None = None,
+    recognizer=None,
+    render: Sequence[Path] = (),
+) -> dict:
     """One instruction executed in `scene`, typed (`instruction`) or heard from `audio` by `recognizer`
     (the result adds the `text` heard). When the recogniser is unsure what was said, nothing moves: the
     result is {text, question, executed: False, success: False}; when it heard nothing, AudioError. With

@@ -42,21 +42,52 @@ PLACEMENT_CHECKS = 2_000_000
 # food shapes ("box", sx, sy, sz) / ("sphere", r) / ("cyl", r, h)
 LIQUIDS = ("water", "milk", "wine", "oil", "vinegar", "honey", "soy sauce")
 POWDERS = ("salt", "sugar", "flour", "black pepper", "cinnamon", "parsley", "cheese")
-CONTAINERS = {"cup": (0.08, 0.08, 0.10), "glass": (0.07, 0.07, 0.12), "mug": (0.09, 0.09, 0.10),
-              "bowl": (0.16, 0.16, 0.07), "plate": (0.24, 0.24, 0.025), "pan": (0.26, 0.26, 0.05),
-              "pot": (0.22, 0.22, 0.15), "skillet": (0.26, 0.26, 0.05), "blender": (0.18, 0.18, 0.22),
-              "microwave": (0.30, 0.26, 0.12), "oven": (0.34, 0.30, 0.12), "sink": (0.36, 0.30, 0.10),
-              "cutting board": (0.30, 0.20, 0.02), "soup": (0.16, 0.16, 0.07), "salad": (0.18, 0.18, 0.08),
-              "chocolate": (0.14, 0.14, 0.06), "batter": (0.14, 0.14, 0.06)}  # food served in a bowl
-FOOD = {"onion": ("sphere", 0.035), "garlic": ("sphere", 0.025), "potato": ("sphere", 0.04),
-        "tomato": ("sphere", 0.035), "apple": ("sphere", 0.04), "strawberry": ("sphere", 0.02),
-        "egg": ("sphere", 0.025), "ice": ("box", 0.03, 0.03, 0.03), "banana": ("box", 0.16, 0.035, 0.035),
-        "bell pepper": ("sphere", 0.04), "bread": ("box", 0.10, 0.08, 0.03), "steak": ("box", 0.14, 0.09, 0.025),
-        "chicken": ("box", 0.12, 0.08, 0.04), "fish": ("box", 0.18, 0.06, 0.03), "rice": ("cyl", 0.04, 0.06),
-        "pasta": ("cyl", 0.035, 0.08), "cake": ("cyl", 0.09, 0.06), "pizza": ("cyl", 0.12, 0.015),
-        "butter": ("box", 0.08, 0.04, 0.03), "knife": ("box", 0.20, 0.025, 0.02), "spoon": ("box", 0.16, 0.03, 0.02),
-        "scissors": ("box", 0.16, 0.07, 0.015), "sponge": ("box", 0.09, 0.06, 0.03),
-        "towel": ("box", 0.20, 0.14, 0.015), "pastry brush": ("box", 0.18, 0.03, 0.02)}
+CONTAINERS = {
+    "cup": (0.08, 0.08, 0.10),
+    "glass": (0.07, 0.07, 0.12),
+    "mug": (0.09, 0.09, 0.10),
+    "bowl": (0.16, 0.16, 0.07),
+    "plate": (0.24, 0.24, 0.025),
+    "pan": (0.26, 0.26, 0.05),
+    "pot": (0.22, 0.22, 0.15),
+    "skillet": (0.26, 0.26, 0.05),
+    "blender": (0.18, 0.18, 0.22),
+    "microwave": (0.30, 0.26, 0.12),
+    "oven": (0.34, 0.30, 0.12),
+    "sink": (0.36, 0.30, 0.10),
+    "cutting board": (0.30, 0.20, 0.02),
+    "soup": (0.16, 0.16, 0.07),
+    "salad": (0.18, 0.18, 0.08),
+    "chocolate": (0.14, 0.14, 0.06),
+    "batter": (0.14, 0.14, 0.06),
+}  # food served in a bowl
+FOOD = {
+    "onion": ("sphere", 0.035),
+    "garlic": ("sphere", 0.025),
+    "potato": ("sphere", 0.04),
+    "tomato": ("sphere", 0.035),
+    "apple": ("sphere", 0.04),
+    "strawberry": ("sphere", 0.02),
+    "egg": ("sphere", 0.025),
+    "ice": ("box", 0.03, 0.03, 0.03),
+    "banana": ("box", 0.16, 0.035, 0.035),
+    "bell pepper": ("sphere", 0.04),
+    "bread": ("box", 0.10, 0.08, 0.03),
+    "steak": ("box", 0.14, 0.09, 0.025),
+    "chicken": ("box", 0.12, 0.08, 0.04),
+    "fish": ("box", 0.18, 0.06, 0.03),
+    "rice": ("cyl", 0.04, 0.06),
+    "pasta": ("cyl", 0.035, 0.08),
+    "cake": ("cyl", 0.09, 0.06),
+    "pizza": ("cyl", 0.12, 0.015),
+    "butter": ("box", 0.08, 0.04, 0.03),
+    "knife": ("box", 0.20, 0.025, 0.02),
+    "spoon": ("box", 0.16, 0.03, 0.02),
+    "scissors": ("box", 0.16, 0.07, 0.015),
+    "sponge": ("box", 0.09, 0.06, 0.03),
+    "towel": ("box", 0.20, 0.14, 0.015),
+    "pastry brush": ("box", 0.18, 0.03, 0.02),
+}
 BOTTLE = (0.03, 0.16)  # radius, height of bottles and jugs
 SHAKER = (0.025, 0.09)
 
@@ -186,8 +217,10 @@ def _check_room(objects: list[SceneObject], where: str) -> None:
     table = (2 * X_LIMIT + CLEAR) * (2 * Y_LIMIT + CLEAR)
     if needed > table:
         free = sum(1 for o in objects if o.xy is None)
-        raise InputError(f"{where}: {len(objects):,} objects ({free:,} without a position) need {needed:.2f} m² "
-                         f"of the table's {table:.2f} m²: they cannot all fit")
+        raise InputError(
+            f"{where}: {len(objects):,} objects ({free:,} without a position) need {needed:.2f} m² "
+            f"of the table's {table:.2f} m²: they cannot all fit"
+        )
 
 
 def load_scene(path: Path) -> Scene:
@@ -230,13 +263,17 @@ def _check_ids(labels: list[str], given: list, vocabulary: set[str], holding: st
         assign_ids(labels + ([holding] if holding else []), given + ([holding] if holding else []))
     except DuplicateIdError as exc:
         held = f" (the held {holding}'s)" if holding and exc.second == len(labels) else ""
-        raise InputError(f"{where}: duplicate object id {exc.ident!r}: objects {exc.first} and {exc.second}{held}") \
-            from None
+        raise InputError(
+            f"{where}: duplicate object id {exc.ident!r}: objects {exc.first} and {exc.second}{held}"
+        ) from None
 
 
 def _valid_xy(xy: object) -> bool:
-    return (isinstance(xy, list) and len(xy) == 2
-            and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in xy))
+    return (
+        isinstance(xy, list)
+        and len(xy) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in xy)
+    )
 
 
 def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding: str | None = None) -> Scene:
@@ -252,17 +289,28 @@ def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding:
     placed: list[SceneObject] = []
     for k, (label, xy, *_) in enumerate(items):
         if xy is not None:
-            if not _valid_xy(xy):
-                raise InputError(f"{where}: object {k} ({label}): xy must be two finite numbers [x, y], not {xy!r:.60}")
-            if abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
-                raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
-            for other in placed:
-                if other.xy is not None and _overlap(label, xy, other.label, other.xy):
-                    raise InputError(f"{where}: object {k} ({label}) overlaps the {other.id or other.label}")
+            _check_position(k, label, xy, placed, where)
         placed.append(SceneObject(label, tuple(xy) if xy is not None else None, id=given[k] or ""))
-    free = [o for o in placed if o.xy is None]
-    if free:
+    if any(o.xy is None for o in placed):
         _check_room(placed, where)
+        _lay_out(placed, seed, where)
+    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
+
+
+def _check_position(k: int, label: str, xy: object, placed: list[SceneObject], where: str) -> None:
+    """Object `k`'s given position: two finite numbers on the table, clear of the objects placed so far."""
+    if not _valid_xy(xy):
+        raise InputError(f"{where}: object {k} ({label}): xy must be two finite numbers [x, y], not {xy!r:.60}")
+    if abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
+        raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
+    for other in placed:
+        if other.xy is not None and _overlap(label, xy, other.label, other.xy):
+            raise InputError(f"{where}: object {k} ({label}) overlaps the {other.id or other.label}")
+
+
+def _lay_out(placed: list[SceneObject], seed: int, where: str) -> None:
+    """Give the objects without a position one, trying layouts until one fits every object."""
+    free = [o for o in placed if o.xy is None]
     # uniform draws first (seeded "7", "7:1", ...: a scene that fits one is laid out as it always was),
     # then tight packings; an unlucky early spot can leave no room for a later object
     layouts = [(_random_spot, seed if k == 0 else f"{seed}:{k}") for k in range(LAYOUT_ATTEMPTS)]
@@ -271,13 +319,12 @@ def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding:
     for k, (spot, layout_seed) in enumerate(layouts):
         try:
             _place(placed, spot, random.Random(layout_seed), where, tries)
-            break
+            return
         except InputError as exc:
             if k == len(layouts) - 1 or tries.left <= 0:
                 raise InputError(f"{exc} ({k + 1} layouts tried)") from None
             for obj in free:
                 obj.xy = None
-    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
 
 
 class _Tries:
@@ -302,8 +349,9 @@ def _place(placed: list[SceneObject], spot, rng: random.Random, where: str, trie
             obj.xy = spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
 
 
-def _packed_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str,
-                 tries: _Tries) -> tuple[float, float]:
+def _packed_spot(
+    label: str, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries
+) -> tuple[float, float]:
     """A free spot where `label` touches the table's edges or its neighbours, drawn at random among them (a
     corner-point packing): scenes crowded with big things (an oven, a sink, a cutting board, ...) that
     uniform draws do not fit."""
@@ -328,8 +376,9 @@ def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, 
     return [xy for xy in on_table if abs(xy[0]) <= X_LIMIT - half_x + 1e-9 and abs(xy[1]) <= Y_LIMIT - half_y + 1e-9]
 
 
-def _random_spot(label: str, placed: list[SceneObject], rng: random.Random, where: str,
-                 tries: _Tries = _Tries()) -> tuple[float, float]:
+def _random_spot(
+    label: str, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries = _Tries()
+) -> tuple[float, float]:
     margin = footprint(label)
     for _ in range(500):
         tries.spend(max(len(placed), 1), label, where)

@@ -26,8 +26,8 @@ DUMP_HEIGHTS = (0.03, 0.07, 0.11)  # the dumped object's middle this far above t
 SHAKE_HEIGHT = 0.18  # a shaker's opening above the target: flat targets (pizza, steak) leave the hand no room lower
 SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
 SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
-PITCHES = (0.0, 0.5)
-TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying  # the gripper upright, or leaning forward to reach the far side of the table
+PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far side of the table
+TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
 GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
 PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
@@ -117,14 +117,25 @@ class Geometry:
         pos, orn = p.getBasePositionAndOrientation(held.body)
         lo, hi = p.getAABB(target.body)
         tpos, _ = p.getBasePositionAndOrientation(target.body)
-        return cls(held, target, pos, orn, np.array([pos[0], pos[1], p.getAABB(held.body)[1][2]]),
-                   np.array([tpos[0], tpos[1], hi[2]]), (lo, hi))
+        return cls(
+            held,
+            target,
+            pos,
+            orn,
+            np.array([pos[0], pos[1], p.getAABB(held.body)[1][2]]),
+            np.array([tpos[0], tpos[1], hi[2]]),
+            (lo, hi),
+        )
 
     def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
         """The gripper pose that grasps the held object by its top, or from the side around its body
         (high enough for the hand to clear the table)."""
         if variant.side:
-            return self.held_top - [0, 0, height(self.held.label) - side_grip_height(self.held.label)], variant.upright()
+            return self.held_top - [
+                0,
+                0,
+                height(self.held.label) - side_grip_height(self.held.label),
+            ], variant.upright()
         return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
 
     def in_hand(self, variant: Variant) -> tuple[tuple, tuple]:
@@ -186,8 +197,8 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
     forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
-    object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it pours), headed from the
-    robot towards the object."""
+    object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it
+    pours), headed from the robot towards the object."""
     half_x, half_y, round_ = outline(held.label)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if round_:  # a square box held across its corners would not fit between fingers set for its sides
@@ -199,21 +210,34 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
         reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
         shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
     signs = (1, -1) if turns else (1,)
-    top = [Variant(yaw, pitch, sign, turn=turn, shift=shift) for shift in shifts for pitch in PITCHES for yaw in yaws
-           for turn in TURNS for sign in signs]
+    top = [
+        Variant(yaw, pitch, sign, turn=turn, shift=shift)
+        for shift in shifts
+        for pitch in PITCHES
+        for yaw in yaws
+        for turn in TURNS
+        for sign in signs
+    ]
     narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
     if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
-        return top + narrow  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
+        return (
+            top + narrow
+        )  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
     x, y = world_xy(held.xy)
     heading = math.atan2(y, x)
-    side = [Variant(heading + a, 0.0, sign, side=True, turn=turn) for a in (0.0, 0.5, -0.5) for turn in TURNS
-            for sign in signs]
+    side = [
+        Variant(heading + a, 0.0, sign, side=True, turn=turn)
+        for a in (0.0, 0.5, -0.5)
+        for turn in TURNS
+        for sign in signs
+    ]
     return side + top + narrow
 
 
 def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:
-    return Step("move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation,
-                touches)
+    return Step(
+        "move", name, tuple(np.array([xy[0], xy[1], TABLE_TOP + h]) for h in CARRY_HEIGHTS), orientation, touches
+    )
 
 
 def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "", into: bool = False) -> Step:
@@ -229,10 +253,18 @@ def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     name = g.held.name
     if v.side:
         back = np.array([math.cos(v.yaw), math.sin(v.yaw), 0.0]) * SIDE_APPROACH
-        return [move(f"next to {name}", pos - back, orn), move(f"grip {name}", pos, orn, touches="held"),
-                Step("grasp", f"grasp {name}"), move(f"lift {name}", pos + [0, 0, 0.12], orn, touches="table")]
-    return [above(pos, f"above {name}", orn), move(f"grip {name}", pos, orn, touches="held"),
-            Step("grasp", f"grasp {name}"), above(pos, f"lift {name}", orn, touches="table")]
+        return [
+            move(f"next to {name}", pos - back, orn),
+            move(f"grip {name}", pos, orn, touches="held"),
+            Step("grasp", f"grasp {name}"),
+            move(f"lift {name}", pos + [0, 0, 0.12], orn, touches="table"),
+        ]
+    return [
+        above(pos, f"above {name}", orn),
+        move(f"grip {name}", pos, orn, touches="held"),
+        Step("grasp", f"grasp {name}"),
+        above(pos, f"lift {name}", orn, touches="table"),
+    ]
 
 
 def over_target(g: Geometry, v: Variant, name: str = "") -> Step:
@@ -246,8 +278,13 @@ def program_pour(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Hold the opening above the target's centre, tilted; let the liquid run; turn back upright."""
     tilt = tilted(v)
     spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, POUR_HEIGHT])
-    return [*pick(g, v, holding), over_target(g, v), move("tilt to pour", spout, tilt),
-            Step("spill", "pour", particles=30), over_target(g, v)]
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move("tilt to pour", spout, tilt),
+        Step("spill", "pour", particles=30),
+        over_target(g, v),
+    ]
 
 
 def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -256,8 +293,11 @@ def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     spout = gripper_for(g.mouth(v), tilt, g.target_top + [0, 0, SHAKE_HEIGHT])
     steps = [*pick(g, v, holding), over_target(g, v), move("tilt", spout, tilt)]
     for k in range(3):
-        steps += [move(f"shake {k + 1} down", spout - [0, 0, 0.02], tilt), Step("spill", "shake", particles=8),
-                  move(f"shake {k + 1} up", spout, tilt)]
+        steps += [
+            move(f"shake {k + 1} down", spout - [0, 0, 0.02], tilt),
+            Step("spill", "shake", particles=8),
+            move(f"shake {k + 1} up", spout, tilt),
+        ]
     return [*steps, over_target(g, v)]
 
 
@@ -269,8 +309,12 @@ def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -
     # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
     bottom = max(t[2] - depth + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
-    steps = [*pick(g, v, holding), over_target(g, v), move(f"lower into {g.target.name}", lower, orn,
-                                                            touches="target"), Step("release", "let go")]
+    steps = [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move(f"lower into {g.target.name}", lower, orn, touches="target"),
+        Step("release", "let go"),
+    ]
     if press:
         steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
     return [*steps, above(t, "retreat", orn)]
@@ -280,10 +324,16 @@ def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Carry the object over the target, turn the hand over and let go."""
     tilt = tilted(v)
     # lowest first (what falls stays where it lands); higher ones when the hand, turned, would meet the rim
-    turned = tuple(gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.label) / 2])
-                   for h in DUMP_HEIGHTS)
-    return [*pick(g, v, holding), over_target(g, v), Step("move", "turn over", turned, tilt), Step("release", "let go"),
-            over_target(g, v)]
+    turned = tuple(
+        gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.label) / 2]) for h in DUMP_HEIGHTS
+    )
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        Step("move", "turn over", turned, tilt),
+        Step("release", "let go"),
+        over_target(g, v),
+    ]
 
 
 def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -293,8 +343,12 @@ def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
     into = g.target.label in CONTAINERS
-    return [*pick(g, v, holding), over_target(g, v), move("dip", dip, orn, touches="target", probe="dip", into=into),
-            move("lift out", out, orn, touches="target", probe="lifted")]
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move("dip", dip, orn, touches="target", probe="dip", into=into),
+        move("lift out", out, orn, touches="target", probe="lifted"),
+    ]
 
 
 def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -303,8 +357,16 @@ def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     lo, hi = g.target_box
     reach = max(0.02, (hi[0] - lo[0]) / 2 - 0.03)
     # the held object's underside skims the surface, 1 cm above it
-    strokes = [move(f"stroke {k + 1}", gripper_for(g.bottom(v), orn, t + [reach if k % 2 else -reach, 0, 0.01]),
-                    orn, touches="target", probe=f"stroke {k + 1}") for k in range(4)]
+    strokes = [
+        move(
+            f"stroke {k + 1}",
+            gripper_for(g.bottom(v), orn, t + [reach if k % 2 else -reach, 0, 0.01]),
+            orn,
+            touches="target",
+            probe=f"stroke {k + 1}",
+        )
+        for k in range(4)
+    ]
     return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
 
 
@@ -312,12 +374,18 @@ def put_down(xy: tuple[float, float]) -> Task:
     """Pick the object up (unless it is in the hand), set it down upright at the free table spot `xy`
     and park the arm: the object is in the way of a task in the hand or out of one arm's reach, and the
     task then starts afresh from there."""
+
     def program(g: Geometry, v: Variant, holding: bool) -> list[Step]:
         orn = v.at_target()
         lower = gripper_for(g.bottom(v), orn, [*world_xy(xy), TABLE_TOP + PUT_DOWN_HEIGHT])
-        return [*pick(g, v, holding), above(lower, "over a free spot", orn),
-                move(f"put the {g.held.name} down", lower, orn, touches="table"), Step("release", "let go"),
-                above(lower, "away from it", orn), Step("park", "out of the way")]
+        return [
+            *pick(g, v, holding),
+            above(lower, "over a free spot", orn),
+            move(f"put the {g.held.name} down", lower, orn, touches="table"),
+            Step("release", "let go"),
+            above(lower, "away from it", orn),
+            Step("park", "out of the way"),
+        ]
 
     return Task("", "", program, lambda held, target, out: {"ok": True})
 
@@ -369,8 +437,11 @@ def check_dip(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
 
 def check_stroke(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
     lo, hi = p.getAABB(target.body)
-    on = all(lo[0] - 0.02 <= pos[0] <= hi[0] + 0.02 and lo[1] - 0.02 <= pos[1] <= hi[1] + 0.02
-             for name, (pos, _) in out.probes.items() if name.startswith("stroke"))
+    on = all(
+        lo[0] - 0.02 <= pos[0] <= hi[0] + 0.02 and lo[1] - 0.02 <= pos[1] <= hi[1] + 0.02
+        for name, (pos, _) in out.probes.items()
+        if name.startswith("stroke")
+    )
     return {"over_target": bool(on), "ok": bool(on)}
 
 
@@ -397,4 +468,3 @@ TASKS = {
     "brush": Task("Theme", "Destination", program_stroke, check_stroke),
     "rub": Task("Theme", "Destination", program_stroke, check_stroke),
 }
-

@@ -24,13 +24,22 @@ def _color(label: str) -> list[float]:
 def _container(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     w, d, h = CONTAINERS[label]
     t = 0.006  # wall thickness
-    parts = [([w / 2, d / 2, t / 2], [0, 0, t / 2]), ([t / 2, d / 2, h / 2], [w / 2 - t / 2, 0, h / 2]),
-             ([t / 2, d / 2, h / 2], [-w / 2 + t / 2, 0, h / 2]), ([w / 2, t / 2, h / 2], [0, d / 2 - t / 2, h / 2]),
-             ([w / 2, t / 2, h / 2], [0, -d / 2 + t / 2, h / 2])]
-    col = p.createCollisionShapeArray([p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts],
-                                      collisionFramePositions=[o for _, o in parts])
-    vis = p.createVisualShapeArray([p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts],
-                                   visualFramePositions=[o for _, o in parts], rgbaColors=[_color(label)] * 5)
+    parts = [
+        ([w / 2, d / 2, t / 2], [0, 0, t / 2]),
+        ([t / 2, d / 2, h / 2], [w / 2 - t / 2, 0, h / 2]),
+        ([t / 2, d / 2, h / 2], [-w / 2 + t / 2, 0, h / 2]),
+        ([w / 2, t / 2, h / 2], [0, d / 2 - t / 2, h / 2]),
+        ([w / 2, t / 2, h / 2], [0, -d / 2 + t / 2, h / 2]),
+    ]
+    col = p.createCollisionShapeArray(
+        [p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts], collisionFramePositions=[o for _, o in parts]
+    )
+    vis = p.createVisualShapeArray(
+        [p.GEOM_BOX] * 5,
+        halfExtents=[e for e, _ in parts],
+        visualFramePositions=[o for _, o in parts],
+        rgbaColors=[_color(label)] * 5,
+    )
     return p.createMultiBody(0.3, col, vis, [x, y, z])
 
 
@@ -65,9 +74,12 @@ def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     floor = p.createCollisionShape(p.GEOM_PLANE)
     p.createMultiBody(0, floor)
     half = [TABLE_SIZE[0] / 2, TABLE_SIZE[1] / 2, 0.02]
-    scene.table = p.createMultiBody(0, p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
-                                    p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
-                                    [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02])
+    scene.table = p.createMultiBody(
+        0,
+        p.createCollisionShape(p.GEOM_BOX, halfExtents=half),
+        p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.55, 0.4, 0.25, 1]),
+        [TABLE_CENTRE[0], TABLE_CENTRE[1], TABLE_TOP - 0.02],
+    )
     robot = p.loadURDF(str(baxter_urdf(cache_dir, urdf)), [0, 0, PEDESTAL_HEIGHT], useFixedBase=True)
     scene.bodies = {}
     for obj in scene.objects:

@@ -42,21 +42,35 @@ MIN_SENTENCES = 20  # a word in fewer sentences says little and would only grow 
 class ContextCooccurrence:
     """Sentence counts of words, object phrases and the two together; scores frames given a context."""
 
-    def __init__(self, sentences: float, word_sentences: dict[str, float], object_sentences: dict[str, float],
-                 pair_sentences: dict[str, dict[str, float]]):
+    def __init__(
+        self,
+        sentences: float,
+        word_sentences: dict[str, float],
+        object_sentences: dict[str, float],
+        pair_sentences: dict[str, dict[str, float]],
+    ):
         self.sentences, self.word_sentences = sentences, word_sentences
         self.object_sentences, self.pair_sentences = object_sentences, pair_sentences
 
     @classmethod
-    def count(cls, db: Path, sql_dir: Path, objects: Iterable[str], corpora: dict[str, float],
-              min_sentences: int = MIN_SENTENCES) -> ContextCooccurrence:
+    def count(
+        cls,
+        db: Path,
+        sql_dir: Path,
+        objects: Iterable[str],
+        corpora: dict[str, float],
+        min_sentences: int = MIN_SENTENCES,
+    ) -> ContextCooccurrence:
         """Count in the store's sentences, one query per corpus (`corpora`: corpus -> weight; 'all': 1)."""
         sentences, words, objs, pairs = 0.0, {}, {}, {}
         con = read_connection(db)
         try:
             for corpus, weight in corpora.items():
-                params = {"phrases": phrase_pattern(o.lower() for o in objects), "corpus": corpus,
-                          "min_sentences": min_sentences}
+                params = {
+                    "phrases": phrase_pattern(o.lower() for o in objects),
+                    "corpus": corpus,
+                    "min_sentences": min_sentences,
+                }
                 for kind, obj, word, n in con.execute(named_query(sql_dir, "context_cooccurrence"), params).fetchall():
                     if kind == "sentences":
                         sentences += weight * n
@@ -71,16 +85,22 @@ class ContextCooccurrence:
         return cls(sentences, words, objs, pairs)
 
     @classmethod
-    def cached(cls, db: Path, sql_dir: Path, objects: Iterable[str], corpora: dict[str, float],
-               cache: Path) -> ContextCooccurrence:
+    def cached(
+        cls, db: Path, sql_dir: Path, objects: Iterable[str], corpora: dict[str, float], cache: Path
+    ) -> ContextCooccurrence:
         """The counts from `cache` when it holds them for these objects (the caller names the file by the
         corpus content and mixture), else counted (about 20 s on the full store) and saved there."""
         objects = sorted({o.lower() for o in objects})
 
         def counted() -> dict:
             found = cls.count(db, sql_dir, objects, corpora)
-            return {"objects": objects, "sentences": found.sentences, "words": found.word_sentences,
-                    "object_sentences": found.object_sentences, "pairs": found.pair_sentences}
+            return {
+                "objects": objects,
+                "sentences": found.sentences,
+                "words": found.word_sentences,
+                "object_sentences": found.object_sentences,
+                "pairs": found.pair_sentences,
+            }
 
         def usable(saved) -> bool:
             return saved["objects"] == objects and isinstance(saved["sentences"], (int, float))
@@ -94,8 +114,11 @@ class ContextCooccurrence:
             STOP_WORDS,  # imported here: building the term (`lmcr evaluate` does) needs no spaCy
         )
 
-        seen = dict.fromkeys(w for w in tokens(context)
-                             if len(w) > 2 and w.isalpha() and w not in STOP_WORDS and w in self.word_sentences)
+        seen = dict.fromkeys(
+            w
+            for w in tokens(context)
+            if len(w) > 2 and w.isalpha() and w not in STOP_WORDS and w in self.word_sentences
+        )
         return list(seen)
 
     def pmi(self, word: str, obj: str) -> float:
@@ -110,8 +133,10 @@ class ContextCooccurrence:
         words = self.context_words(context) if context else []
         if not words:
             return [0.0] * len(frames)
-        return [weight * sum(self.pmi(w, value) for _, value in frame.roles for w in words if not _names(w, value))
-                for frame in frames]
+        return [
+            weight * sum(self.pmi(w, value) for _, value in frame.roles for w in words if not _names(w, value))
+            for frame in frames
+        ]
 
 
 def _names(word: str, value: str) -> bool:

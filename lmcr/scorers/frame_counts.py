@@ -23,6 +23,7 @@ from pathlib import Path
 
 from lmcr.frame import Frame
 from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.resources import MethodUnavailable
 from lmcr.store import named_query, read_connection
 
 ALPHA = 5.0  # the smoothing mass (module docstring)
@@ -38,8 +39,9 @@ def dirichlet(count: float, total: float, prior: float, alpha: float = ALPHA) ->
     return (count + alpha * prior) / (total + alpha)
 
 
-def weighted_counts(db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: str = "all",
-                    mixture: Mixture = Mixture()) -> list[list[tuple]]:
+def weighted_counts(
+    db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: str = "all", mixture: Mixture = Mixture()
+) -> list[list[tuple]]:
     """Each named count query's rows over the setting `corpus` (`all`: every corpus), the count (last
     column) of each corpus's rows times the weight the mixture gives it."""
     found: list[list[tuple]] = [[] for _ in queries]
@@ -47,8 +49,10 @@ def weighted_counts(db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: s
     try:
         for part, weight in mixture.parts(corpus).items():
             for rows, query in zip(found, queries):
-                rows += [(*row[:-1], weight * row[-1])
-                         for row in con.execute(named_query(sql_dir, query), {"corpus": part}).fetchall()]
+                rows += [
+                    (*row[:-1], weight * row[-1])
+                    for row in con.execute(named_query(sql_dir, query), {"corpus": part}).fetchall()
+                ]
     finally:
         con.close()
     return found
@@ -57,8 +61,12 @@ def weighted_counts(db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: s
 class FrameCountScorer:
     """Smoothed conditional filler probabilities from (predicate, role, value) and pair counts."""
 
-    def __init__(self, fillers: Iterable[tuple[str, str, str, float]],
-                 pairs: Iterable[tuple[str, str, str, str, str, float]], alpha: float = ALPHA):
+    def __init__(
+        self,
+        fillers: Iterable[tuple[str, str, str, float]],
+        pairs: Iterable[tuple[str, str, str, str, str, float]],
+        alpha: float = ALPHA,
+    ):
         self.alpha = alpha
         # Counts may be weighted (a mixture), hence floats.
         self.filler: Counter[tuple[str, str, str]] = Counter()  # (v, role, value)
@@ -76,13 +84,14 @@ class FrameCountScorer:
         self.n, self.types = sum(self.value.values()), len(self.value)
 
     @classmethod
-    def from_store(cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = ALPHA,
-                   mixture: Mixture = Mixture()) -> FrameCountScorer:
+    def from_store(
+        cls, db: Path, sql_dir: Path, corpus: str = "all", alpha: float = ALPHA, mixture: Mixture = Mixture()
+    ) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
         corpus's frames count as often as the mixture weighs it."""
         fillers, pairs = weighted_counts(db, sql_dir, ("frame_fillers", "frame_filler_pairs"), corpus, mixture)
         if not fillers:
-            raise ValueError(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
+            raise MethodUnavailable(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
         return cls(fillers, pairs, alpha)
 
     def p_value(self, value: str) -> float:
@@ -94,8 +103,12 @@ class FrameCountScorer:
 
     def p_given(self, v: str, given_role: str, given: str, role: str, value: str) -> float:
         """P(value | v, given_role = given, role)."""
-        return dirichlet(self.pair[(v, given_role, given, role, value)], self.given_total[(v, given_role, given, role)],
-                         self.p_filler(v, role, value), self.alpha)
+        return dirichlet(
+            self.pair[(v, given_role, given, role, value)],
+            self.given_total[(v, given_role, given, role)],
+            self.p_filler(v, role, value),
+            self.alpha,
+        )
 
     def score_frame(self, frame: Frame) -> float:
         v, roles = frame

@@ -19,8 +19,10 @@ def lm_checkpoint_dir(checkpoints: Path, linearization: str, corpus: str) -> Pat
         return checkpoints
     from lmcr.lm.checkpoint import CheckpointError
 
-    raise CheckpointError(f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
-                               f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)")
+    raise CheckpointError(
+        f"no {linearization} checkpoint for corpus {corpus!r} under {checkpoints} "
+        f"(run `lmcr train --linearization {linearization} --corpus {corpus}`)"
+    )
 
 
 def load_lm(res: MethodResources, linearization: str, corpus: str):
@@ -48,8 +50,7 @@ def lm_settings(method: str, res: MethodResources) -> list[Setting]:
     linearisation in the setting's corpus, or, under a mixture, in `all` and in each weighted corpus (the
     experts of `lm_experts`, counted before a corpus without words drops out)."""
     corpora = ["all", *(c for c, _ in res.mixture.weights)] if res.mixed else [res.corpus]
-    return [Setting(LM_METHODS[part], corpus) for part in method.split("+") if part in LM_METHODS
-            for corpus in corpora]
+    return [Setting(LM_METHODS[part], corpus) for part in method.split("+") if part in LM_METHODS for corpus in corpora]
 
 
 def lm_version_dir(res: MethodResources, linearization: str, corpus: str | None = None) -> Path:

@@ -113,7 +113,9 @@ def load_choice(data_dir: Path) -> tuple[Mixture, float | None]:
         raise MixtureError(f"{path}: not a mixture file ({exc}); run `lmcr mixture` again") from exc
     weight = data.get("context_weight")
     if weight is not None and not _positive(weight):
-        raise MixtureError(f"{path}: context_weight must be a positive number, not {weight!r}; run `lmcr mixture` again")
+        raise MixtureError(
+            f"{path}: context_weight must be a positive number, not {weight!r}; run `lmcr mixture` again"
+        )
     return mixture, weight
 
 

@@ -40,11 +40,14 @@ class PhraseCounts:
     as a mixture weighs it), counted in one pass for every phrase not seen before and kept. `words` is
     the store's words per source corpus (`scorers.resources.corpus_words`)."""
 
-    def __init__(self, db: Path, sql_dir: Path, words: dict[str, int], corpus: str = "all",
-                 mixture: Mixture = Mixture()):
+    def __init__(
+        self, db: Path, sql_dir: Path, words: dict[str, int], corpus: str = "all", mixture: Mixture = Mixture()
+    ):
         self.db, self.sql_dir = Path(db), sql_dir
         self.weights = mixture.parts(corpus)
-        self.words = float(sum(mixture.weight(c) * n for c, n in words.items()) if corpus == "all" else words.get(corpus, 0))
+        self.words = float(
+            sum(mixture.weight(c) * n for c, n in words.items()) if corpus == "all" else words.get(corpus, 0)
+        )
         self.counts: dict[str, float] = {}
 
     def count(self, phrases: Iterable[str]) -> None:
@@ -56,8 +59,9 @@ class PhraseCounts:
         con = read_connection(self.db)
         try:
             for part, weight in self.weights.items():
-                rows = con.execute(named_query(self.sql_dir, "phrase_counts"),
-                                   {"phrases": phrase_pattern(todo), "corpus": part}).fetchall()
+                rows = con.execute(
+                    named_query(self.sql_dir, "phrase_counts"), {"phrases": phrase_pattern(todo), "corpus": part}
+                ).fetchall()
                 for phrase, n in rows:
                     found[phrase] = found.get(phrase, 0.0) + weight * n
         finally:
@@ -76,8 +80,11 @@ class PhraseCounts:
 
         def usable(saved) -> bool:
             counts = saved["counts"]
-            return (saved["words"] == self.words and set(phrases) <= set(counts)
-                    and all(isinstance(n, (int, float)) for n in counts.values()))
+            return (
+                saved["words"] == self.words
+                and set(phrases) <= set(counts)
+                and all(isinstance(n, (int, float)) for n in counts.values())
+            )
 
         self.counts.update({p: float(n) for p, n in cached_json(cache, usable, counted)["counts"].items()})
 

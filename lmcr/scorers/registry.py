@@ -16,6 +16,7 @@ from lmcr.scorers.caches import count_cache, word_vectors
 from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir, load_lm
 from lmcr.scorers.resources import (
     MethodResources,
+    MethodUnavailable,
     corpus_sentences,
     corpus_words,
     robot_terms,
@@ -65,13 +66,16 @@ def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., 
 
         experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
         return experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
+
     return build
 
 
 def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     def fingerprint(res: MethodResources) -> str:
-        return ",".join(file_sha256(lm_version_dir(res, linearization, corpus) / "manifest.json")
-                        for corpus, _ in lm_experts(res))
+        return ",".join(
+            file_sha256(lm_version_dir(res, linearization, corpus) / "manifest.json") for corpus, _ in lm_experts(res)
+        )
+
     return fingerprint
 
 
@@ -152,7 +156,7 @@ def _word2vec(res: MethodResources) -> Scorer:
 
 def _conceptnet_edges(res: MethodResources) -> Path:
     if res.conceptnet is None:
-        raise ValueError("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+        raise MethodUnavailable("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
     return res.conceptnet
 
 
@@ -180,8 +184,10 @@ def _random(res: MethodResources) -> Scorer:
 # the instruction's context after the filled frame, as one more stretch of text; the frame LM learned
 # bare frames, where a purpose clause never occurs.
 SCORERS: dict[str, ScorerSpec] = {
-    **{method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
-       for method, lin in LM_METHODS.items()},
+    **{
+        method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
+        for method, lin in LM_METHODS.items()
+    },
     "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
     "similar_verbs": ScorerSpec(_similar_verbs, _similar_verbs_fingerprint),
     "cooccur": ScorerSpec(_cooccur),
@@ -198,8 +204,13 @@ METHODS = tuple(SCORERS)
 TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
 # what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
 # its third expert
-EVALUATED = (*METHODS[:4], "sentence_lm+frame_counts", COMPLETION_METHOD.replace("+similar_verbs", ""),
-             COMPLETION_METHOD, *(m for m in METHODS[4:] if m not in TERMS))
+EVALUATED = (
+    *METHODS[:4],
+    "sentence_lm+frame_counts",
+    COMPLETION_METHOD.replace("+similar_verbs", ""),
+    COMPLETION_METHOD,
+    *(m for m in METHODS[4:] if m not in TERMS),
+)
 
 
 def make_scorer(method: str, res: MethodResources) -> Scorer:
@@ -209,7 +220,7 @@ def make_scorer(method: str, res: MethodResources) -> Scorer:
         parts = [make_scorer(m, res) for m in method.split("+")]
         return lambda frames, context="": [sum(s) for s in zip(*(part(frames, context) for part in parts))]
     if method not in SCORERS:
-        raise ValueError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+        raise MethodUnavailable(f"unknown method {method!r}; available: {', '.join(METHODS)}")
     spec = SCORERS[method]
     score = spec.build(res)
     if spec.reads_context:

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lmcr.checkout import SQL_DIR
+from lmcr.errors import LMCRError
 from lmcr.lexicon import load_lexicon
 from lmcr.scorers.context_pmi import WEIGHT as CONTEXT_WEIGHT
 from lmcr.scorers.mixture import Mixture
@@ -39,10 +40,14 @@ class MethodResources:
         return self.corpus == "all" and not self.mixture.plain
 
 
+class MethodUnavailable(LMCRError, ValueError):
+    """A method the user asked for that cannot be built (no checkpoint or store, a bad vector or edge file, ...)."""
+
+
 def store_path(res: MethodResources, method: str, what: str = "frames") -> Path:
     """The store a count-based scorer reads, or why there is none."""
     if res.db is None or not Path(res.db).exists():
-        raise ValueError(f"{method} needs the store's {what}: no store at {res.db}")
+        raise MethodUnavailable(f"{method} needs the store's {what}: no store at {res.db}")
     return Path(res.db)
 
 

@@ -44,6 +44,7 @@ from lmcr.frame import Frame
 from lmcr.lexicon import Lexicon, PredicateSpec
 from lmcr.scorers.frame_counts import add_one, dirichlet, weighted_counts
 from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.resources import MethodUnavailable
 
 WEIGHT = 0.25
 NEIGHBOURS = 20
@@ -71,9 +72,11 @@ class Relation:
     def filler_pair(self, frame: Frame) -> tuple[str, str]:
         """(object-role filler, other-role filler) of a complete frame."""
         roles = frame.role_map
+        # a bug: completion and evaluation score complete frames only
         if not roles.get(self.object_role) or not roles.get(self.other_role):
-            raise ValueError(f"similar_verbs scores complete frames: {frame.to_json()} lacks "
-                             f"{self.object_role} or {self.other_role}")
+            raise ValueError(
+                f"similar_verbs scores complete frames: {frame.to_json()} lacks {self.object_role} or {self.other_role}"
+            )
         return roles[self.object_role], roles[self.other_role]
 
 
@@ -104,10 +107,14 @@ class PairTable:
 
     def restricted(self, words: set[str]) -> PairTable:
         """The same table holding only pairs and marginals of `words` (what a cache keeps; sizes unchanged)."""
-        return PairTable({k: n for k, n in self.pairs.items() if k[0] in words and k[1] in words},
-                         {a: n for a, n in self.objects.items() if a in words},
-                         {o: n for o, n in self.others.items() if o in words},
-                         self.total, self.object_types, self.other_types)
+        return PairTable(
+            {k: n for k, n in self.pairs.items() if k[0] in words and k[1] in words},
+            {a: n for a, n in self.objects.items() if a in words},
+            {o: n for o, n in self.others.items() if o in words},
+            self.total,
+            self.object_types,
+            self.other_types,
+        )
 
 
 def relation_pairs(name: str, lex: Lexicon, generic: dict[str, list[tuple]], robot: list[tuple]) -> dict[str, Counter]:
@@ -119,7 +126,9 @@ def relation_pairs(name: str, lex: Lexicon, generic: dict[str, list[tuple]], rob
     for prep in relation.preps:
         for verb, a, o, n in generic.get(prep, ()):
             pairs[verb][(a, o)] += n
-    same_roles = {p for p, spec in lex.predicates.items() if set(spec.roles) == {relation.object_role, relation.other_role}}
+    same_roles = {
+        p for p, spec in lex.predicates.items() if set(spec.roles) == {relation.object_role, relation.other_role}
+    }
     for predicate, given_role, a, role, o, n in robot:
         if predicate in same_roles and given_role == relation.object_role and role == relation.other_role:
             pairs[predicate][(a, o)] += n
@@ -136,7 +145,9 @@ def _ppmi(marginals: dict[str, Counter]) -> dict[str, tuple[dict[str, float], fl
     vectors = {}
     for verb, counts in marginals.items():
         size = sum(counts.values())
-        vector = {x: math.log(n * grand / (size * totals[x])) for x, n in counts.items() if n * grand > size * totals[x]}
+        vector = {
+            x: math.log(n * grand / (size * totals[x])) for x, n in counts.items() if n * grand > size * totals[x]
+        }
         vectors[verb] = vector, math.sqrt(sum(x * x for x in vector.values()))
     return vectors
 
@@ -148,7 +159,9 @@ def _cosine(u: tuple[dict[str, float], float], v: tuple[dict[str, float], float]
     return sum(x * large.get(k, 0.0) for k, x in small.items()) / (small_norm * large_norm)
 
 
-def neighbours(pairs: dict[str, Counter], predicate: str, k: int = NEIGHBOURS, min_pairs: int = MIN_PAIRS) -> dict[str, float]:
+def neighbours(
+    pairs: dict[str, Counter], predicate: str, k: int = NEIGHBOURS, min_pairs: int = MIN_PAIRS
+) -> dict[str, float]:
     """The k verbs whose fillers are most like `predicate`'s (PPMI cosine of the object-role fillers
     times that of the other role's), each weighted by its similarity over the best one's."""
     sides = []
@@ -160,8 +173,11 @@ def neighbours(pairs: dict[str, Counter], predicate: str, k: int = NEIGHBOURS, m
                 side[key[i]] += n
         sides.append(_ppmi(marginals))
     own = [side.get(predicate, ({}, 0.0)) for side in sides]
-    similar = [(_cosine(own[0], sides[0][verb]) * _cosine(own[1], sides[1][verb]), verb)
-               for verb, counts in pairs.items() if verb != predicate and sum(counts.values()) >= min_pairs]
+    similar = [
+        (_cosine(own[0], sides[0][verb]) * _cosine(own[1], sides[1][verb]), verb)
+        for verb, counts in pairs.items()
+        if verb != predicate and sum(counts.values()) >= min_pairs
+    ]
     top = sorted(((s, verb) for s, verb in similar if s > 0), key=lambda sv: (-sv[0], sv[1]))[:k]
     return {verb: s / top[0][0] for s, verb in top}
 
@@ -169,8 +185,14 @@ def neighbours(pairs: dict[str, Counter], predicate: str, k: int = NEIGHBOURS, m
 class SimilarVerbs:
     """Per robot predicate, the counts its most similar verbs pool; scores complete frames."""
 
-    def __init__(self, tables: dict[str, PairTable], near: dict[str, dict[str, float]], lex: Lexicon,
-                 words: set[str] | None = None, full: Callable[[], SimilarVerbs] | None = None):
+    def __init__(
+        self,
+        tables: dict[str, PairTable],
+        near: dict[str, dict[str, float]],
+        lex: Lexicon,
+        words: set[str] | None = None,
+        full: Callable[[], SimilarVerbs] | None = None,
+    ):
         # `words`: the tables hold only these fillers' counts (a cache); a frame with another filler is
         # scored by `full()`, the complete counts, made when first needed.
         self.tables, self.near, self.words, self._full = tables, near, words, full
@@ -194,11 +216,13 @@ class SimilarVerbs:
         return cls(tables, near, lex)
 
     @classmethod
-    def count(cls, db: Path, sql_dir: Path, lex: Lexicon, corpus: str = "all", mixture: Mixture = Mixture()) -> SimilarVerbs:
+    def count(
+        cls, db: Path, sql_dir: Path, lex: Lexicon, corpus: str = "all", mixture: Mixture = Mixture()
+    ) -> SimilarVerbs:
         """Counted in the store's frames of a corpus setting (`all`: each corpus weighted by the mixture)."""
         generic, robot = weighted_counts(db, sql_dir, ("verb_filler_pairs", "frame_filler_pairs"), corpus, mixture)
         if not robot:
-            raise ValueError(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
+            raise MethodUnavailable(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
         return cls.from_counts(lex, generic, robot)
 
     @classmethod
@@ -212,12 +236,18 @@ class SimilarVerbs:
 
         def counted() -> dict:
             found = full()
-            return {"words": words, "neighbours": found.near,
-                    "tables": {name: _table_json(t.restricted(set(words))) for name, t in found.tables.items()}}
+            return {
+                "words": words,
+                "neighbours": found.near,
+                "tables": {name: _table_json(t.restricted(set(words))) for name, t in found.tables.items()},
+            }
 
         def usable(saved) -> bool:  # a malformed table raises here, and is counted afresh
-            return (saved["words"] == words and set(saved["tables"]) == set(lex.predicates)
-                    and all(_table_of(t) for t in saved["tables"].values()))
+            return (
+                saved["words"] == words
+                and set(saved["tables"]) == set(lex.predicates)
+                and all(_table_of(t) for t in saved["tables"].values())
+            )
 
         saved = cached_json(cache, usable, counted)
         tables = {name: _table_of(t) for name, t in saved["tables"].items()}
@@ -231,7 +261,7 @@ class SimilarVerbs:
         """WEIGHT * (log P(o | a) + log P(a | o)) under each frame's predicate's pooled counts."""
         scores = []
         for frame in frames:
-            if frame.predicate not in self.relations:
+            if frame.predicate not in self.relations:  # a bug: only robot predicates are completed or rated
                 raise ValueError(f"similar_verbs scores robot predicates, not {frame.predicate!r}")
             a, o = self.relations[frame.predicate].filler_pair(frame)
             source = self if self.words is None or {a, o} <= self.words else self.complete_counts
@@ -240,11 +270,22 @@ class SimilarVerbs:
 
 
 def _table_json(table: PairTable) -> dict:
-    return {"pairs": [[a, o, n] for (a, o), n in sorted(table.pairs.items())], "objects": table.objects,
-            "others": table.others, "total": table.total, "object_types": table.object_types,
-            "other_types": table.other_types}
+    return {
+        "pairs": [[a, o, n] for (a, o), n in sorted(table.pairs.items())],
+        "objects": table.objects,
+        "others": table.others,
+        "total": table.total,
+        "object_types": table.object_types,
+        "other_types": table.other_types,
+    }
 
 
 def _table_of(saved: dict) -> PairTable:
-    return PairTable({(a, o): float(n) for a, o, n in saved["pairs"]}, saved["objects"], saved["others"],
-                     float(saved["total"]), int(saved["object_types"]), int(saved["other_types"]))
+    return PairTable(
+        {(a, o): float(n) for a, o, n in saved["pairs"]},
+        saved["objects"],
+        saved["others"],
+        float(saved["total"]),
+        int(saved["object_types"]),
+        int(saved["other_types"]),
+    )

@@ -127,9 +127,15 @@ def create_app(ws: Workspace, method: str = COMPLETION_METHOD, corpus: str = "al
     @app.get("/api/vocabulary")
     def vocabulary() -> dict:
         lex = load_lexicon()
-        return {"objects": list(lex.objects), "max_objects": MAX_OBJECTS, "example": EXAMPLE,
-                "predicates": {name: spec.sentence for name, spec in lex.predicates.items()},
-                "method": method, "corpus": corpus, "data_dir": str(ws.data_dir)}
+        return {
+            "objects": list(lex.objects),
+            "max_objects": MAX_OBJECTS,
+            "example": EXAMPLE,
+            "predicates": {name: spec.sentence for name, spec in lex.predicates.items()},
+            "method": method,
+            "corpus": corpus,
+            "data_dir": str(ws.data_dir),
+        }
 
     @app.post("/api/complete")
     def complete(body: SceneRequest) -> dict:
@@ -147,8 +153,9 @@ def create_app(ws: Workspace, method: str = COMPLETION_METHOD, corpus: str = "al
     async def listen(request: Request, objects: str = Query("", max_length=2000)) -> dict:
         declared = request.headers.get("content-length", "")
         if declared.isdigit() and int(declared) > MAX_AUDIO_BYTES:
-            raise RequestError(f"the recording is {int(declared) / 2**20:.1f} MiB; the limit is "
-                               f"{MAX_AUDIO_BYTES / 2**20:.0f} MiB")
+            raise RequestError(
+                f"the recording is {int(declared) / 2**20:.1f} MiB; the limit is {MAX_AUDIO_BYTES / 2**20:.0f} MiB"
+            )
         audio = await request.body()
         labels = [o for o in objects.split(",") if o.strip()]
         return await run_in_threadpool(robot.listen, audio, labels)
@@ -179,8 +186,14 @@ def is_loopback(host: str) -> bool:
         return host == "localhost"
 
 
-def serve(ws: Workspace, host: str = "127.0.0.1", port: int = 8000, method: str = COMPLETION_METHOD,
-          corpus: str = "all", say: Callable[[str], None] = print) -> None:
+def serve(
+    ws: Workspace,
+    host: str = "127.0.0.1",
+    port: int = 8000,
+    method: str = COMPLETION_METHOD,
+    corpus: str = "all",
+    say: Callable[[str], None] = print,
+) -> None:
     """Serve the page on host:port until interrupted (Ctrl-C or SIGTERM); `say` gets the address."""
     import uvicorn
 

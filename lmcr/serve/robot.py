@@ -69,8 +69,10 @@ def check_labels(objects: list[str]) -> list[str]:
     known = set(load_lexicon().objects)
     for label in labels:
         if label not in known:
-            raise RequestError(f"unknown object {label[:40]!r}: the robot knows {len(known)} objects (the page lists "
-                               "them; GET /api/vocabulary)")
+            raise RequestError(
+                f"unknown object {label[:40]!r}: the robot knows {len(known)} objects (the page lists "
+                "them; GET /api/vocabulary)"
+            )
     repeated = next((label for label in labels if labels.count(label) > 1), None)
     if repeated:
         raise RequestError(f"the {repeated} is on the list twice; the robot tells objects apart by name")
@@ -123,8 +125,10 @@ class ServedRobot:
                 parser = self.ws.parser()
                 scorer, config = self.ws.completion_scorer(self.method, self.ws.resources(corpus=self.corpus))
             except (LMCRError, OSError, ValueError, RuntimeError, KeyError) as exc:
-                raise ModelsUnavailable(f"cannot load the models from {self.ws.data_dir} ({one_line(exc, 300)}); "
-                                        "run `make demo` or the pipeline for this data folder first") from exc
+                raise ModelsUnavailable(
+                    f"cannot load the models from {self.ws.data_dir} ({one_line(exc, 300)}); "
+                    "run `make demo` or the pipeline for this data folder first"
+                ) from exc
             self._models = parser, scorer, config
         return self._models
 
@@ -138,19 +142,27 @@ class ServedRobot:
         with self.lock:
             parser, scorer, config = self.models()
             completion = complete(parser, scorer, text, labels, config)
-        missing = completion["missing_roles"]
-        said = {r: (None if r in missing else v) for r, v in completion["frame"]["roles"].items()}
+        missing = completion.missing_roles
+        said = {r: (None if r in missing else v) for r, v in completion.frame.roles}
         pending = None
-        if completion["question"] and missing:
-            stated = {v for r, v in completion["frame"]["roles"].items() if r != missing[0]}
-            choices = list(dict.fromkeys(c["object"] for c in completion["candidates"]))
-            pending = asdict(Pending("choose", missing[0], choices, [o for o in labels if o not in stated],
-                                     completion["question"]))
-        return {"instruction": text, "scene": [{"label": o.label, "xy": list(o.xy)} for o in layout.objects],
-                "said": {"predicate": completion["frame"]["predicate"], "roles": said}, **completion,
-                "calibration": config.source, "pending": pending}
+        if completion.question and missing:
+            stated = {v for r, v in completion.frame.roles if r != missing[0]}
+            choices = list(dict.fromkeys(c.object for c in completion.candidates))
+            pending = asdict(
+                Pending("choose", missing[0], choices, [o for o in labels if o not in stated], completion.question)
+            )
+        return {
+            "instruction": text,
+            "scene": [{"label": o.label, "xy": list(o.xy)} for o in layout.objects],
+            "said": {"predicate": completion.frame.predicate, "roles": said},
+            **completion.to_json(),
+            "calibration": config.source,
+            "pending": pending,
+        }
 
-    def execute(self, instruction: str, objects: list[str], seed: int = 0, answer: dict[str, str] | None = None) -> dict:
+    def execute(
+        self, instruction: str, objects: list[str], seed: int = 0, answer: dict[str, str] | None = None
+    ) -> dict:
         """Execute the instruction in simulation (with a person's `answer`, role -> object, when given) and
         record it: the result, the animation's id, what the robot says, and its offer when the choice was
         out of reach but another object is not."""
@@ -165,16 +177,22 @@ class ServedRobot:
             if answer:
                 _check_answer(answer, read_instruction(parser, text)[0].roles, labels)
             recorder = Recorder(layout)
-            result = execute(text, layout, parser, scorer, config, self.ws.robot, recorder, answer=answer,
-                             urdf=self.ws.baxter_urdf)
+            result = execute(
+                text, layout, parser, scorer, config, self.ws.robot, recorder, answer=answer, urdf=self.ws.baxter_urdf
+            )
             animation = self._keep(recorder) if recorder.pictures else None
         pending = None
         if not result["feasible"] and result.get("suggestion"):
             role, offered = next(iter(result["suggestion"].items()))
             pending = asdict(Pending("offer", role, [offered, result["chosen_object"]], labels, say(result)))
         shown = {k: v for k, v in result.items() if k != "detections"}
-        return {**shown, "animation": animation, "captions": recorder.captions, "reply": say(result),
-                "pending": pending}
+        return {
+            **shown,
+            "animation": animation,
+            "captions": recorder.captions,
+            "reply": say(result),
+            "pending": pending,
+        }
 
     def _keep(self, recorder) -> str:
         """Keep the run's GIF (the last KEPT_ANIMATIONS are served) and return its id."""
@@ -193,8 +211,9 @@ class ServedRobot:
         from lmcr.speech.listen import listen
 
         if len(audio) > MAX_AUDIO_BYTES:
-            raise RequestError(f"the recording is {len(audio) / 2**20:.1f} MiB; the limit is "
-                               f"{MAX_AUDIO_BYTES / 2**20:.0f} MiB")
+            raise RequestError(
+                f"the recording is {len(audio) / 2**20:.1f} MiB; the limit is {MAX_AUDIO_BYTES / 2**20:.0f} MiB"
+            )
         labels = check_labels(objects) if objects else None
         with tempfile.TemporaryDirectory(prefix="lmcr-serve-") as tmp:
             path = Path(tmp) / "recording.wav"
@@ -214,7 +233,8 @@ class ServedRobot:
 def _check_answer(answer: dict[str, str], roles: dict, labels: list[str]) -> None:
     for role, obj in answer.items():
         if role not in roles:
-            raise RequestError(f"the answer fills {role[:40]!r}, which is no role of this instruction "
-                               f"({', '.join(roles)})")
+            raise RequestError(
+                f"the answer fills {role[:40]!r}, which is no role of this instruction ({', '.join(roles)})"
+            )
         if obj not in labels:
             raise RequestError(f"the answer names {obj[:40]!r}, which is not on the table")

@@ -30,8 +30,18 @@ from lmcr.versions import publish_version, resolve, write_json
 FILES = ("domain.lm", "domain.dict", "build.json")
 WORD = re.compile(r"[a-z]+(?:'[a-z]+)?")
 # Generic English request frames (not sentences of any test set): the spoken form of an instruction.
-PREFIXES = ("", "", "please ", "could you ", "can you ", "would you ", "could you please ", "go ahead and ",
-            "i want you to ", "now ")
+PREFIXES = (
+    "",
+    "",
+    "please ",
+    "could you ",
+    "can you ",
+    "would you ",
+    "could you please ",
+    "go ahead and ",
+    "i want you to ",
+    "now ",
+)
 SUFFIXES = ("", "", "", " please", " for me", " now")
 DETERMINERS = ("the ", "the ", "some ", "a ", "my ", "")
 
@@ -62,8 +72,11 @@ def lexicon_words(lexicon: Lexicon) -> set[str]:
 
 def corpus_sentences(con: duckdb.DuckDBPyConnection, limit: int, seed: int) -> list[str]:
     """Up to `limit` distinct instruction sentences of the store, a deterministic sample."""
-    rows = con.execute("select text from (select distinct text from sentences where kind = 'instruction') "
-                       "order by hash(text || ?) limit ?", [str(seed), limit]).fetchall()
+    rows = con.execute(
+        "select text from (select distinct text from sentences where kind = 'instruction') "
+        "order by hash(text || ?) limit ?",
+        [str(seed), limit],
+    ).fetchall()
     return [r[0] for r in rows]
 
 
@@ -90,8 +103,12 @@ def _cores(spec, rng: random.Random, objects: list[str], recipients: list[str], 
     a, b = rng.choice(objects), rng.choice(objects)
     det = lambda: rng.choice(DETERMINERS)  # noqa: E731
     prep = rng.choice(sorted(spec.preps.get(other, ())) or ["with"])
-    cores = [f"{verb} {det()}{a} {prep} {det()}{b}", f"{verb} {det()}{a}", f"{verb} {prep} {det()}{b}",
-             f"{verb} {rng.choice(recipients)} {det()}{a}"]
+    cores = [
+        f"{verb} {det()}{a} {prep} {det()}{b}",
+        f"{verb} {det()}{a}",
+        f"{verb} {prep} {det()}{b}",
+        f"{verb} {rng.choice(recipients)} {det()}{a}",
+    ]
     if quantities:
         cores.append(f"{verb} {rng.choice(('a', 'some', 'two'))} {rng.choice(quantities)} of {a}")
     if spec.with_role:  # "fill the cup with water", "brush the bread with oil"
@@ -136,7 +153,7 @@ def count_ngrams(sentences: Iterable[tuple[list[str], float]], vocab: set[str]) 
                 padded = ["<s>", *run, "</s>"]
                 for n in (1, 2, 3):
                     for i in range(len(padded) - n + 1):
-                        counts[n - 1][tuple(padded[i:i + n])] += weight
+                        counts[n - 1][tuple(padded[i : i + n])] += weight
             run = []
     return counts
 
@@ -170,8 +187,9 @@ def _backed_off(gram: tuple, probs: list[dict], backoff: list[dict]) -> float:
     """P(gram) from a lower order when the gram itself was not kept."""
     if len(gram) == 1:
         return probs[0].get(gram, 1e-9)
-    return backoff[len(gram) - 2].get(gram[:-1], 1.0) * (probs[len(gram) - 2].get(gram[1:])
-                                                         or _backed_off(gram[1:], probs, backoff))
+    return backoff[len(gram) - 2].get(gram[:-1], 1.0) * (
+        probs[len(gram) - 2].get(gram[1:]) or _backed_off(gram[1:], probs, backoff)
+    )
 
 
 def _log10(p: float) -> float:
@@ -191,29 +209,22 @@ def write_arpa(entries: list[dict[tuple, tuple[float, float]]], path: Path) -> N
         out.write("\\end\\\n")
 
 
-def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: Path, model_dir: Path,
-                    config: SpeechLMConfig = SpeechLMConfig(), log: Callable[[str], None] = print) -> Path:
-    """Estimate the domain model from the store and the lexicon and publish a version of it in
-    `model_dir` (the workspace's `speech` folder); when
-    the latest version was built from the same inputs (ingested files, lexicon, dictionary, settings),
-    return it instead (re-running the stage is free)."""
-    fingerprint = inputs_fingerprint(con, cmudict, config)
-    if (model_dir / "LATEST").exists():
-        current = resolve(model_dir)
-        if (current / "build.json").exists() and load_build(current).get("inputs_sha256") == fingerprint:
-            log(f"speech model {current}: inputs unchanged (kept)")
-            return current
-    corpus = [tokenize(s) for s in corpus_sentences(con, config.max_sentences, config.seed)]
-    requests = [tokenize(s) for s in request_forms(lexicon, config.request_forms, config.seed)]
-    corpus_tokens, request_tokens = sum(map(len, corpus)) or 1, sum(map(len, requests)) or 1
-    ratio = config.request_share * corpus_tokens / ((1 - config.request_share) * request_tokens)
-    w_corpus, w_request = (1.0, ratio) if ratio >= 1 else (1 / ratio, 1.0)  # weights >= 1: discounts stay sound
-    prons = read_cmudict(cmudict)
-    needed = lexicon_words(lexicon)
-    frequency = Counter(w for words in corpus for w in words)
-    for words in requests:  # weighted like the n-gram counts: every occurrence counts w_request
-        for w in words:
-            frequency[w] += w_request
+def _built_from(model_dir: Path, fingerprint: str) -> Path | None:
+    """The latest version in `model_dir` when it was built from inputs with this fingerprint, else None."""
+    if not (model_dir / "LATEST").exists():
+        return None
+    current = resolve(model_dir)
+    if (current / "build.json").exists() and load_build(current).get("inputs_sha256") == fingerprint:
+        return current
+    return None
+
+
+def _pronounced_vocabulary(
+    frequency: Counter, needed: set[str], prons: dict[str, list], config: SpeechLMConfig
+) -> tuple[dict[str, list], list[str], list[str]]:
+    """The vocabulary, most frequent words first, up to `config.max_vocab` (the lexicon's words always),
+    each with its pronunciations; returns it with the words pronounced from their parts and the words
+    dropped for want of a pronunciation."""
     vocab, fallback, missing = {}, [], []
     for word, _ in frequency.most_common():
         if len(vocab) >= config.max_vocab and word not in needed:
@@ -227,33 +238,78 @@ def build_speech_lm(con: duckdb.DuckDBPyConnection, lexicon: Lexicon, cmudict: P
         if word not in prons:
             fallback.append(word)
         vocab[word] = [pron] if word not in prons else prons[word]
+    return vocab, fallback, missing
+
+
+def build_speech_lm(
+    con: duckdb.DuckDBPyConnection,
+    lexicon: Lexicon,
+    cmudict: Path,
+    model_dir: Path,
+    config: SpeechLMConfig = SpeechLMConfig(),
+    log: Callable[[str], None] = print,
+) -> Path:
+    """Estimate the domain model from the store and the lexicon and publish a version of it in
+    `model_dir` (the workspace's `speech` folder); when
+    the latest version was built from the same inputs (ingested files, lexicon, dictionary, settings),
+    return it instead (re-running the stage is free)."""
+    fingerprint = inputs_fingerprint(con, cmudict, config)
+    current = _built_from(model_dir, fingerprint)
+    if current is not None:
+        log(f"speech model {current}: inputs unchanged (kept)")
+        return current
+    corpus = [tokenize(s) for s in corpus_sentences(con, config.max_sentences, config.seed)]
+    requests = [tokenize(s) for s in request_forms(lexicon, config.request_forms, config.seed)]
+    corpus_tokens, request_tokens = sum(map(len, corpus)) or 1, sum(map(len, requests)) or 1
+    ratio = config.request_share * corpus_tokens / ((1 - config.request_share) * request_tokens)
+    w_corpus, w_request = (1.0, ratio) if ratio >= 1 else (1 / ratio, 1.0)  # weights >= 1: discounts stay sound
+    prons = read_cmudict(cmudict)
+    needed = lexicon_words(lexicon)
+    frequency = Counter(w for words in corpus for w in words)
+    for words in requests:  # weighted like the n-gram counts: every occurrence counts w_request
+        for w in words:
+            frequency[w] += w_request
+    vocab, fallback, missing = _pronounced_vocabulary(frequency, needed, prons, config)
     for word in sorted(needed - set(vocab)):
         log(f"warning: lexicon word {word!r} has no pronunciation; the recogniser cannot hear it")
     if fallback:
         log(f"warning: {len(fallback)} words pronounced from their parts: {', '.join(sorted(fallback)[:10])}")
     counts = count_ngrams([(w, w_corpus) for w in corpus] + [(w, w_request) for w in requests], set(vocab))
     entries = estimate(counts, config.discount, config.min_trigram)
-    build = {"inputs_sha256": fingerprint, "config": asdict(config), "corpus_sentences": len(corpus), "request_forms": len(requests),
-             "corpus_tokens": corpus_tokens, "request_tokens": request_tokens, "weights": [w_corpus, w_request],
-             "vocabulary": len(vocab), "ngrams": [len(e) for e in entries], "pronounced_from_parts": sorted(fallback),
-             "dropped_without_pronunciation": len(missing)}
+    build = {
+        "inputs_sha256": fingerprint,
+        "config": asdict(config),
+        "corpus_sentences": len(corpus),
+        "request_forms": len(requests),
+        "corpus_tokens": corpus_tokens,
+        "request_tokens": request_tokens,
+        "weights": [w_corpus, w_request],
+        "vocabulary": len(vocab),
+        "ngrams": [len(e) for e in entries],
+        "pronounced_from_parts": sorted(fallback),
+        "dropped_without_pronunciation": len(missing),
+    }
 
     def write(folder: Path) -> None:
         write_arpa(entries, folder / "domain.lm")
         lines = [f"{w}{'' if i == 0 else f'({i + 1})'} {p}" for w in sorted(vocab) for i, p in enumerate(vocab[w])]
         (folder / "domain.dict").write_text("\n".join(lines) + "\n", encoding="utf-8")
         write_json(folder / "build.json", build)
+
     path = publish_version(model_dir.parent, model_dir.name, FILES, write)
-    log(f"speech model {path}: {len(vocab):,} words, n-grams {build['ngrams']}, "
-        f"{len(corpus):,} corpus sentences + {len(requests):,} request forms")
+    log(
+        f"speech model {path}: {len(vocab):,} words, n-grams {build['ngrams']}, "
+        f"{len(corpus):,} corpus sentences + {len(requests):,} request forms"
+    )
     return path
 
 
 def inputs_fingerprint(con: duckdb.DuckDBPyConnection, cmudict: Path, config: SpeechLMConfig) -> str:
     """What a speech model is built from: the ingested files' hashes, the lexicon, the dictionary, the
     settings and this module."""
-    digest = hashlib.sha256(repr((con.execute("select sha256 from ingested_files order by 1").fetchall(),
-                                  asdict(config))).encode())
+    digest = hashlib.sha256(
+        repr((con.execute("select sha256 from ingested_files order by 1").fetchall(), asdict(config))).encode()
+    )
     for path in (*LEXICON_FILES, cmudict, Path(__file__)):
         digest.update(file_sha256(path).encode())
     return digest.hexdigest()

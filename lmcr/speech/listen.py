@@ -59,8 +59,9 @@ def read_listen_input(path: Path) -> list[tuple[int, dict]]:
     return list(read_jsonl(path, required=LISTEN_FIELDS))
 
 
-def listen_batch(records: list[tuple[int, dict]], base: Path, recognizer: Recognizer, parser: FrameParser
-                 ) -> Iterator[dict]:
+def listen_batch(
+    records: list[tuple[int, dict]], base: Path, recognizer: Recognizer, parser: FrameParser
+) -> Iterator[dict]:
     """Each record {id, audio} (audio relative to `base` or absolute) heard and parsed, in order, as soon as
     each is done; a line whose audio cannot be decoded gets an `error` and the batch goes on."""
     for line, rec in records:

@@ -42,9 +42,13 @@ class Transcript:
     doubts: list[list[str]] = field(default_factory=list)  # lexicon words the alternatives disagree on
 
     def to_json(self) -> dict:
-        return {"text": self.text, "confidence": round(self.confidence, 4), "alternatives": self.alternatives,
-                "doubts": self.doubts,
-                **({"reason": self.reason} if self.reason else {})}
+        return {
+            "text": self.text,
+            "confidence": round(self.confidence, 4),
+            "alternatives": self.alternatives,
+            "doubts": self.doubts,
+            **({"reason": self.reason} if self.reason else {}),
+        }
 
 
 def acoustic_model_dir() -> Path:
@@ -73,9 +77,18 @@ class Recognizer:
             raise SpeechModelError(f"{exc} (build it with `lmcr speech-lm`)") from exc
         from pocketsphinx import Decoder
 
-        self.decoder = Decoder(hmm=str(acoustic_model_dir()), lm=str(self.path / "domain.lm"),
-                               dict=str(self.path / "domain.dict"), samprate=RATE, bestpath=True, lw=lw,
-                               dither=True, cmn="batch", loglevel="FATAL", logfn=os.devnull)
+        self.decoder = Decoder(
+            hmm=str(acoustic_model_dir()),
+            lm=str(self.path / "domain.lm"),
+            dict=str(self.path / "domain.dict"),
+            samprate=RATE,
+            bestpath=True,
+            lw=lw,
+            dither=True,
+            cmn="batch",
+            loglevel="FATAL",
+            logfn=os.devnull,
+        )
         self.key_words = lexicon_words(lexicon)
 
     def transcribe(self, samples: np.ndarray) -> Transcript:

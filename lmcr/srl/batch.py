@@ -28,8 +28,11 @@ def srl_batch(parser: FrameParser, records: list[tuple[int, dict]], all_predicat
     `all_predicates` the generic frames of other verbs too."""
     found = parser.pipe(record["text"] for _, record in records)
     for (_, record), frames in zip(records, found):
-        yield {"id": record["id"], "text": record["text"],
-               "frames": [f.to_json() for f in frames if all_predicates or f.known]}
+        yield {
+            "id": record["id"],
+            "text": record["text"],
+            "frames": [f.to_json() for f in frames if all_predicates or f.known],
+        }
 
 
 def parse_instructions(parser: FrameParser, tasks: list[dict]) -> Iterator[tuple[dict, dict | None, bool]]:

@@ -123,16 +123,28 @@ class Compounds:
         """Whether `modifier head` is a fixed compound by the corpus statistics."""
         if modifier in self.predicative:
             return False
-        return (modifier in self.proper or self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
-                or f"{modifier} {head}" in self.strong_bigrams)
+        return (
+            modifier in self.proper
+            or self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
+            or f"{modifier} {head}" in self.strong_bigrams
+        )
 
     def save(self, path: Path) -> None:
         """Write as JSON with sorted keys: the frame corpus's fingerprint hashes this file, and the
         statistics come out of DuckDB in no fixed order."""
         with atomic_path(path) as tmp:
-            tmp.write_text(json.dumps({"head_rates": self.head_rates, "strong_bigrams": sorted(self.strong_bigrams),
-                                       "predicative": sorted(self.predicative), "proper": sorted(self.proper),
-                                       "singular_counts": self.singular_counts}, sort_keys=True))
+            tmp.write_text(
+                json.dumps(
+                    {
+                        "head_rates": self.head_rates,
+                        "strong_bigrams": sorted(self.strong_bigrams),
+                        "predicative": sorted(self.predicative),
+                        "proper": sorted(self.proper),
+                        "singular_counts": self.singular_counts,
+                    },
+                    sort_keys=True,
+                )
+            )
 
     @classmethod
     def load(cls, path: Path) -> Compounds:
@@ -142,9 +154,13 @@ class Compounds:
     @classmethod
     def _from_json(cls, data: dict) -> Compounds:
         singular = data.get("singular_counts")
-        return cls({_word(w): float(r) for w, r in data["head_rates"].items()}, _words(data["strong_bigrams"]),
-                   _words(data.get("predicative", [])), _words(data.get("proper", [])),
-                   None if singular is None else {_word(w): int(n) for w, n in singular.items()})
+        return cls(
+            {_word(w): float(r) for w, r in data["head_rates"].items()},
+            _words(data["strong_bigrams"]),
+            _words(data.get("predicative", [])),
+            _words(data.get("proper", [])),
+            None if singular is None else {_word(w): int(n) for w, n in singular.items()},
+        )
 
 
 def _word(value: object) -> str:
@@ -165,11 +181,15 @@ def learn_compounds(con: duckdb.DuckDBPyConnection, corpus: str = "all") -> Comp
     con.execute(_TOKENS, [corpus, corpus])
     try:
         con.execute(_UNIGRAMS)
-        rates = {w: round(r, 4) for w, r in con.execute(_HEAD_RATES, [MIN_DETERMINED]).fetchall()
-                 if r >= HEAD_RATE_MIN}
-        bigrams = frozenset(b for b, npmi, p_head in con.execute(_STRONG_BIGRAMS, [MIN_BIGRAM]).fetchall()
-                            if npmi >= NPMI_MIN or npmi >= NPMI_WITH_HEAD and p_head >= HEAD_GIVEN_MODIFIER_MIN)
-        predicative = frozenset(w for (w,) in con.execute(_PREDICATIVE, [MIN_PREDICATIVE_USES, PREDICATIVE_MIN]).fetchall())
+        rates = {w: round(r, 4) for w, r in con.execute(_HEAD_RATES, [MIN_DETERMINED]).fetchall() if r >= HEAD_RATE_MIN}
+        bigrams = frozenset(
+            b
+            for b, npmi, p_head in con.execute(_STRONG_BIGRAMS, [MIN_BIGRAM]).fetchall()
+            if npmi >= NPMI_MIN or npmi >= NPMI_WITH_HEAD and p_head >= HEAD_GIVEN_MODIFIER_MIN
+        )
+        predicative = frozenset(
+            w for (w,) in con.execute(_PREDICATIVE, [MIN_PREDICATIVE_USES, PREDICATIVE_MIN]).fetchall()
+        )
         singular = dict(con.execute(_SINGULAR_USES, [MIN_SINGULAR]).fetchall())
         proper = frozenset(w for (w,) in con.execute(_PROPER, [corpus, corpus, MIN_PROPER_USES, PROPER_MIN]).fetchall())
     finally:

@@ -40,7 +40,7 @@ def _clauses_before(doc: Doc, predicate: Token) -> list[list[int]]:
     """The word indices before the predicate in its sentence, cut at clause breaks, nearest first (the
     predicate's own clause may be empty); each earlier clause holds the break that ends it."""
     clauses: list[list[int]] = [[]]
-    for token in reversed(doc[predicate.sent.start: predicate.i]):
+    for token in reversed(doc[predicate.sent.start : predicate.i]):
         if token.text in CLAUSE_BREAKS:
             clauses.append([])
         clauses[-1].append(token.i)
@@ -104,7 +104,9 @@ def utterance_context(doc: Doc, mention: FrameMention, said: frozenset[str] = fr
     return " ".join(t.lower_ for t in words)
 
 
-def antecedents(doc: Doc, mention: FrameMention, role: str, lex: Lexicon, compounds: Compounds | None = None) -> list[str]:
+def antecedents(
+    doc: Doc, mention: FrameMention, role: str, lex: Lexicon, compounds: Compounds | None = None
+) -> list[str]:
     """The names a pronoun role may refer back to, most likely first: the heads of the noun phrases
     before the pronoun, outside the frame's own words, that agree with it in number ("I'd love some
     wine, could you pour it?" -> ["wine"]); [] when the role is no such pronoun. A verb's subject or
@@ -118,8 +120,13 @@ def antecedents(doc: Doc, mention: FrameMention, role: str, lex: Lexicon, compou
     frame_words = _role_words(doc, mention, predicate) if predicate is not None else set()
     found: list[tuple[bool, int, str]] = []
     for token in doc:
-        if token.idx >= mention.spans[role][0] or token.i in frame_words or token.tag_ not in NOUN_TAGS \
-                or token.dep_ == "compound" or (token.tag_ in ("NNS", "NNPS")) != ANAPHOR_PLURAL[pronoun]:
+        if (
+            token.idx >= mention.spans[role][0]
+            or token.i in frame_words
+            or token.tag_ not in NOUN_TAGS
+            or token.dep_ == "compound"
+            or (token.tag_ in ("NNS", "NNPS")) != ANAPHOR_PLURAL[pronoun]
+        ):
             continue
         value = argument_value(token, lex, compounds)
         if value is not None:

@@ -35,8 +35,18 @@ class SrlScores:
         rows = []
         for name in sorted(set(self.predicates) - {"all"}) + ["all"]:
             p, r = self.predicates[name].as_dict(), self.roles[name].as_dict()
-            rows.append({"predicate": name, "pred_p": p["precision"], "pred_r": p["recall"], "pred_f1": p["f1"],
-                         "role_p": r["precision"], "role_r": r["recall"], "role_f1": r["f1"], "frames": p["support"]})
+            rows.append(
+                {
+                    "predicate": name,
+                    "pred_p": p["precision"],
+                    "pred_r": p["recall"],
+                    "pred_f1": p["f1"],
+                    "role_p": r["precision"],
+                    "role_r": r["recall"],
+                    "role_f1": r["f1"],
+                    "frames": p["support"],
+                }
+            )
         return rows
 
 
@@ -75,8 +85,12 @@ def score_frames(gold: list[list[dict]], predicted: list[list[dict]], known: set
 
 def _is_frame(value: object, open_roles: bool = True) -> bool:
     """A frame as the gold files write it; without `open_roles` every role has a value."""
-    return isinstance(value, dict) and isinstance(value.get("predicate"), str) and isinstance(value.get("roles"), dict) \
+    return (
+        isinstance(value, dict)
+        and isinstance(value.get("predicate"), str)
+        and isinstance(value.get("roles"), dict)
         and all(isinstance(v, str) or open_roles and v is None for v in value["roles"].values())
+    )
 
 
 def read_gold(path: Path) -> list[dict]:
@@ -94,11 +108,12 @@ def check_expected(record: dict, where: str) -> dict:
     """An instruction record whose `expected` frame names every role's object and whose `missing`
     (when given) is null or one of those roles; else the InputError for `where` (file:line)."""
     if not _is_frame(record["expected"], open_roles=False):
-        raise InputError(f"{where}: field 'expected' must be {{\"predicate\": str, \"roles\": {{role: object}}}}")
+        raise InputError(f'{where}: field \'expected\' must be {{"predicate": str, "roles": {{role: object}}}}')
     missing = record.get("missing")
     if missing is not None and (not isinstance(missing, str) or missing not in record["expected"]["roles"]):
-        raise InputError(f"{where}: field 'missing' must be null or one of the expected roles "
-                         f"{sorted(record['expected']['roles'])}")
+        raise InputError(
+            f"{where}: field 'missing' must be null or one of the expected roles {sorted(record['expected']['roles'])}"
+        )
     return record
 
 
@@ -107,8 +122,9 @@ def read_instruction_tasks(path: Path) -> list[dict]:
     return [check_expected(r, f"{path}:{line}") for line, r in read_jsonl(path, {"instruction": str, "expected": dict})]
 
 
-def instruction_correct(frame: dict | None, expected: dict, missing: str | None,
-                        pronouns: frozenset[str] = frozenset()) -> bool:
+def instruction_correct(
+    frame: dict | None, expected: dict, missing: str | None, pronouns: frozenset[str] = frozenset()
+) -> bool:
     """Right predicate, every stated role right, and the right role (or none) marked missing. A role
     said with a pronoun of `pronouns` is right as the pronoun ("I'd love some wine, could you pour it?":
     what "it" refers to is completion's to find, not the parse's)."""
@@ -123,8 +139,16 @@ def instruction_correct(frame: dict | None, expected: dict, missing: str | None,
 
 
 # Error classes a regression is reported under (`classify_errors`), in the order `lmcr srl-eval` prints them.
-ERROR_CLASSES = ("missed predicate", "extra predicate", "boundary", "lemma", "role", "missed role", "extra role",
-                 "wrong filler")
+ERROR_CLASSES = (
+    "missed predicate",
+    "extra predicate",
+    "boundary",
+    "lemma",
+    "role",
+    "missed role",
+    "extra role",
+    "wrong filler",
+)
 
 
 def _value_error(gold: str, pred: str) -> str:
@@ -159,7 +183,9 @@ def frame_errors(gold: dict, pred: dict | None) -> list[tuple[str, str]]:
     return errors
 
 
-def classify_errors(gold: list[list[dict]], predicted: list[list[dict]], known: set[str]) -> list[list[tuple[str, str]]]:
+def classify_errors(
+    gold: list[list[dict]], predicted: list[list[dict]], known: set[str]
+) -> list[list[tuple[str, str]]]:
     """For each sentence, its errors as (class, detail): gold and predicted frames of a predicate aligned
     in order as `score_frames` does; extra predicted frames are "extra predicate"."""
     out = []
@@ -170,7 +196,9 @@ def classify_errors(gold: list[list[dict]], predicted: list[list[dict]], known: 
         for name in sorted(set(g) | set(p)):
             gs, ps = g.get(name, []), p.get(name, [])
             for i, frame in enumerate(gs):
-                errors += [(c, f"{name}.{r}" if r else name) for c, r in frame_errors(frame, ps[i] if i < len(ps) else None)]
+                errors += [
+                    (c, f"{name}.{r}" if r else name) for c, r in frame_errors(frame, ps[i] if i < len(ps) else None)
+                ]
             errors += [("extra predicate", name)] * max(0, len(ps) - len(gs))
         out.append(errors)
     return out

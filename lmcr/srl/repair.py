@@ -29,8 +29,12 @@ def _split(noun: Token, plural: Token) -> str | None:
     flakes/VBZ, a clause of its own), 'objects' (bread/dobj crumbs/dobj, siblings)."""
     if plural.tag_ == "VBZ" and noun.head.i == plural.i and noun.dep_ == "nsubj" and plural.dep_ in CLAUSE_DEPS:
         return "subject"
-    if plural.tag_ == "VBZ" and noun.dep_ in PHRASE_DEPS and plural.dep_ in CLAUSE_DEPS \
-            and plural.n_lefts + plural.n_rights == 0:
+    if (
+        plural.tag_ == "VBZ"
+        and noun.dep_ in PHRASE_DEPS
+        and plural.dep_ in CLAUSE_DEPS
+        and plural.n_lefts + plural.n_rights == 0
+    ):
         return "verb"
     if plural.tag_ == "NNS" and noun.dep_ == plural.dep_ == "dobj" and noun.head.i == plural.head.i:
         return "objects"
@@ -38,7 +42,7 @@ def _split(noun: Token, plural: Token) -> str | None:
 
 
 def _rejoin_gerund(gerund: Token, noun: Token) -> None:
-    """"frying/VBG pan/dobj" -> "frying/NN pan": the noun takes the gerund's place, with its other words."""
+    """ "frying/VBG pan/dobj" -> "frying/NN pan": the noun takes the gerund's place, with its other words."""
     noun.dep_ = GERUND_PLACES[gerund.dep_]
     noun.head = noun if gerund.dep_ == "ROOT" else gerund.head
     for child in list(gerund.children):
@@ -54,13 +58,21 @@ def rejoin_split_compounds(doc: Doc, compounds: Compounds | None) -> Doc:
     if compounds is None:
         return doc
     for gerund, noun in zip(doc[:-1], doc[1:]):
-        if gerund.tag_ == "VBG" and gerund.dep_ in GERUND_PLACES and noun.head.i == gerund.i \
-                and noun.dep_ == "dobj" and noun.tag_.startswith("NN") \
-                and f"{gerund.lower_} {noun.lower_}" in compounds.strong_bigrams:
+        if (
+            gerund.tag_ == "VBG"
+            and gerund.dep_ in GERUND_PLACES
+            and noun.head.i == gerund.i
+            and noun.dep_ == "dobj"
+            and noun.tag_.startswith("NN")
+            and f"{gerund.lower_} {noun.lower_}" in compounds.strong_bigrams
+        ):
             _rejoin_gerund(gerund, noun)
     for noun, plural in zip(doc[:-1], doc[1:]):
-        if noun.tag_ not in ("NN", "NNP") or not plural.lower_.endswith("s") \
-                or f"{noun.lower_} {plural.lower_}" not in compounds.strong_bigrams:
+        if (
+            noun.tag_ not in ("NN", "NNP")
+            or not plural.lower_.endswith("s")
+            or f"{noun.lower_} {plural.lower_}" not in compounds.strong_bigrams
+        ):
             continue
         kind = _split(noun, plural)
         if kind is None:

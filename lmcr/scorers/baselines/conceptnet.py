@@ -61,8 +61,9 @@ def read_edges(path: Path) -> list[tuple[str, str, float]]:
                 elif not row:
                     continue  # a blank line
                 else:
-                    raise ConceptNetFileError(f"{path}:{line}: {len(row)} tab-separated field(s); an edge is "
-                                              "relation, head, tail")
+                    raise ConceptNetFileError(
+                        f"{path}:{line}: {len(row)} tab-separated field(s); an edge is relation, head, tail"
+                    )
                 if head and tail and head != tail:
                     edges.append((head, tail, 1.0))
     except (OSError, EOFError, UnicodeDecodeError, csv.Error) as exc:
@@ -72,7 +73,9 @@ def read_edges(path: Path) -> list[tuple[str, str, float]]:
     return edges
 
 
-def embed_graph(edges: list[tuple[str, str, float]], dim: int = 100, seed: int = 0) -> tuple[dict[str, int], np.ndarray]:
+def embed_graph(
+    edges: list[tuple[str, str, float]], dim: int = 100, seed: int = 0
+) -> tuple[dict[str, int], np.ndarray]:
     """Concept index and unit-length SVD embeddings of the PPMI of the symmetric adjacency matrix."""
     index: dict[str, int] = {}
     for head, tail, _ in edges:
@@ -86,7 +89,7 @@ def embed_graph(edges: list[tuple[str, str, float]], dim: int = 100, seed: int =
     degree = np.asarray(adj.sum(axis=1)).ravel()
     coo = adj.tocoo()
     # context distribution smoothing (alpha 0.75), as in word-embedding PPMI
-    smoothed = degree ** 0.75
+    smoothed = degree**0.75
     pmi = np.log(coo.data * smoothed.sum() / (degree[coo.row] * smoothed[coo.col]))
     keep = pmi > 0
     ppmi = sparse.csr_matrix((pmi[keep], (coo.row[keep], coo.col[keep])), shape=adj.shape)
@@ -132,9 +135,11 @@ class ConceptNetScorer:
 
 def relatedness(vector: Callable[[str], np.ndarray | None]) -> Callable[[list[Frame]], list[float]]:
     """The ConceptNet score of frames from a term's unit vector: summed cosines, 0 for an unknown term."""
+
     def rel(x: str, y: str) -> float:
         a, b = vector(x), vector(y)
         # Rounded: an SVD basis is unique only up to rotations inside degenerate subspaces, so cosines of
         # two builds differ in the last bits, and a tie (credit 1/t) must not depend on those bits.
         return 0.0 if a is None or b is None else round(float(a @ b), 9)
+
     return lambda frames: [pair_sum(f, rel) for f in frames]

