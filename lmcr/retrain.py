@@ -58,8 +58,7 @@ def inputs_sha256(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
 def last_inputs(con: duckdb.DuckDBPyConnection, setting: Setting) -> str | None:
     """The inputs hash of the setting's last retrain decision, None before the first."""
     row = con.execute(
-        "select inputs_sha256 from retrain_decisions where setting = ? order by decided_at desc limit 1",
-        [setting.name],
+        "select inputs_sha256 from retrain_decisions where setting = ? order by decided_at desc limit 1", [setting.name]
     ).fetchone()
     return row[0] if row else None
 

@@ -14,30 +14,16 @@ import pytest
 from lmcr.annotate.quality import alpha_by_verb, dawid_skene, decisions, worker_table, write_decisions
 from lmcr.annotate.results import ingest_ratings
 from lmcr.annotate.tasks import TaskConfig, disagreement_frames, generate_tasks, protocol_frames, render
+from tests.mturk import write_results
 
 
 def seed_ratings(con, path):
     """A past batch: 'pour water into cup' rated 5 and 'into scissors' 1 by three workers (gold material)."""
-    with open(path, "w", newline="") as handle:
-        w = csv.writer(handle)
-        w.writerow(
-            [
-                "HITId",
-                "AssignmentId",
-                "WorkerId",
-                "AssignmentStatus",
-                "Input.verb",
-                "Input.role1",
-                "Input.arg1",
-                "Input.role2",
-                "Input.arg2",
-                "Answer.rating",
-            ]
-        )
-        for i, worker in enumerate(["W1", "W2", "W3"]):
-            w.writerow(["H0", f"P{i}a", worker, "Approved", "pour", "Theme", "water", "Destination", "cup", "5"])
-            w.writerow(["H0", f"P{i}b", worker, "Approved", "pour", "Theme", "water", "Destination", "scissors", "1"])
-    ingest_ratings(con, path)
+    rows = []
+    for i, worker in enumerate(["W1", "W2", "W3"]):
+        rows.append(["H0", f"P{i}a", worker, "Approved", "pour", "Theme", "water", "Destination", "cup", "5"])
+        rows.append(["H0", f"P{i}b", worker, "Approved", "pour", "Theme", "water", "Destination", "scissors", "1"])
+    ingest_ratings(con, write_results(path, rows))
 
 
 def test_render_and_protocol_frames():

@@ -155,11 +155,7 @@ def test_a_stated_object_that_is_detected_grounds_without_the_robot_vocabulary(p
     out = complete(parser, scorer, "season the sliced cucumbers", ["cucumber", "salt", "kumquat", "cup"])
     assert out.unresolved == {} and out.missing == "Instrument" and out.question is None
     assert out.frame.role_map == {"Theme": "cucumber", "Instrument": "cup"}  # the stand-in likes cups
-    assert out.unfamiliar_objects == ("kumquat",) and [c.object for c in out.candidates] == [
-        "cup",
-        "salt",
-        "kumquat",
-    ]
+    assert out.unfamiliar_objects == ("kumquat",) and [c.object for c in out.candidates] == ["cup", "salt", "kumquat"]
     unseen = complete(parser, scorer, "season the sliced cucumbers", ["salt", "cup"])
     assert unseen.unresolved == {"Theme": "cucumber"} and unseen.question.startswith("I see no cucumber.")
 

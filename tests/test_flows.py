@@ -10,6 +10,7 @@ import pytest
 
 from flows.ingest import ingest_flow
 from lmcr.scorers.registry import COMPLETION_METHOD
+from tests.mturk import write_results
 
 
 def test_ingest_flow_on_sample(prefect_api, sample_dir, tmp_path):
@@ -66,30 +67,14 @@ def test_train_flow_publishes_requested_settings(prefect_api, sample_dir, tmp_pa
 
 def evaluate_on_trained(tmp_path):
     """The evaluate flow on the checkpoints just trained and a small ratings file: report and calibration."""
-    import csv
-
     from flows.evaluate import evaluate_flow
 
     objects = ["cup", "glass", "mug", "bowl", "scissors", "knife", "towel", "sponge", "oven", "sink"]
-    header = [
-        "HITId",
-        "AssignmentId",
-        "WorkerId",
-        "AssignmentStatus",
-        "Input.verb",
-        "Input.role1",
-        "Input.arg1",
-        "Input.role2",
-        "Input.arg2",
-        "Answer.rating",
+    rows = [
+        ["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj, "5" if i < 3 else "1"]
+        for i, obj in enumerate(objects)
     ]
-    with open(tmp_path / "ratings.csv", "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(header)
-        for i, obj in enumerate(objects):
-            writer.writerow(
-                ["H", f"A{i}", "W", "Approved", "pour", "Theme", "water", "Destination", obj, "5" if i < 3 else "1"]
-            )
+    write_results(tmp_path / "ratings.csv", rows)
     results = evaluate_flow(
         ratings=str(tmp_path / "ratings.csv"),
         out=str(tmp_path / "report"),
@@ -113,31 +98,18 @@ def evaluate_on_trained(tmp_path):
 
 
 def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):
-    import csv
 
     from flows.annotate import annotate_flow
     from lmcr.annotate.tasks import TaskConfig
 
-    path = tmp_path / "results.csv"
-    with open(path, "w", newline="") as handle:
-        w = csv.writer(handle)
-        w.writerow(
-            [
-                "HITId",
-                "AssignmentId",
-                "WorkerId",
-                "AssignmentStatus",
-                "Input.verb",
-                "Input.role1",
-                "Input.arg1",
-                "Input.role2",
-                "Input.arg2",
-                "Answer.rating",
-            ]
-        )
-        for i, worker in enumerate(["W1", "W2", "W3"]):
-            for j, (obj, rating) in enumerate([("cup", 5 - (i == 2)), ("scissors", 1 + (i == 1)), ("bowl", 3)]):
-                w.writerow(["H", f"A{i}{j}", worker, "Approved", "pour", "Theme", "water", "Destination", obj, rating])
+    path = write_results(
+        tmp_path / "results.csv",
+        [
+            ["H", f"A{i}{j}", worker, "Approved", "pour", "Theme", "water", "Destination", obj, rating]
+            for i, worker in enumerate(["W1", "W2", "W3"])
+            for j, (obj, rating) in enumerate([("cup", 5 - (i == 2)), ("scissors", 1 + (i == 1)), ("bowl", 3)])
+        ],
+    )
     out = annotate_flow(
         tasks_out=str(tmp_path / "tasks"),
         task_config=TaskConfig(n_frames=20),

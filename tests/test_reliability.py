@@ -442,23 +442,25 @@ def test_labels_that_name_nothing_are_ignored():
         complete(load_parser(), prefer_junk, "pour me some water", junk)
 
 
-def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monkeypatch):
+def complete_with_a_flat_scorer(path, tmp_path, monkeypatch):
+    """`lmcr complete --input PATH` with a scorer that rates every frame alike (the parser is real)."""
     import lmcr.complete as completion
 
-    path = tmp_path / "in.jsonl"
-    path.write_text(
-        json.dumps({"id": "long", "instruction": "pour " + "🥛" * 3000, "objects": ["cup"]}) + "\n", encoding="utf-8"
-    )
-    monkeypatch.setattr(
-        completion,
-        "completion_scorer",
-        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()),
-    )
-    result = runner.invoke(
+    flat = (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig())
+    monkeypatch.setattr(completion, "completion_scorer", lambda *a: flat)
+    return runner.invoke(
         app,
         ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
         env={"LMCR_DATA_DIR": str(tmp_path / "data")},
     )
+
+
+def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monkeypatch):
+    path = tmp_path / "in.jsonl"
+    path.write_text(
+        json.dumps({"id": "long", "instruction": "pour " + "🥛" * 3000, "objects": ["cup"]}) + "\n", encoding="utf-8"
+    )
+    result = complete_with_a_flat_scorer(path, tmp_path, monkeypatch)
     assert result.exit_code == 0, result.output
     line = json.loads((tmp_path / "o.jsonl").read_text())
     assert line["id"] == "long" and "the limit is 1,000" in line["error"]
@@ -466,8 +468,6 @@ def test_an_overlong_instruction_is_a_per_line_error_in_complete(tmp_path, monke
 
 def test_a_line_that_cannot_be_completed_gets_its_error_and_the_batch_goes_on(tmp_path, monkeypatch):
     """A well-formed line in the middle that cannot be parsed (no predicate) or completed (no objects)."""
-    import lmcr.complete as completion
-
     lines = [
         {"id": "a", "instruction": "pour me some water", "objects": ["cup", "bowl"]},
         {"id": "b", "instruction": "wash the dishes", "objects": ["cup"]},
@@ -476,16 +476,7 @@ def test_a_line_that_cannot_be_completed_gets_its_error_and_the_batch_goes_on(tm
     ]
     path = tmp_path / "in.jsonl"
     path.write_text("".join(json.dumps(line) + "\n" for line in lines), encoding="utf-8")
-    monkeypatch.setattr(
-        completion,
-        "completion_scorer",
-        lambda *a: (lambda frames, context="": [0.0] * len(frames), completion.CompletionConfig()),
-    )
-    result = runner.invoke(
-        app,
-        ["complete", "--input", str(path), "--output", str(tmp_path / "o.jsonl")],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
-    )
+    result = complete_with_a_flat_scorer(path, tmp_path, monkeypatch)
     assert result.exit_code == 0, result.output
     out = [json.loads(line) for line in (tmp_path / "o.jsonl").read_text().splitlines()]
     assert [o["id"] for o in out] == ["a", "b", "c", "d"]

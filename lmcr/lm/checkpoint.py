@@ -19,13 +19,7 @@ from lmcr.errors import one_line
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.vocab import Vocab
 from lmcr.setting import Setting
-from lmcr.versions import (  # noqa: F401 - the checkpoint API callers use
-    CheckpointError,
-    publish_version,
-    remove_stale_tmp,
-    resolve,
-    write_json,
-)
+from lmcr.versions import CheckpointError, publish_version, remove_stale_tmp, resolve, write_json  # noqa: F401 - the checkpoint API callers use
 from lmcr.versions import set_latest as set_latest_version
 from lmcr.versions import verify as verify_version
 

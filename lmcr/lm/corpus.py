@@ -61,10 +61,7 @@ def corpus_hash(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
 
 
 def training_text(
-    con: duckdb.DuckDBPyConnection,
-    setting: Setting,
-    kinds: tuple[str, ...] = ("instruction",),
-    articles: bool = True,
+    con: duckdb.DuckDBPyConnection, setting: Setting, kinds: tuple[str, ...] = ("instruction",), articles: bool = True
 ) -> TrainingText:
     """The setting's sequences (its linearisation of its corpus), split by document (5% held out); without
     `articles`, sentences lose a/an/the (frames have none)."""

@@ -20,78 +20,18 @@ PEDESTAL_HEIGHT = 0.93  # floor to Baxter's base frame
 
 # (joint, parent link, child link, origin xyz, origin rpy, (lower, upper) limits, child mass, child shape)
 # shape: ("cyl", radius, length, z offset of its centre) or ("box", sx, sy, sz, z offset)
+# One joint a row, so the table reads as Baxter's kinematic chain (kept by fmt: off, allowed past 120 columns).
+# fmt: off
 ARM_CHAIN = [
-    (
-        "s0",
-        "arm_mount",
-        "upper_shoulder",
-        (0.055695, 0, 0.011038),
-        (0, 0, 0),
-        (-1.70167633, 1.70167633),
-        5.70,
-        ("cyl", 0.06, 0.27, 0.135),
-    ),
-    (
-        "s1",
-        "upper_shoulder",
-        "lower_shoulder",
-        (0.069, 0, 0.27035),
-        (-HALF_PI, 0, 0),
-        (-2.147, 1.047),
-        3.23,
-        ("cyl", 0.06, 0.10, 0.0),
-    ),
-    (
-        "e0",
-        "lower_shoulder",
-        "upper_elbow",
-        (0.102, 0, 0),
-        (HALF_PI, 0, HALF_PI),
-        (-3.0541961, 3.0541961),
-        4.31,
-        ("cyl", 0.055, 0.26, 0.13),
-    ),
-    (
-        "e1",
-        "upper_elbow",
-        "lower_elbow",
-        (0.069, 0, 0.26242),
-        (-HALF_PI, -HALF_PI, 0),
-        (-0.05, 2.618),
-        2.07,
-        ("cyl", 0.05, 0.10, 0.0),
-    ),
-    (
-        "w0",
-        "lower_elbow",
-        "upper_forearm",
-        (0.10359, 0, 0),
-        (HALF_PI, 0, HALF_PI),
-        (-3.059, 3.059),
-        2.25,
-        ("cyl", 0.045, 0.27, 0.135),
-    ),
-    (
-        "w1",
-        "upper_forearm",
-        "lower_forearm",
-        (0.01, 0, 0.2707),
-        (-HALF_PI, -HALF_PI, 0),
-        (-1.57079632679, 2.094),
-        1.61,
-        ("cyl", 0.045, 0.10, 0.0),
-    ),
-    (
-        "w2",
-        "lower_forearm",
-        "wrist",
-        (0.115975, 0, 0),
-        (HALF_PI, 0, HALF_PI),
-        (-3.059, 3.059),
-        0.35,
-        ("cyl", 0.04, 0.10, 0.05),
-    ),
+    ("s0", "arm_mount", "upper_shoulder", (0.055695, 0, 0.011038), (0, 0, 0), (-1.70167633, 1.70167633), 5.70, ("cyl", 0.06, 0.27, 0.135)),
+    ("s1", "upper_shoulder", "lower_shoulder", (0.069, 0, 0.27035), (-HALF_PI, 0, 0), (-2.147, 1.047), 3.23, ("cyl", 0.06, 0.10, 0.0)),
+    ("e0", "lower_shoulder", "upper_elbow", (0.102, 0, 0), (HALF_PI, 0, HALF_PI), (-3.0541961, 3.0541961), 4.31, ("cyl", 0.055, 0.26, 0.13)),
+    ("e1", "upper_elbow", "lower_elbow", (0.069, 0, 0.26242), (-HALF_PI, -HALF_PI, 0), (-0.05, 2.618), 2.07, ("cyl", 0.05, 0.10, 0.0)),
+    ("w0", "lower_elbow", "upper_forearm", (0.10359, 0, 0), (HALF_PI, 0, HALF_PI), (-3.059, 3.059), 2.25, ("cyl", 0.045, 0.27, 0.135)),
+    ("w1", "upper_forearm", "lower_forearm", (0.01, 0, 0.2707), (-HALF_PI, -HALF_PI, 0), (-1.57079632679, 2.094), 1.61, ("cyl", 0.045, 0.10, 0.0)),
+    ("w2", "lower_forearm", "wrist", (0.115975, 0, 0), (HALF_PI, 0, HALF_PI), (-3.059, 3.059), 0.35, ("cyl", 0.04, 0.10, 0.05)),
 ]
+# fmt: on
 ARM_MOUNTS = {
     "left": ((0.024645, 0.219645, 0.118588), (0, 0, math.pi / 4)),
     "right": ((0.024645, -0.219645, 0.118588), (0, 0, -math.pi / 4)),

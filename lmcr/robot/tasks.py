@@ -5,6 +5,10 @@ A program is built for one way of doing the task (`Variant`: the gripper's turn 
 it grasps, the direction it tilts to pour); the planner tries variants until one is feasible. Poses are
 exact, not corrected while moving: the held object's pose in the hand is known from the grasp, so the
 gripper pose that puts a bottle's mouth over the cup's centre is computed, not searched for.
+
+Over 400 lines on purpose: the eleven predicates' programs and their checks share the same geometry
+helpers (rims, mouths, grasp heights) and read as one table of motions; a module per predicate would
+repeat the helpers' imports eleven times for a dozen lines each.
 """
 
 from __future__ import annotations
