@@ -301,6 +301,13 @@ def test_srl_batch_text_over_the_length_cap_is_one_line(tmp_path):
 
 FRAMES_HEADER = "verb,role1,arg1,role2,arg2,note"
 FRAMES_ROW = "pour,Theme,water,Destination,cup,x"
+
+
+def score_one_frame(tmp: Path, *method_args: str):
+    """`lmcr score` of `tmp/frames.csv` into `tmp/scores.csv` with the given method options."""
+    return invoke(["score", "--frames", str(tmp / "frames.csv"), "--out", str(tmp / "scores.csv"), *method_args], tmp)
+
+
 FRAME_DEFECTS = st.sampled_from(
     [
         ("bad header", "verb,role1,arg1,arg2", 1),
@@ -360,20 +367,7 @@ def test_a_malformed_vector_file_is_one_line_naming_its_line(before, defect, hea
         tmp = Path(tmp)
         (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
         (tmp / "v.txt").write_bytes("\n".join(lines).encode() + b"\n" + garbage)
-        result = invoke(
-            [
-                "score",
-                "--frames",
-                str(tmp / "frames.csv"),
-                "--out",
-                str(tmp / "scores.csv"),
-                "--methods",
-                "word2vec",
-                "--vectors",
-                str(tmp / "v.txt"),
-            ],
-            tmp,
-        )
+        result = score_one_frame(tmp, "--methods", "word2vec", "--vectors", str(tmp / "v.txt"))
         if result.exit_code == 0:  # the defect made a valid line after all ("milk 1 2")
             assert not garbage and len(defect.split()) == 3
         else:
@@ -405,20 +399,7 @@ def test_a_malformed_conceptnet_edge_file_is_one_line(before, defect, gz):
         path = tmp / ("edges.txt.gz" if gz != "plain" else "edges.txt")
         path.write_bytes(gzip.compress(raw) if gz == "gzip" else raw if gz == "plain" else b"\x1f\x8b" + raw)
         (tmp / "frames.csv").write_text(f"{FRAMES_HEADER}\n{FRAMES_ROW}\n")
-        result = invoke(
-            [
-                "score",
-                "--frames",
-                str(tmp / "frames.csv"),
-                "--out",
-                str(tmp / "scores.csv"),
-                "--methods",
-                "conceptnet",
-                "--conceptnet",
-                str(path),
-            ],
-            tmp,
-        )
+        result = score_one_frame(tmp, "--methods", "conceptnet", "--conceptnet", str(path))
         named_line = gz != "corrupt gzip" and defect != "\udcff"
         assert "edge" in assert_one_line_error(result, path, len(lines) if named_line else None)
         assert not (tmp / "scores.csv").exists()

@@ -382,20 +382,9 @@ def test_a_pickle_in_model_pt_is_refused_by_name_and_never_run(published, tmp_pa
     assert not marker.exists()
     frames = tmp_path / "frames.csv"
     frames.write_text("verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\n")
+    command = ["score", "--frames", str(frames), "--out", str(tmp_path / "s.csv"), "--methods", "sentence_lm"]
     result = runner.invoke(
-        app,
-        [
-            "score",
-            "--frames",
-            str(frames),
-            "--out",
-            str(tmp_path / "s.csv"),
-            "--methods",
-            "sentence_lm",
-            "--checkpoint",
-            str(tmp_path / "checkpoints"),
-        ],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
+        app, [*command, "--checkpoint", str(tmp_path / "checkpoints")], env={"LMCR_DATA_DIR": str(tmp_path / "data")}
     )
     line = one_line_error(result)
     assert str(model_pt) in line and "refusing to load it" in line and "weights_only" not in line
@@ -422,6 +411,13 @@ def test_an_unusable_model_pt_says_why(published, cut, reason):
 # 5. a method asked for must build; only defaults are skipped, with a note
 
 
+def evaluate_sample(tmp_path, sample_dir, out: str, *args: str):
+    """`lmcr evaluate` on the sample's ratings into `out`, with a data folder of its own."""
+    ratings = str(sample_dir / "ratings" / "sample_ratings_mturk.csv")
+    command = ["evaluate", "--ratings", ratings, "--out", out, *args]
+    return runner.invoke(app, command, env={"LMCR_DATA_DIR": str(tmp_path / "data")})
+
+
 @pytest.mark.parametrize(
     "args, method",
     [
@@ -435,18 +431,7 @@ def test_an_unusable_model_pt_says_why(published, cut, reason):
 )
 def test_a_requested_method_that_cannot_be_built_is_an_error(tmp_path, sample_dir, args, method):
     (tmp_path / "BAD").write_text("not vectors, not edges\n")
-    result = runner.invoke(
-        app,
-        [
-            "evaluate",
-            "--ratings",
-            str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-            "--out",
-            str(tmp_path / "report"),
-            *args,
-        ],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
-    )
+    result = evaluate_sample(tmp_path, sample_dir, str(tmp_path / "report"), *args)
     assert f"method {method}: cannot be built" in one_line_error(result)
     assert not (tmp_path / "report").exists()
 
@@ -454,21 +439,7 @@ def test_a_requested_method_that_cannot_be_built_is_an_error(tmp_path, sample_di
 def test_default_methods_that_cannot_be_built_are_skipped_with_a_note(tmp_path, sample_dir, monkeypatch):
     monkeypatch.chdir(tmp_path)  # `--vectors BAD` relative, as a user types it
     (tmp_path / "BAD").write_text("not vectors\n")
-    result = runner.invoke(
-        app,
-        [
-            "evaluate",
-            "--ratings",
-            str(sample_dir / "ratings" / "sample_ratings_mturk.csv"),
-            "--out",
-            "report",
-            "--vectors",
-            "BAD",
-            "--settings",
-            "random",
-        ],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
-    )
+    result = evaluate_sample(tmp_path, sample_dir, "report", "--vectors", "BAD", "--settings", "random")
     assert result.exit_code == 0, result.output
     assert "word2vec not evaluated: BAD:1" in result.stderr and "conceptnet not evaluated" in result.stderr
     assert json.loads((tmp_path / "report" / "figures.json").read_text())["table1"].keys() == {"random"}

@@ -66,15 +66,8 @@ def test_scripted_dialogue_question_answer_execution(robot_parts):
 
     parser, scorer, config, cache = robot_parts
     said = []
-    outcomes = converse(
-        iter(["pour me some water", "the bowl", "into the glass please"]),
-        _scene(),
-        parser,
-        scorer,
-        config,
-        cache,
-        said.append,
-    )
+    turns = iter(["pour me some water", "the bowl", "into the glass please"])
+    outcomes = converse(turns, _scene(), parser, scorer, config, cache, said.append)
     assert said[0] == "you: pour me some water" and said[1].startswith("robot: Should I pour water into the")
     assert said[3].startswith("robot: I don't see a bowl on the table. Should I pour")
     assert outcomes[0]["answer"] == {"Destination": "glass"} and outcomes[0]["chosen_object"] == "glass"
@@ -88,15 +81,8 @@ def test_three_unusable_answers_and_the_robot_leaves_it(robot_parts):
 
     parser, scorer, config, cache = robot_parts
     said = []
-    outcomes = converse(
-        iter(["pour me some water", "the bowl", "no", "what?", "juggle the cup"]),
-        _scene(),
-        parser,
-        scorer,
-        config,
-        cache,
-        said.append,
-    )
+    turns = iter(["pour me some water", "the bowl", "no", "what?", "juggle the cup"])
+    outcomes = converse(turns, _scene(), parser, scorer, config, cache, said.append)
     assert "robot: I'll leave it." in said and outcomes[0]["left"] and outcomes[0]["reply"] == "I'll leave it."
     assert "no known predicate" in outcomes[1]["error"]  # the next instruction is heard again
     assert (

@@ -77,18 +77,8 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     )
     out = tmp_path / "scores.csv"
     monkeypatch.setenv("LMCR_DATA_DIR", str(paths.data_dir))
-    result = runner.invoke(
-        app,
-        [
-            "score",
-            "--frames",
-            str(frames),
-            "--out",
-            str(out),
-            "--methods",
-            "sentence_lm,frame_lm,random,frame_counts,sentence_lm+frame_counts",
-        ],
-    )
+    methods = "sentence_lm,frame_lm,random,frame_counts,sentence_lm+frame_counts"
+    result = runner.invoke(app, ["score", "--frames", str(frames), "--out", str(out), "--methods", methods])
     assert result.exit_code == 0, result.output
     rows = list(csv.DictReader(out.open()))
     assert [r["id"] for r in rows] == ["1", "2"]

@@ -94,31 +94,11 @@ def test_a_file_output_that_is_a_folder_is_refused(tmp_path):
 
 
 def test_render_into_a_folder_is_refused_before_the_simulation(tmp_path, sample_dir):
-    result = runner.invoke(
-        app,
-        [
-            "execute",
-            "pour me some water",
-            "--scene",
-            str(sample_dir / "scenes" / "pour_me_some_water.json"),
-            "--render",
-            str(tmp_path),
-        ],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
-    )
+    scene, env = str(sample_dir / "scenes" / "pour_me_some_water.json"), {"LMCR_DATA_DIR": str(tmp_path / "data")}
+    result = runner.invoke(app, ["execute", "pour me some water", "--scene", scene, "--render", str(tmp_path)], env=env)
     assert "is a folder" in one_line_error(result)
-    bad_suffix = runner.invoke(
-        app,
-        [
-            "execute",
-            "pour me some water",
-            "--scene",
-            str(sample_dir / "scenes" / "pour_me_some_water.json"),
-            "--render",
-            str(tmp_path / "out.txt"),
-        ],
-        env={"LMCR_DATA_DIR": str(tmp_path / "data")},
-    )
+    render = str(tmp_path / "out.txt")
+    bad_suffix = runner.invoke(app, ["execute", "pour me some water", "--scene", scene, "--render", render], env=env)
     assert ".png or .gif" in one_line_error(bad_suffix)
 
 

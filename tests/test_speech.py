@@ -144,6 +144,9 @@ def speech_workspace(tmp_path_factory):
     return ws
 
 
+TINY_MODEL_JSON = ("--method", "sentence_lm", "--corpus", "youcook2", "--json")  # the workspace's one LM
+
+
 def _lmcr(ws, *args: str) -> subprocess.CompletedProcess:
     return subprocess.run(
         [
@@ -201,11 +204,7 @@ def test_execute_audio_hears_completes_and_executes(speech_workspace, tmp_path):
         str(FIXTURES / "pour_me_some_water.wav"),
         "--scene",
         str(tmp_path / "scene.json"),
-        "--method",
-        "sentence_lm",
-        "--corpus",
-        "youcook2",
-        "--json",
+        *TINY_MODEL_JSON,
     )
     assert done.returncode == 0, done.stderr + done.stdout
     result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -235,11 +234,7 @@ def test_spoken_turns_drive_the_robot(speech_workspace, tmp_path):
         str(tmp_path / "scene.json"),
         "--audio-dir",
         str(tmp_path / "turns"),
-        "--method",
-        "sentence_lm",
-        "--corpus",
-        "youcook2",
-        "--json",
+        *TINY_MODEL_JSON,
     )
     assert done.returncode == 0, done.stderr + done.stdout
     outcome = json.loads(done.stdout.strip().splitlines()[-1])
