@@ -1,7 +1,7 @@
 """Benchmark: the Baxter executor on random table layouts, per predicate.
 
 Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill]
-       [--urdf PATH] [--holding] [--json PATH]
+       [--urdf PATH] [--holding] [--videos DIR] [--json PATH]
 For each of the 11 predicates, an incomplete instruction on `--placements` random layouts: the two
 objects the frame needs plus `--distractors` random other objects (obstacles, and other candidates for
 the completion), placed at random with a seed. With `--holding` the stated object starts in the robot's
@@ -9,7 +9,9 @@ hand instead of on the table (for fill and season it is the target: the robot pu
 The task's own object is given as the answer, so the run measures execution; how often the language
 model (the published checkpoint of $LMCR_DATA_DIR) would have chosen another object is counted beside it.
 Prints per predicate: executed successfully / executed, refused before moving (infeasible), then a
-histogram of failure and refusal reasons, and the time to plan and execute one instruction.
+histogram of failure and refusal reasons, and the time to plan and execute one instruction. With `--videos`,
+each executed plan that failed is saved there as an animated GIF (SEED-PREDICATE-K.gif); every run is then
+filmed as it goes (rendering adds seconds to each, so the times are not comparable).
 """
 
 from __future__ import annotations
@@ -20,12 +22,14 @@ import os
 import random
 import statistics
 import time
+from pathlib import Path
 
 from record import add_json_option, write_results
 
 from lmcr.jsonl import InputError
 from lmcr.lexicon import load_lexicon
 from lmcr.robot.execute import execute
+from lmcr.robot.render import VIDEO_EVERY, Recorder
 from lmcr.robot.scene import make_scene
 from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
@@ -109,8 +113,11 @@ def main() -> None:
     parser_.add_argument(
         "--holding", action="store_true", help="the stated object starts in the hand (fill, season: put down first)"
     )
+    parser_.add_argument("--videos", type=Path, help="folder for an animated GIF of each executed plan that failed")
     add_json_option(parser_, "bench_executor")
     args = parser_.parse_args()
+    if args.videos and args.videos.exists() and not args.videos.is_dir():
+        parser_.error(f"--videos {args.videos}: is a file, not a folder")
     if args.urdf:
         os.environ["LMCR_BAXTER_URDF"] = args.urdf
     ws = Workspace.from_env()
@@ -132,8 +139,17 @@ def main() -> None:
                 stated if args.holding else None,
             )
             started = time.perf_counter()
+            recorder = Recorder(scene, every=VIDEO_EVERY) if args.videos else None
             out = execute(
-                instruction, scene, nlp, scorer, config, ws.robot, answer={role: expected}, urdf=ws.baxter_urdf
+                instruction,
+                scene,
+                nlp,
+                scorer,
+                config,
+                ws.robot,
+                recorder,
+                answer={role: expected},
+                urdf=ws.baxter_urdf,
             )
             times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"])
             slowest.append((times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
@@ -149,6 +165,8 @@ def main() -> None:
             if not out["success"]:
                 held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
                 reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
+                if recorder is not None:
+                    print(f"  video: {recorder.save_video(args.videos / f'{args.seed}-{predicate}-{k}.gif')}")
         totals.update(row)
         per_predicate[f"{predicate}: succeeded"] = f"{row['ok']}/{args.placements}"
         print(

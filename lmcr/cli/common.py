@@ -6,10 +6,11 @@ and the light commands start fast."""
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Literal
@@ -21,8 +22,10 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
+from typer._click.globals import get_current_context  # typer's own click, vendored
 
 from lmcr.errors import LMCRError, one_line
+from lmcr.partial import PartialOutput
 from lmcr.setting import CORPORA
 
 console = Console(stderr=True)
@@ -181,24 +184,45 @@ def one_or_batch(item: object, input: Path | None, output: Path | None, usage: s
         fail(usage)
     if batch:
         check_output_file(output, reads=input)
+        if input.is_file():  # an unfinished output of another batch is refused before the models load
+            PartialOutput.open(output, input, batch_options())
     return batch
 
 
-def write_batch(output: Path, results: Iterable[dict], total: int | None, what: str) -> Counter:
-    """A batch's result lines written to `output` as each is done (into a temporary file beside it, which
-    replaces `output` when the batch ends: never a partial output), with a progress bar on a terminal.
-    Returns the tally: `lines`, and the lines with an `error`, a `question`, a `success`."""
-    from lmcr.jsonl import write_jsonl_atomic
+def batch_options() -> dict:
+    """The running command's name and options (as JSON values, --input and --output left out): what a
+    resumed batch must have been run with."""
+    ctx = get_current_context(silent=True)
+    if ctx is None:
+        return {}
+    params = {k: v for k, v in ctx.params.items() if k not in ("input", "output")}
+    return json.loads(json.dumps({"command": ctx.info_name, **params}, default=str))
 
+
+def write_batch(
+    output: Path, input: Path, records: Sequence, run: Callable[[Sequence], Iterable[dict]], what: str
+) -> Counter:
+    """The result lines of a batch of `records` (read from `input`; `run` turns records into one result line
+    each, in order) written to `output` as each is done, with a progress bar on a terminal. Each line goes
+    into the sidecar `output`.partial as soon as it is done, which becomes `output` when the batch ends; a
+    batch that stopped midway (killed, interrupted, failed) and is run again with the same input and options
+    keeps the sidecar's lines and runs only the records after them (see lmcr.partial). Returns the tally:
+    `lines`, and the lines with an `error`, a `question`, a `success`."""
+    partial = PartialOutput.open(output, input, batch_options())
+    done = min(partial.done, len(records))
+    if done:
+        note(f"resuming: {done} of {len(records)} done ({partial.sidecar})")
     tally = Counter()
-
-    def counted(progress: Progress) -> Iterator[dict]:
-        for record in results:
-            tally["lines"] += 1
-            tally.update(key for key in ("error", "question", "success") if record.get(key))
+    for line in partial.kept[:done]:
+        _count(tally, json.loads(line))
+    with progress_bar(what, len(records)) as progress:
+        advance(progress, done)
+        for record in partial.write(run(records[done:])):
+            _count(tally, record)
             advance(progress)
-            yield record
-
-    with progress_bar(what, total) as progress:
-        write_jsonl_atomic(output, counted(progress))
     return tally
+
+
+def _count(tally: Counter, record: dict) -> None:
+    tally["lines"] += 1
+    tally.update(key for key in ("error", "question", "success") if record.get(key))

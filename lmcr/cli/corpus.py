@@ -139,7 +139,7 @@ def srl(
 
         records = read_srl_input(input)  # bad input fails before the model loads
         parser = Workspace.from_env().parser(model, resources)
-        tally = write_batch(output, srl_batch(parser, records, all_predicates), len(records), "parsing")
+        tally = write_batch(output, input, records, lambda rest: srl_batch(parser, rest, all_predicates), "parsing")
         console.print(f"{tally['lines']} records -> {output}")
         return
     parser = Workspace.from_env().parser(model, resources)

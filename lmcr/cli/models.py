@@ -250,8 +250,12 @@ def complete(
     records = read_complete_input(input)  # bad input fails before the models load
     ws = Workspace.from_env()
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus, vectors, conceptnet))
-    completed = complete_batch(ws.parser(model), scorer, config, records, input, log=lambda m: note(m, soft_wrap=True))
-    tally = write_batch(output, completed, len(records), "completing")
+    parser = ws.parser(model)
+
+    def completed(rest):
+        return complete_batch(parser, scorer, config, rest, input, log=lambda m: note(m, soft_wrap=True))
+
+    tally = write_batch(output, input, records, completed, "completing")
     console.print(
         f"{tally['lines']:,} instructions -> {output} ({tally['question']} clarifying questions, "
         f"{tally['error']} not completed; {config.source})"

@@ -9,6 +9,7 @@ from pathlib import Path
 import typer
 
 from lmcr.cli.common import SPACY_MODEL_HELP, CorpusSetting, app, console, fail, note, one_or_batch, write_batch
+from lmcr.robot.budget import IK_CALLS, IK_CALLS_RANGE, PLAN_SECONDS, PLAN_SECONDS_RANGE, Budget
 from lmcr.scorers.registry import COMPLETION_METHOD, METHODS
 from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.workspace import Workspace
@@ -19,8 +20,18 @@ METHOD_HELP = "Scorer that completes the instructions."
 CORPUS_HELP = "Corpus setting of the LM checkpoints and frame counts."
 EXECUTE_USAGE = (
     'give "INSTRUCTION" (or --audio FILE.wav) and --scene SCENE.json, or --input IN.jsonl and '
-    "--output OUT.jsonl (no instruction, --scene or --render)"
+    "--output OUT.jsonl (no instruction, --scene, --render or --video)"
 )
+PLAN_SECONDS_HELP = "Planning search's time budget per instruction (seconds of wall clock); then it refuses."
+IK_BUDGET_HELP = "Planning search's budget of inverse-kinematics solves per instruction; then it refuses."
+
+
+def plan_seconds_option():
+    return typer.Option(PLAN_SECONDS, "--plan-seconds", **PLAN_SECONDS_RANGE, help=PLAN_SECONDS_HELP)
+
+
+def ik_budget_option():
+    return typer.Option(IK_CALLS, "--ik-budget", **IK_CALLS_RANGE, help=IK_BUDGET_HELP)
 
 
 @app.command("speech-lm")
@@ -70,8 +81,10 @@ def listen(
     ws = Workspace.from_env()
     if batch:
         records = read_listen_input(input)  # bad input fails before the models load
-        heard = listen_batch(records, input.parent, ws.recognizer(speech_model, asr), ws.parser(model))
-        tally = write_batch(output, heard, len(records), "listening")
+        recognizer, parser = ws.recognizer(speech_model, asr), ws.parser(model)
+        tally = write_batch(
+            output, input, records, lambda rest: listen_batch(rest, input.parent, recognizer, parser), "listening"
+        )
         console.print(f"{tally['lines']:,} recordings -> {output} ({tally['error']} could not be decoded)")
         return
     result = listen_one(ws.recognizer(speech_model, asr), ws.parser(model), audio)
@@ -106,21 +119,26 @@ def execute(
         help="Official Baxter URDF (baxter_common/baxter_description/urdf/"
         "baxter.urdf; default $LMCR_BAXTER_URDF, else the built-in model).",
     ),
+    video: Path | None = typer.Option(None, help="Save an animation of the run: out.gif (the motions as they go)."),
+    plan_seconds: float = plan_seconds_option(),
+    ik_budget: int = ik_budget_option(),
 ) -> None:
     """Detect, complete, plan and execute an instruction with a simulated Baxter (pybullet, headless);
     with --audio, the instruction is heard first; with --input/--output, a batch of instructions and
     scenes with the models loaded once."""
-    from lmcr.jsonl import check_text, read_bytes
+    from lmcr.jsonl import check_text
 
     ws = Workspace.from_env()
     if audio is not None and (instruction is not None or input is not None or output is not None):
         fail("--audio replaces INSTRUCTION (and is not a batch option)")
     batch = one_or_batch(instruction if audio is None else audio, input, output, EXECUTE_USAGE)
-    if (batch and (scene is not None or render)) or (not batch and scene is None):
+    if (batch and (scene is not None or render or video is not None)) or (not batch and scene is None):
         fail(EXECUTE_USAGE)
-    _check_render(render)  # before the simulation, so a bad path does not cost its result
+    _check_render(render, video)  # before the simulation, so a bad path does not cost its result
     if batch:
-        read_bytes(input)  # an unreadable input fails before the models load
+        from lmcr.robot.execute import read_batch
+
+        lines = read_batch(input)  # an unreadable input fails before the models load
     else:
         from lmcr.robot.scene import load_scene  # pybullet: after the argument checks
 
@@ -131,22 +149,27 @@ def execute(
     from lmcr.robot.request import Executor, execute_request
 
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
-    executor = Executor(ws.parser(model), scorer, config, ws.robot, urdf or ws.baxter_urdf)
+    budget = Budget(plan_seconds, ik_budget)
+    executor = Executor(ws.parser(model), scorer, config, ws.robot, urdf or ws.baxter_urdf, budget)
     if batch:
-        tally = write_batch(output, executor.run_batch(input), None, "executing")
+        tally = write_batch(output, input, lines, lambda rest: executor.run_batch(input, rest), "executing")
         console.print(f"{tally['lines']:,} lines -> {output}: {tally['success']} succeeded, {tally['error']} errors")
         return
     recognizer = ws.recognizer(speech_model, asr) if audio is not None else None
-    _show_execution(execute_request(executor, layout, instruction, audio, recognizer, render), json_out)
+    _show_execution(execute_request(executor, layout, instruction, audio, recognizer, render, video), json_out)
 
 
-def _check_render(paths: list[Path]) -> None:
+def _check_render(paths: list[Path], video: Path | None) -> None:
     from lmcr.files import OutputError, check_output_file
 
     for path in paths:
         check_output_file(path)
         if path.suffix.lower() not in (".png", ".gif"):
             raise OutputError(f"{path}: --render takes a .png or .gif file name")
+    if video is not None:
+        check_output_file(video)
+        if video.suffix.lower() != ".gif":
+            raise OutputError(f"{video}: --video takes a .gif file name (an animated GIF)")
 
 
 def _show_execution(result: dict, json_out: bool) -> None:
@@ -176,6 +199,8 @@ def robot(
     asr: str | None = typer.Option(
         None, help="Speech recogniser for --audio-dir: whisper (default; $LMCR_ASR) or sphinx."
     ),
+    plan_seconds: float = plan_seconds_option(),
+    ik_budget: int = ik_budget_option(),
 ) -> None:
     """Talk to the robot: instructions and answers to its questions, typed, scripted or spoken."""
     from lmcr.jsonl import read_lines
@@ -195,7 +220,9 @@ def robot(
     else:
         said = _typed_turns()
     scorer, config = ws.completion_scorer(method, ws.resources(checkpoint, corpus))
-    outcomes = converse(said, layout, parser, scorer, config, ws.robot, say=note)
+    outcomes = converse(
+        said, layout, parser, scorer, config, ws.robot, say=note, budget=Budget(plan_seconds, ik_budget)
+    )
     if json_out:
         for outcome in outcomes:
             print(json.dumps({k: v for k, v in outcome.items() if k not in ("waypoints", "detections")}))

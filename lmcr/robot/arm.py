@@ -63,6 +63,8 @@ class Arm:
     held: int | None = None
     constraint: int | None = None
     on_waypoint: object = None  # called after each reached waypoint (rendering)
+    on_step: object = None  # called after each step of a followed path (a video's frames)
+    ik_calls: int = 0  # poses solved for (`solve`): what the planning search's budget counts
     log: list[dict] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -142,6 +144,7 @@ class Arm:
         seed the pose is also approached in stages (a large turn of the wrist, as in tilting to pour,
         defeats a single local solve). A position beyond the arm's reach is not searched: the error is then
         how far beyond it lies, the least any joints would leave."""
+        self.ik_calls += 1
         beyond = self.beyond_reach(position)
         if beyond > IK_POSITION:
             return np.asarray(seeds[0], dtype=float), beyond, math.pi
@@ -208,6 +211,8 @@ class Arm:
                 self.hold(a + (b - a) * k / n)
                 p.stepSimulation()
                 p.stepSimulation()
+                if self.on_step:
+                    self.on_step()
         for _ in range(240):
             if float(np.max(np.abs(self.config() - path[-1]))) < SETTLED:
                 break

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from lmcr.complete import Completion, CompletionConfig, complete
 from lmcr.errors import LMCRError
+from lmcr.robot.budget import Budget
 from lmcr.robot.execute import execute
 from lmcr.robot.reply import error_outcome
 from lmcr.robot.reply import say as sentence
@@ -77,9 +78,11 @@ def converse(
     config: CompletionConfig,
     cache_dir: Path,
     say: Callable[[str], None],
+    budget: Budget = Budget(),
 ) -> list[dict]:
     """Run the conversation until the turns run out; each instruction's outcome is one dict (executed
-    result, left, or error) with what the robot said about it (`reply`)."""
+    result, left, or error) with what the robot said about it (`reply`); each instruction's planning search
+    has the `budget`."""
     outcomes = []
     on_table = [o.label for o in scene.objects]
 
@@ -98,13 +101,13 @@ def converse(
                 if answer is None:
                     done({"instruction": instruction, "left": True, "question": completion.question})
                     continue
-            result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
+            result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer, budget=budget)
             if not result["feasible"] and result.get("suggestion"):  # "I can't reach the cup: should I ...?"
                 answer = _offer(result, turns, on_table, parser.lex.objects, say)
                 if answer is None:
                     done({"instruction": instruction, **result, "left": True})
                     continue
-                result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer)
+                result = execute(instruction, scene, parser, scorer, config, cache_dir, answer=answer, budget=budget)
         except LMCRError as exc:
             done({"instruction": instruction, **error_outcome(exc)})
             continue

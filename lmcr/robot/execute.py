@@ -10,7 +10,8 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import pybullet as p
@@ -20,6 +21,7 @@ from lmcr.errors import LMCRError, one_line
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
 from lmcr.robot.act import run_plan
+from lmcr.robot.budget import Budget
 from lmcr.robot.detect import detect
 from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
@@ -56,6 +58,7 @@ def execute(
     recorder: Recorder | None = None,
     answer: dict[str, str] | None = None,
     urdf: Path | None = None,
+    budget: Budget = Budget(),
 ) -> dict:
     """The CLI contract's result: frame, chosen object (`chosen_object` its label, `chosen_id` which of the
     objects with that label; `role_ids` the object of every role), waypoint errors, per-verb checks,
@@ -63,22 +66,23 @@ def execute(
     the whole plan is feasible. When the language model's choice is not but another candidate is, nothing
     moves and the result asks (`question`, `suggestion`). A `recorder` takes a picture at the start, at
     every waypoint and at the end. `answer` (role -> object) is what a person answered: it fills those
-    roles instead. `urdf`: the official Baxter description to use instead of ours."""
+    roles instead. `urdf`: the official Baxter description to use instead of ours. The planning search
+    stops when its `budget` is spent: the refusal then says so (`budget_exhausted`)."""
     started = time.perf_counter()
     _connect()
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
     completed = time.perf_counter()
-    planner = Planner(robot, scene, scene.table)
+    planner = Planner(robot, scene, scene.table, budget)
     options = _options(completion, answer)[:MAX_TRIED]
     tried = []  # (frame, candidate, role -> object, plan or why not)
     for frame, candidate in options:
         for objects in _assignments(scene, frame, {d.id for d in seen})[:MAX_INSTANCES]:
             tried.append((frame, candidate, objects, _plan(planner, scene, frame, objects)))
-            if isinstance(tried[-1][3], Plan):
+            if isinstance(tried[-1][3], Plan) or planner.stopped:
                 break
-        if isinstance(tried[-1][3], Plan):
+        if isinstance(tried[-1][3], Plan) or planner.stopped:
             break
     planned = time.perf_counter()
     # the language model's choice, as the first of its objects the robot can act on (else the nearest)
@@ -99,8 +103,12 @@ def execute(
         "holding": scene.holding.label if scene.holding else None,
         "ranking": _ranking(completion, tried),
         "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]} for d in seen],
+        "budget_exhausted": isinstance(result, Infeasible) and bool(planner.stopped),
+        "ik_calls": sum(arm.ik_calls for arm in planner.arms.values()),  # the planning search's, as budgeted
     }
     if isinstance(result, Infeasible):
+        if planner.stopped:
+            result = replace(result, reason=f"{result.reason} ({planner.stopped})")
         out.update(_refusal(out, result, tried))
     else:
         task = TASKS[frame.predicate]
@@ -111,6 +119,7 @@ def execute(
                 arm.on_waypoint = lambda log=arm.log: recorder.shot(
                     f"{log[-1]['name']} ({1000 * log[-1]['error_m']:.0f} mm)"
                 )
+                arm.on_step = recorder.tick
             recorder.shot(f"{frame.predicate} {held.id} -> {target.id}: start")
         out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)], planner))
         out["set_down_first"] = result.first.geometry.held.id if result.first else None
@@ -173,7 +182,7 @@ def _plan(planner: Planner, scene: Scene, frame: Frame, objects: dict[str, Scene
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
     direct = planner.plan(task, held, target, holding)
-    if isinstance(direct, Plan):
+    if isinstance(direct, Plan) or planner.stopped:
         return direct
     # set down elsewhere first: the held object when no arm reaches all the task as it stands (from the
     # table it may be picked up by either arm, in any grasp), else, with the hand free, the object on
@@ -229,12 +238,21 @@ def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
 BATCH_FIELDS = {"id": (str, int), "instruction": str}
 
 
-def execute_batch(path: Path, run: Callable[[str, Scene], dict]) -> Iterator[dict]:
-    """The batch form of the CLI contract: one output line per input line, in order. Each line gives an
-    instruction and a `scene` object or a `scene_file` (relative to the input's folder); `run` executes
-    one. A bad line (not JSON, a bad scene, an instruction that cannot be completed or acted on) gets
-    `{"id", "error"}` and the rest go on; only an unreadable input file raises."""
-    for line_no, record, error in read_jsonl_lines(path, BATCH_FIELDS):
+def read_batch(path: Path) -> list[tuple[int, dict | None, InputError | None]]:
+    """The non-blank lines of a batch input, read (line number, record, the line's error or None); only an
+    unreadable input file raises."""
+    return list(read_jsonl_lines(path, BATCH_FIELDS))
+
+
+def execute_batch(
+    path: Path, run: Callable[[str, Scene], dict], lines: Sequence[tuple] | None = None
+) -> Iterator[dict]:
+    """The batch form of the CLI contract: one output line per input line (of `lines` of `read_batch(path)`
+    when given), in order. Each line gives an instruction and a `scene` object or a `scene_file` (relative
+    to the input's folder); `run` executes one. A bad line (not JSON, a bad scene, an instruction that
+    cannot be completed or acted on) gets `{"id", "error"}` and the rest go on; only an unreadable input
+    file raises."""
+    for line_no, record, error in read_batch(path) if lines is None else lines:
         ident = record.get("id") if isinstance(record, dict) else None
         try:
             if error is not None:

@@ -12,12 +12,14 @@ back into the others' state. Joint-space paths are `joint_paths.py`, acting the 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pybullet as p
 
 from lmcr.robot.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose, rotation_error
+from lmcr.robot.budget import Budget
 from lmcr.robot.collision import Carried, Clearance
 from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, world_xy
@@ -76,15 +78,27 @@ class Infeasible:
 
 @dataclass
 class Planner:
-    """Plans tasks in a built world: `robot`, the scene's objects and the table body."""
+    """Plans tasks in a built world: `robot`, the scene's objects and the table body; its searches together
+    stop when the `budget` is spent (from the planner's making): `stopped` then says after how much."""
 
     robot: int
     scene: Scene
     table: int
+    budget: Budget = field(default_factory=Budget)
     arms: dict[str, Arm] = field(default_factory=dict)
+    stopped: str = ""  # "search stopped after 20 s / 2,000 IK calls" once the budget ended the search
+    started: float = field(default_factory=time.perf_counter)
 
     def __post_init__(self) -> None:
         self.arms = {side: Arm(self.robot, side) for side in SIDES}
+
+    def spent(self) -> bool:
+        """Whether the budget is spent (from now on every search returns at once, with what it found)."""
+        if not self.stopped:
+            seconds, solved = time.perf_counter() - self.started, sum(a.ik_calls for a in self.arms.values())
+            if seconds >= self.budget.seconds or solved >= self.budget.ik_calls:
+                self.stopped = f"search stopped after {seconds:.0f} s / {solved:,} IK call{'s' * (solved != 1)}"
+        return bool(self.stopped)
 
     def plan(
         self,
@@ -97,7 +111,7 @@ class Planner:
     ) -> Plan | Infeasible:
         """The first feasible plan over the `arms` (the nearer one first) and the task's variants, or the
         reason of the attempt that got furthest. The arm starts at its `start` configuration ("home",
-        or "parked": then it first moves home), the other one parked."""
+        or "parked": then it first moves home), the other one parked. A spent budget ends the search."""
         near = held if not holding else target
         sides = sorted(arms, key=lambda s: (near.xy[1] >= 0) != (s == "left"))
         best = Infeasible("nothing was tried", -1)
@@ -115,6 +129,8 @@ class Planner:
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
                 for variant in _variants(held, task, holding, arm.opening):
+                    if self.spent():
+                        return best
                     grasp = (variant.yaw, variant.pitch, variant.side, variant.shift, variant.narrow)
                     if grasp in failed_grasps:
                         continue  # the same pick-up failed already: only the later steps differ
@@ -159,10 +175,13 @@ class Planner:
         """Set `moved` (in the hand when `holding`, else on the table) down at the first of the free `spots`
         where that works and park that arm, then do the task with either arm: what the hand holds is out
         of the way, or the held object is passed from one arm's reach to the other's. Both parts are
-        planned before anything moves, the task in the world as the first part leaves it."""
+        planned before anything moves, the task in the world as the first part leaves it. A spent budget
+        ends the search."""
         best = Infeasible(f"found no free spot to put {_named(moved)} down", -1)
         for xy in spots:
             for side in SIDES:
+                if self.spent():
+                    return best
                 first = self.plan(put_down(xy), moved, moved, holding, arms=(side,))
                 if isinstance(first, Infeasible):
                     best = first if first.progress > best.progress else best
@@ -275,6 +294,8 @@ class Planner:
                 return Infeasible(_cannot_reach(arm, step, short), i, True)
         q, segments, released = start, [], False
         for i, step in enumerate(steps):
+            if self.spent():
+                return Infeasible(f"the {arm.side} arm's plan stopped before '{step.name}'", i)
             if step.kind == "grasp":
                 carried = Carried(held.body, *_grasped(arm, q, held))
             elif step.kind == "release":

@@ -1,6 +1,7 @@
 """Renders a person can read: a 3/4 view of the table at 640x480 with every object labelled and the
 target outlined, one picture per reached waypoint, saved as an animated GIF or a contact sheet PNG
-with each waypoint's name and error as its caption.
+with each waypoint's name and error as its caption; and a video of the run: the same view every few
+simulation steps of each motion as well, saved as an animated GIF (Pillow).
 
 The camera stands at the far left corner of the table, facing the robot: the arm reaches towards the
 camera, so it does not hide the objects it acts on (the detection camera looks straight down).
@@ -35,6 +36,11 @@ OUTLINE = 3  # pixels
 SHEET_COLUMNS = 3
 SHEET_SCALE = 0.5  # contact-sheet tiles at half size
 FRAME_MS = 700
+# a video: a picture every VIDEO_EVERY steps of a followed path (each 2 simulation steps: 1/120 s, so about
+# 4 pictures a second of the robot's time; a picture takes 0.1 to 0.3 s to render), each shown VIDEO_MS,
+# the waypoints' pictures WAYPOINT_MS; at half size (a GIF of a minute's run stays a few MB)
+VIDEO_EVERY, VIDEO_MS, WAYPOINT_MS, VIDEO_SCALE = 30, 120, 600, 0.5
+VIDEO_SUFFIXES = (".gif",)
 
 
 def _font(size: int) -> ImageFont.ImageFont:
@@ -70,16 +76,26 @@ def _label(draw: ImageDraw.ImageDraw, xy: tuple[float, float], text: str, colour
 
 @dataclass
 class Recorder:
-    """Pictures of one execution: `shot(caption)` at the start and at every waypoint."""
+    """Pictures of one execution: `shot(caption)` at the start and at every waypoint, and with `every` (a
+    video) a picture every `every` calls of `tick` (one per step of a followed path) as well."""
 
     scene: Scene
     target: str | None = None  # id of the object outlined as what the action is for
     held: str | None = None  # id of the object the hand takes
     camera: Camera = VIEW
+    every: int = 0
     pictures: list[Image.Image] = field(default_factory=list)
     captions: list[str] = field(default_factory=list)
+    moving: list[bool] = field(default_factory=list)  # per picture: taken by `tick`, during a motion
+    ticks: int = 0
 
-    def shot(self, caption: str) -> None:
+    def tick(self) -> None:
+        """One step of a motion: a video's picture every `every` steps (captioned as the last waypoint)."""
+        self.ticks += 1
+        if self.every and self.ticks % self.every == 0:
+            self.shot(self.captions[-1] if self.captions else "", moving=True)
+
+    def shot(self, caption: str, moving: bool = False) -> None:
         rgb, _, seg = capture(self.camera, shaded=True)
         rgb = rgb.copy()
         objects = self.scene.present
@@ -97,30 +113,42 @@ class Recorder:
             _label(draw, _project(top, self.camera), obj.id, colour)
         self.pictures.append(image)
         self.captions.append(caption)
+        self.moving.append(moving)
+
+    def waypoints(self) -> list[tuple[Image.Image, str]]:
+        """The pictures at the start, at each waypoint and at the end, with their captions."""
+        return [(im, c) for im, c, moving in zip(self.pictures, self.captions, self.moving) if not moving]
 
     def save(self, path: Path) -> Path:
-        """`path`.gif: every picture in turn; `path`.png: the contact sheet with captions."""
+        """`path`.gif: every waypoint's picture in turn; `path`.png: the contact sheet with captions."""
         path = Path(path)
         with atomic_path(path) as tmp:
             if path.suffix.lower() == ".gif":
-                captioned = [_captioned(im, c, 1.0) for im, c in zip(self.pictures, self.captions)]
-                captioned[0].save(
-                    tmp, format="GIF", save_all=True, append_images=captioned[1:], duration=FRAME_MS, loop=0
-                )
+                _save_gif(tmp, [_captioned(im, c, 1.0) for im, c in self.waypoints()], FRAME_MS)
             else:
                 self.sheet().save(tmp, format="PNG")
         return path
 
+    def save_video(self, path: Path) -> Path:
+        """`path`.gif: every picture, the motions' and the waypoints', at half size: the run as it went."""
+        path = Path(path)
+        frames = [_captioned(im, c, VIDEO_SCALE) for im, c in zip(self.pictures, self.captions)]
+        with atomic_path(path) as tmp:
+            _save_gif(tmp, frames, [VIDEO_MS if moving else WAYPOINT_MS for moving in self.moving])
+        return path
+
     def sheet(self) -> Image.Image:
-        tiles = [
-            _captioned(im, f"{i}. {c}", SHEET_SCALE) for i, (im, c) in enumerate(zip(self.pictures, self.captions))
-        ]
+        tiles = [_captioned(im, f"{i}. {c}", SHEET_SCALE) for i, (im, c) in enumerate(self.waypoints())]
         w, h = tiles[0].size
         rows = -(-len(tiles) // SHEET_COLUMNS)
         sheet = Image.new("RGB", (SHEET_COLUMNS * w, rows * h), (255, 255, 255))
         for i, tile in enumerate(tiles):
             sheet.paste(tile, ((i % SHEET_COLUMNS) * w, (i // SHEET_COLUMNS) * h))
         return sheet
+
+
+def _save_gif(path: Path, frames: list[Image.Image], duration: int | list[int]) -> None:
+    frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:], duration=duration, loop=0)
 
 
 def _captioned(image: Image.Image, caption: str, scale: float) -> Image.Image:

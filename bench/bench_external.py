@@ -1,0 +1,123 @@
+"""Benchmark: the external request sets (IntroPlan, HuRIC, TidyBot, COAT) completed as `lmcr complete` does.
+
+Usage: python bench/bench_external.py [--sets DIR] [--data-dir DIR] [--method M] [--json PATH] [--out-jsonl PATH]
+--sets: the folder of `<set>.jsonl` files (default $LMCR_SHARED_DIR/eval/external). The data folder
+(--data-dir, else $LMCR_DATA_DIR) gives the store, checkpoints, mixture, context weight and the
+calibration `lmcr evaluate` wrote there, as for `lmcr complete`. Per set: right predicate (named with
+its particle: `put away`) and missing role, top guess among `expected_any`, questions asked (help rate),
+how often the prediction set holds a right object and its mean size (KnowNo's success and help), the
+share with no completion and why, and the latency of one completion (p50, p90). The measures are
+defined in lmcr/evaluate/external.py. --out-jsonl writes one line per item: its set, the completion
+line (`prediction_set` included, or its error) and its outcome.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from record import add_json_option, write_results
+
+from lmcr.errors import LMCRError
+from lmcr.evaluate.external import read_sets, run_set, summarize
+from lmcr.files import check_output_file
+from lmcr.jsonl import InputError, write_jsonl_atomic
+from lmcr.scorers.registry import COMPLETION_METHOD
+from lmcr.workspace import Workspace
+
+COLUMNS = (
+    ("items", "items", "{:d}"),
+    ("pred+role", "right predicate and missing role", "{:.3f}"),
+    ("top", "top guess right", "{:.3f}"),
+    ("asked", "questions asked", "{:.3f}"),
+    ("set holds", "set holds a right object", "{:.3f}"),
+    ("set size", "mean set size", "{:.2f}"),
+    ("errors", "errors", "{:.3f}"),
+    ("p50 ms", "p50 ms", "{:.1f}"),
+    ("p90 ms", "p90 ms", "{:.1f}"),
+)
+
+
+def sets_folder(given: Path | None) -> Path:
+    """--sets, else $LMCR_SHARED_DIR/eval/external; neither is an InputError."""
+    if given is not None:
+        return given
+    shared = os.environ.get("LMCR_SHARED_DIR")
+    if not shared:
+        raise InputError("no request sets: give --sets DIR or set LMCR_SHARED_DIR")
+    return Path(shared) / "eval" / "external"
+
+
+def table(summaries: dict[str, dict]) -> str:
+    """The sets' figures, one row per set."""
+
+    def cell(value, form: str) -> str:
+        return "-" if value is None else form.format(value)
+
+    rows = [["set", *(head for head, _, _ in COLUMNS)]]
+    rows += [[name, *(cell(s[key], form) for _, key, form in COLUMNS)] for name, s in summaries.items()]
+    widths = [max(len(row[k]) for row in rows) for k in range(len(rows[0]))]
+    return "\n".join(
+        "  ".join(c.rjust(w) if k else c.ljust(w) for k, (c, w) in enumerate(zip(row, widths))) for row in rows
+    )
+
+
+def flat(name: str, summary: dict) -> dict:
+    """A set's figures as the results page lists them: `<set>: <figure>`, the errors and wrong predicates
+    one figure per reason."""
+    figures = {f"{name}: {k}": v for k, v in summary.items() if not isinstance(v, dict)}
+    figures |= {f"{name}: {k} (count)": v for k, v in summary["counts"].items()}
+    figures |= {f"{name}: error {reason!r}": count for reason, count in summary["error reasons"].items()}
+    figures |= {f"{name}: predicate read as {pair}": count for pair, count in summary["wrong predicates"].items()}
+    return figures
+
+
+def outcome_fields(outcome) -> dict:
+    """An outcome as its item's output line carries it: what the line does not already say (its id, error)."""
+    return {k: round(v, 3) if k == "ms" else v for k, v in outcome.to_json().items() if k not in ("id", "error")}
+
+
+def main() -> None:
+    parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser_.add_argument("--sets", type=Path, default=None, help="folder of <set>.jsonl request sets")
+    parser_.add_argument("--data-dir", type=Path, default=None, help="data folder (default $LMCR_DATA_DIR)")
+    parser_.add_argument("--method", default=COMPLETION_METHOD, help=f"completion method (default {COMPLETION_METHOD})")
+    parser_.add_argument("--out-jsonl", type=Path, default=None, help="one line per item: completion and outcome")
+    add_json_option(parser_, "bench_external")
+    args = parser_.parse_args()
+    try:
+        run(args)
+    except LMCRError as exc:
+        sys.exit(f"error: {exc}")
+
+
+def run(args: argparse.Namespace) -> None:
+    sets = read_sets(sets_folder(args.sets))
+    if args.out_jsonl is not None:
+        check_output_file(args.out_jsonl)
+    ws = Workspace.from_env(data_dir=args.data_dir)
+    scorer, config = ws.completion_scorer(args.method)
+    parser = ws.parser()
+    print(f"{args.method}; {config.source}")
+    summaries, lines = {}, []
+    for name, items in sets.items():
+        done = run_set(parser, scorer, config, items)
+        summaries[name] = summarize(items, [outcome for _, outcome in done])
+        lines += [{"set": name, **line, "outcome": outcome_fields(outcome)} for line, outcome in done]
+    print(table(summaries))
+    for name, summary in summaries.items():
+        reasons = ", ".join(f"{reason} {count}" for reason, count in summary["error reasons"].items())
+        print(f"{name}: errors: {reasons or 'none'}")
+    if args.out_jsonl is not None:
+        write_jsonl_atomic(args.out_jsonl, lines)
+        print(f"{len(lines)} items written to {args.out_jsonl}")
+    figures = {"method": args.method, "calibration": config.source, "sets": ", ".join(sets)}
+    for name, summary in summaries.items():
+        figures |= flat(name, summary)
+    write_results(args.json, "bench_external", __doc__.splitlines()[0], figures)
+
+
+if __name__ == "__main__":
+    main()

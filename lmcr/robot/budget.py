@@ -1,0 +1,26 @@
+"""How far the planning search of one instruction may go before the robot refuses, saying so: seconds of
+wall clock and inverse-kinematics solves. A light module: the command line reads its defaults for the
+options' help without loading the simulator."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# The whole search counts (every candidate, arm and grasp, every spot to set an object down first). The
+# eleven predicates' plans take tens to hundreds of solves and a few seconds; setting an object down first
+# took 200 to 1,100 solves. The count is what binds by default: it stops a search at the same point on
+# any machine, however busy, so a plan's outcome never depends on the load. The wall-clock limit is a
+# safety net for a pathological tail (275 s was seen on 2 cores); `--plan-seconds 20` trades the slow
+# rearrangements for an answer within 30 s on a quiet 2-core machine.
+PLAN_SECONDS, IK_CALLS = 300.0, 2000
+# the options' ranges: a budget too small to plan anything is still a budget (it refuses at once)
+PLAN_SECONDS_RANGE = {"min": 0.01, "max": 3600.0}
+IK_CALLS_RANGE = {"min": 1, "max": 10_000_000}
+
+
+@dataclass(frozen=True)
+class Budget:
+    """The planning search's limits: `seconds` of wall clock, `ik_calls` poses solved."""
+
+    seconds: float = PLAN_SECONDS
+    ik_calls: int = IK_CALLS
