@@ -4,6 +4,7 @@ worker, see the schedule fire and the artifacts a UI user sees."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -116,10 +117,25 @@ def test_readme_deployment_commands_as_written(tmp_path):
         assert "InvalidRequestError" not in server_log and scheduler_errors == [], scheduler_errors
     finally:
         for proc in reversed(background):
-            os.killpg(proc.pid, signal.SIGTERM)
-            proc.wait(timeout=30)
+            stop_group(proc)
         for log in logs:
             log.close()
+
+
+def stop_group(proc: subprocess.Popen, grace_s: float = 30.0) -> None:
+    """Stop a service the way its user would (SIGTERM to its process group), then make sure nothing of it
+    is left: a Prefect worker outlives its shell and, once its server is gone, retries for ever."""
+    os.killpg(proc.pid, signal.SIGTERM)
+    proc.wait(timeout=grace_s)
+    deadline = time.monotonic() + grace_s
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.5)
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGKILL)
 
 
 def api(url: str, path: str, parent_only: bool = False) -> list[dict]:

@@ -55,7 +55,9 @@ def run_env(tmp_path: Path, marker: str) -> dict[str, str]:
     }
 
 
-def pipeline(tmp_path: Path, env: dict[str, str], **popen) -> subprocess.Popen:
+def pipeline(tmp_path: Path, env: dict[str, str]) -> subprocess.Popen:
+    """`python -m flows.pipeline` on the sample, small, as a user starts it at a terminal: Ctrl-C
+    interrupts it even where the test itself runs with SIGINT ignored (a job started in the background)."""
     params = json.dumps(SMALL | {"data_dir": str(tmp_path / "data")})
     return subprocess.Popen(
         [sys.executable, "-m", "flows.pipeline", params],
@@ -64,7 +66,7 @@ def pipeline(tmp_path: Path, env: dict[str, str], **popen) -> subprocess.Popen:
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
-        **popen,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
 
 
