@@ -99,7 +99,8 @@ def _drain_prefect_workers(timeout_s: float = 30.0) -> None:
             pass
 
 
-def _stop(process: subprocess.Popen) -> None:
+def stop_process(process: subprocess.Popen) -> None:
+    """Terminate `process` and wait for it; killed if it has not ended within 10 s."""
     if process.poll() is None:
         process.terminate()
         try:
@@ -149,7 +150,7 @@ def local_server(timeout_s: float | None = None) -> Iterator[str]:
             _drain_prefect_workers()
         if os.environ.pop("PREFECT_API_URL", None):
             refresh_global_settings_context()
-        _stop(process)
+        stop_process(process)
 
 
 def run_with_server(main, *args, **kwargs):

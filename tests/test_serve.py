@@ -21,6 +21,7 @@ import pytest
 from fastapi.testclient import TestClient
 from typer.testing import CliRunner
 
+from flows.server import stop_process
 from lmcr.checkout import REPO_ROOT
 from lmcr.lexicon import load_lexicon
 from lmcr.robot.dialogue import MAX_TRIES
@@ -306,12 +307,7 @@ def test_the_page_in_headless_chromium(trained, tmp_path):
             timeout=600,
         )
     finally:
-        server.terminate()
-        try:
-            server.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            server.wait()
+        stop_process(server)
     if shot.exists():
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         shutil.copy(shot, ARTIFACTS / "serve.png")
