@@ -30,7 +30,7 @@ def dev_scores(parser, eval_dir: Path) -> dict:
     """Role F1 and predicate recall on the SRL dev set, and the instructions parsed right."""
     gold = [r for _, r in read_jsonl(eval_dir / "srl_dev.jsonl", {"text": str, "frames": list})]
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in gold)]
-    overall = score_frames([r["frames"] for r in gold], predicted, set(parser.lex.predicates)).table()[-1]
+    overall = score_frames([r["frames"] for r in gold], predicted, set(parser.lex.hand_written)).table()[-1]
     tasks = [r for _, r in read_jsonl(eval_dir / "instructions_dev.jsonl", {"instruction": str})]
     right = 0
     for task in tasks:

@@ -93,7 +93,10 @@ def _frame_of(row: dict, path: Path, line: int, lex: Lexicon, n_columns: int) ->
     verb = (row["verb"] or "").strip().lower()
     spec = lex.predicates.get(verb)
     if spec is None:
-        raise InputError(f"{path}:{line}: unknown verb {row['verb']!r} (one of {', '.join(sorted(lex.predicates))})")
+        raise InputError(
+            f"{path}:{line}: unknown verb {row['verb']!r} "
+            f"(one of {', '.join(lex.hand_written)}, or a predicate learned from the corpora)"
+        )
     roles = {
         (row["role1"] or "").strip(): (row["arg1"] or "").strip().lower(),
         (row["role2"] or "").strip(): (row["arg2"] or "").strip().lower(),

@@ -5,9 +5,11 @@ from __future__ import annotations
 import json
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
+
+from lmcr.data_dir import PREDICATES_FILE, SRL_SUBDIR, data_dir_from_env
 
 LEXICON_PATH = Path(__file__).with_name("lexicon.json")
 # What the lexicon is made of: a change to either changes every frame the parser finds.
@@ -71,28 +73,36 @@ class Lexicon:
     recipient_pronouns: frozenset[str]
     courtesy_words: frozenset[str] = frozenset()  # "please": closes a request, never part of a name
     objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
+    # the predicates learned from the frame corpus (a subset of `predicates`), and the verbs the corpus uses
+    # too seldom to learn (verb -> frames): a request with one of those is refused by name
+    learned: frozenset[str] = frozenset()
+    refused: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def hand_written(self) -> list[str]:
+        """The predicates of the hand-written lexicon (the paper's eleven)."""
+        return sorted(p for p in self.predicates if p not in self.learned)
+
+
+def _spec(name: str, spec: dict) -> PredicateSpec:
+    return PredicateSpec(
+        name=name,
+        roles=tuple(spec["roles"]),
+        object_role=spec["object"],
+        with_role=spec.get("with"),
+        preps={role: tuple(p) for role, p in spec.get("preps", {}).items()},
+        particles=frozenset(spec.get("particles", [])),
+        alternating=bool(spec.get("alternating")),
+        sentence=spec["sentence"],
+        past=spec.get("past"),
+    )
 
 
 @lru_cache(maxsize=4)
-def load_lexicon(path: str | None = None) -> Lexicon:
-    """Load the lexicon (`LMCR_LEXICON` or the packaged `lexicon.json`)."""
-    data = json.loads(Path(path or os.environ.get("LMCR_LEXICON") or LEXICON_PATH).read_text("utf-8"))
-    predicates = {
-        name: PredicateSpec(
-            name=name,
-            roles=tuple(spec["roles"]),
-            object_role=spec["object"],
-            with_role=spec.get("with"),
-            preps={role: tuple(p) for role, p in spec.get("preps", {}).items()},
-            particles=frozenset(spec.get("particles", [])),
-            alternating=bool(spec.get("alternating")),
-            sentence=spec["sentence"],
-            past=spec.get("past"),
-        )
-        for name, spec in data["predicates"].items()
-    }
+def _hand_written(path: str) -> Lexicon:
+    data = json.loads(Path(path).read_text("utf-8"))
     return Lexicon(
-        predicates=predicates,
+        predicates={name: _spec(name, spec) for name, spec in data["predicates"].items()},
         measure_nouns=frozenset(data["measure_nouns"]),
         quantity_nouns=frozenset(data["quantity_nouns"]),
         object_pronouns=frozenset(data["object_pronouns"]),
@@ -100,3 +110,50 @@ def load_lexicon(path: str | None = None) -> Lexicon:
         objects=tuple(data.get("objects", ())),
         courtesy_words=frozenset(data.get("courtesy_words", ())),
     )
+
+
+@lru_cache(maxsize=8)
+def _with_learned(path: str, table: str, modified_ns: int) -> Lexicon:
+    """The hand-written lexicon with a learned table's predicates added (the hand-written ones win); a table
+    that cannot be read is a ResourceError naming it."""
+    from lmcr.files import read_resource
+
+    lex = _hand_written(path)
+    data = read_resource(Path(table), "learned predicate table", _learned_table)
+    learned = {
+        name: _spec(name, entry["spec"]) for name, entry in data["predicates"].items() if name not in lex.predicates
+    }
+    return replace(
+        lex,
+        predicates={**learned, **lex.predicates},
+        learned=frozenset(learned),
+        refused={name: int(n) for name, n in data.get("refused", {}).items()},
+    )
+
+
+def _learned_table(value: object) -> dict:
+    if not (isinstance(value, dict) and isinstance(value.get("predicates"), dict)):
+        raise ValueError("not a learned predicate table: no 'predicates' object")
+    for name, entry in value["predicates"].items():
+        spec = entry.get("spec") if isinstance(entry, dict) else None
+        if not (isinstance(spec, dict) and isinstance(spec.get("roles"), list) and len(spec["roles"]) == 2):
+            raise ValueError(f"predicate {name!r} has no spec with two roles")
+        if not isinstance(spec.get("sentence"), str) or not isinstance(spec.get("object"), str):
+            raise ValueError(f"predicate {name!r} has no sentence template or object role")
+    return value
+
+
+def learned_table_path() -> Path:
+    """Where the workspace's learned predicate table is: `$LMCR_DATA_DIR/srl/predicates.json`."""
+    return data_dir_from_env() / SRL_SUBDIR / PREDICATES_FILE
+
+
+def load_lexicon(path: str | None = None, learned: Path | str | bool = True) -> Lexicon:
+    """The lexicon (`LMCR_LEXICON` or the packaged `lexicon.json`), with the predicates learned from the
+    frame corpus merged in: `learned` a table's path, True for the workspace's (`learned_table_path`, when
+    the frame build has written one), False for none (the frame build itself parses with the eleven)."""
+    base = str(path or os.environ.get("LMCR_LEXICON") or LEXICON_PATH)
+    table = learned_table_path() if learned is True else Path(learned) if learned else None
+    if table is None or not table.is_file():
+        return _hand_written(base)
+    return _with_learned(base, str(table.resolve()), table.stat().st_mtime_ns)

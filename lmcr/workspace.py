@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from lmcr.checkout import SQL_DIR
+from lmcr.data_dir import PREDICATES_FILE, SRL_SUBDIR, data_dir_from_env
 from lmcr.srl.spacy_model import SPACY_MODEL, spacy_model_from_env
 
 if TYPE_CHECKING:  # the scorers, the parser and DuckDB are imported when first used (CLI start-up)
@@ -50,7 +51,7 @@ class Workspace:
     @classmethod
     def from_env(cls, data_dir: str | Path | None = None, db: str | Path | None = None) -> Workspace:
         """Explicit arguments win, then the environment, then `data/` beside the current directory."""
-        data = Path(data_dir or os.environ.get("LMCR_DATA_DIR") or "data")
+        data = data_dir_from_env(data_dir)
         return cls(
             data_dir=data,
             db=Path(db or os.environ.get("LMCR_DB") or data / "lmcr.duckdb"),
@@ -67,7 +68,7 @@ class Workspace:
     @property
     def srl_dir(self) -> Path:
         """Learned SRL resources (compounds, role priors) built by the frames stage."""
-        return self.data_dir / "srl"
+        return self.data_dir / SRL_SUBDIR
 
     @property
     def checkpoints(self) -> Path:
@@ -147,6 +148,7 @@ class Workspace:
             seed=seed,
             mixture=mixture,
             context_weight=context_weight or WEIGHT,
+            predicates=self.srl_dir / PREDICATES_FILE,
         )
 
     def parser(self, model: str | None = None, resources: Path | None = None) -> FrameParser:

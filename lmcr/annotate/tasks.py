@@ -64,7 +64,7 @@ def protocol_frames(seed: int, fixed_per_role: int) -> list[Frame]:
     lex = load_lexicon()
     rng = random.Random(seed)
     frames = []
-    for verb, spec in sorted(lex.predicates.items()):
+    for verb, spec in sorted((v, lex.predicates[v]) for v in lex.hand_written):
         for role in spec.roles:
             for fixed in rng.sample(lex.objects, fixed_per_role):
                 frames += [Frame.of(verb, {role: fixed, spec.other(role): o}) for o in lex.objects if o != fixed]
@@ -78,7 +78,7 @@ def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Fra
         "join frame_roles r using (corpus, doc_id, sent_id, frame_no) where f.predicate in (select unnest(?)) "
         "group by f.corpus, f.doc_id, f.sent_id, f.frame_no, f.predicate "
         "having count(r.value) = 2 and bool_and(r.value not in (select unnest(?)))",
-        [list(lex.predicates), sorted(lex.object_pronouns)],
+        [lex.hand_written, sorted(lex.object_pronouns)],
     ).fetchall()
     distinct = sorted({(p, tuple(zip(roles, values))) for p, roles, values in rows})
     picked = random.Random(seed).sample(distinct, min(n, len(distinct)))

@@ -123,6 +123,57 @@ def frames(
 
 
 @app.command()
+def predicates(
+    verb: str | None = typer.Argument(None, help="Show one predicate (or refused verb) with its evidence."),
+    top: int = typer.Option(30, min=0, help="Predicates listed, most evidence first."),
+    relearn: bool = typer.Option(False, help="Learn again from the current frame corpus, even if it has a table."),
+    db: Path | None = typer.Option(None, help="DuckDB store."),
+) -> None:
+    """The predicates learned from the frame corpus: coverage, and each one's roles and evidence."""
+    from lmcr.frame_corpus.load import last_build
+    from lmcr.frame_corpus.predicates import refresh_predicates
+    from lmcr.lexicon import PREDICATES_FILE, load_lexicon
+
+    ws = Workspace.from_env(db=db)
+    if not ws.db.exists():
+        fail(f"{ws.db}: no store yet (run `lmcr ingest`, then `lmcr frames`)")
+    con = ws.connect()
+    build = last_build(con)
+    if build is None:
+        fail(f"{ws.db}: no frame corpus yet (run `lmcr frames`)")
+    refresh_predicates(con, load_lexicon(learned=False), ws.srl_dir, build, force=relearn)
+    rows = [
+        dict(zip(("predicate", "frames", "roles", "rate", "sentence"), row))
+        for row in con.execute(
+            "select predicate, frames, role1 || ', ' || role2, round(role2_rate, 3), sentence from learned_predicates"
+            " order by frames desc, predicate"
+        ).fetchall()
+    ]
+    lex = load_lexicon(learned=ws.srl_dir / PREDICATES_FILE)
+    if verb is not None:
+        _show_predicate(verb, rows, lex)
+        return
+    print_rows(f"predicates learned from {ws.db} (top {top} of {len(rows):,})", rows[:top])
+    console.print(f"{len(rows):,} learned, {len(lex.refused):,} verbs refused for too little evidence")
+
+
+def _show_predicate(verb: str, rows: list[dict], lex) -> None:
+    """One predicate's row, a refused verb's evidence, or an error naming the verb."""
+    name = " ".join(verb.lower().split())
+    found = [r for r in rows if r["predicate"] == name]
+    if found:
+        print_rows(f"learned predicate {name!r}", found)
+    elif name in lex.refused:
+        console.print(f"{name!r}: refused, {lex.refused[name]:,} frames (too little evidence)")
+    elif name in lex.predicates:
+        console.print(
+            f"{name!r}: hand-written ({', '.join(lex.predicates[name].roles)}): {lex.predicates[name].sentence}"
+        )
+    else:
+        fail(f"no predicate {name!r}: the corpora use it too seldom, or never")
+
+
+@app.command()
 def srl(
     text: str | None = typer.Argument(None, help="One instruction to parse and show."),
     input: Path | None = typer.Option(None, "--input", help="JSONL of {id, text}."),
@@ -147,7 +198,7 @@ def srl(
     for frame in found if all_predicates else [f for f in found if f.known]:
         Console().print(_frame_line(frame), highlight=False)
     if not any(f.known for f in found):
-        fail(f"no known predicate in {text!r}: the robot can {', '.join(sorted(parser.lex.predicates))}")
+        fail(f"no known predicate in {text!r}: the robot can {', '.join(parser.lex.hand_written)}")
 
 
 def _frame_line(frame) -> str:
@@ -176,9 +227,9 @@ def srl_eval(
     tasks = read_instruction_tasks(instructions) if instructions else []
     parser = Workspace.from_env().parser(model, resources)
     predicted = [[f.to_json() for f in found] for found in parser.pipe(r["text"] for r in records)]
-    scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.predicates))
+    scores = score_frames([r["frames"] for r in records], predicted, set(parser.lex.hand_written))
     print_rows(f"SRL on {gold.name} ({len(records)} sentences)", scores.table())
-    _print_error_classes(records, predicted, set(parser.lex.predicates), show)
+    _print_error_classes(records, predicted, set(parser.lex.hand_written), show)
     console.print(
         f"resources: compounds={'yes' if parser.compounds else 'no'}, "
         f"role priors={'yes' if parser.priors else 'no'}; imperative re-parses: "

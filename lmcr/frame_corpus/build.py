@@ -20,6 +20,7 @@ import duckdb
 from lmcr.files import atomic_path
 from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.frame_corpus.load import last_build, load_frames
+from lmcr.frame_corpus.predicates import refresh_predicates
 from lmcr.frame_corpus.shards import (
     Shard,
     ShardJob,
@@ -29,6 +30,7 @@ from lmcr.frame_corpus.shards import (
     learn_first_words,
     parse_shard,
 )
+from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import learn_compounds
 from lmcr.srl.parser import COMPOUNDS_FILE, FIRST_WORDS_FILE, PRIORS_FILE
 
@@ -107,6 +109,7 @@ def build_frame_corpus(
     prepared = prepare_build(con, staging, srl_dir, config)
     if prepared is None:
         log("frame corpus unchanged: skipped")
+        _learn(con, srl_dir, last_build(con), log)
         return None
     fingerprint, shards = prepared
     started = time.perf_counter()  # the wall time and words/s include the first words' minute
@@ -117,4 +120,12 @@ def build_frame_corpus(
     build = summarize_build(fingerprint, config, results, time.perf_counter() - started)
     log(f"{build['words']:,} words at {build['words_per_s']:,.0f} words/s")
     finish_build(con, srl_dir, results, build, job)
+    _learn(con, srl_dir, fingerprint, log)
     return build
+
+
+def _learn(con: duckdb.DuckDBPyConnection, srl_dir: Path, build: str | None, log: Callable[[str], None]) -> None:
+    """Learn the predicates of the build when it has no table yet (`frame_corpus.predicates`)."""
+    table = refresh_predicates(con, load_lexicon(learned=False), srl_dir, build)
+    if table is not None:
+        log(f"learned {len(table.predicates):,} predicates; {len(table.refused):,} verbs refused (too little evidence)")

@@ -24,7 +24,7 @@ group by all
 
 def learn_priors(con: duckdb.DuckDBPyConnection) -> RolePriors:
     """Role preferences from fully specified, syntactically unambiguous alternating-verb frames."""
-    alternating = [name for name, spec in load_lexicon().predicates.items() if spec.alternating]
+    alternating = [name for name, spec in load_lexicon(learned=False).predicates.items() if spec.alternating]
     priors = RolePriors()
     for verb, value, role, n in con.execute(_PRIOR_COUNTS, [alternating]).fetchall():
         priors.by_verb[(verb, value, role)] += n
@@ -45,7 +45,7 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
             (corpus, doc_id, sent_id, frame_no), FrameMention(predicate, {}, True, 0, 0, {}, ambiguous)
         )
         frame.roles[role] = value
-    lex = load_lexicon()
+    lex = load_lexicon(learned=False)
     flipped = []
     for key, frame in frames.items():
         roles = lex.predicates[frame.predicate].roles

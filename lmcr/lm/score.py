@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import torch
 from torch.nn import functional as F
 
+from lmcr.lexicon import Lexicon
 from lmcr.lm.checkpoint import Checkpoint
 from lmcr.lm.linearize import linearize, tokens
 from lmcr.lm.train import pick_precision
@@ -144,6 +145,7 @@ class LMScorer:
         self.vocab = checkpoint.vocab
         self.score_end = score_end
         self.chunk = chunk
+        self.lex: Lexicon | None = None  # whose templates frames are read with (None: the workspace's lexicon)
         decoder = self.model.decoder
         self.precision = pick_precision(precision, decoder.weight.device)
         dtype = torch.bfloat16 if self.precision == "bf16" else decoder.weight.dtype
@@ -208,7 +210,7 @@ class LMScorer:
         return add_context(scores, gains)
 
     def frame_texts(self, frames: list[tuple[str, dict[str, str]]]) -> list[str]:
-        return [linearize(self.checkpoint.linearization, predicate, roles) for predicate, roles in frames]
+        return [linearize(self.checkpoint.linearization, predicate, roles, self.lex) for predicate, roles in frames]
 
     def context_ids(self, context: str) -> list[int]:
         """The context's token ids as this model reads them after a frame (no <s>, no </s>)."""

@@ -31,8 +31,16 @@ GRASP_SLACK = 0.02  # metres: the fingertips must be at most this far outside th
 
 def rotation_error(current, target) -> np.ndarray:
     """World-frame rotation vector turning orientation `current` into `target` (quaternions)."""
-    rc = np.asarray(p.getMatrixFromQuaternion(current)).reshape(3, 3)
-    rt = np.asarray(p.getMatrixFromQuaternion(target)).reshape(3, 3)
+    return rotation_error_to(current, rotation_matrix(target))
+
+
+def rotation_matrix(orientation) -> np.ndarray:
+    return np.asarray(p.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+
+
+def rotation_error_to(current, rt: np.ndarray) -> np.ndarray:
+    """`rotation_error` towards a target given as its rotation matrix (an IK loop converts it once)."""
+    rc = rotation_matrix(current)
     r = rt @ rc.T
     angle = math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2)))
     if angle < 1e-9:
@@ -131,8 +139,8 @@ class Arm:
         return np.array([s[0] for s in p.getJointStates(self.robot, self.joints)])
 
     def set_config(self, q) -> None:
-        for j, v in zip(self.joints, q):
-            p.resetJointState(self.robot, j, float(v))
+        # one call for the seven joints (the IK loop sets them hundreds of thousands of times a plan)
+        p.resetJointStatesMultiDof(self.robot, self.joints, [[float(v)] for v in q], [[0.0]] * len(self.joints))
 
     def ee_pose(self) -> tuple[np.ndarray, tuple]:
         state = p.getLinkState(self.robot, self.ee, computeForwardKinematics=True)
@@ -176,10 +184,11 @@ class Arm:
         lo, hi = self.limits.T
         all_q = [s[0] for s in p.getJointStates(self.robot, self.movable)]
         zeros = [0.0] * len(self.movable)
+        goal = rotation_matrix(orientation)
         for _ in range(iterations + 1):
             self.set_config(q)
             pos, orn = self.ee_pose()
-            err_pos, err_rot = target - pos, rotation_error(orn, orientation)
+            err_pos, err_rot = target - pos, rotation_error_to(orn, goal)
             if _ == iterations or (np.linalg.norm(err_pos) < 2e-4 and np.linalg.norm(err_rot) < 2e-3):
                 break
             for c, v in zip(self.columns, q):

@@ -29,10 +29,27 @@ from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
 from lmcr.robot.tasks import TASKS
 from lmcr.robot.world import build_world
+from lmcr.srl.parser import NoPredicateError
 
 MAX_TRIED = 4  # candidates planned at most, in the language model's order, to find one the robot can do
 MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (nearest first)
 ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (table frame): both arms reach there
+
+
+class NoMotionError(NoPredicateError):
+    """A predicate the robot understands (learned from the corpora) but has no motion for yet."""
+
+    def __init__(self, predicate: str):
+        can = ", ".join(sorted(TASKS))
+        super().__init__(f"the simulated Baxter has no motion for {predicate!r} yet (it can {can})")
+        self.predicate = predicate
+
+
+def _with_motion(completion: Completion) -> Completion:
+    """The completion, when the robot has a motion for its predicate; else NoMotionError."""
+    if completion.frame.predicate not in TASKS:
+        raise NoMotionError(completion.frame.predicate)
+    return completion
 
 
 class ExecutionError(LMCRError, ValueError):
@@ -72,7 +89,9 @@ def execute(
     _connect()
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
-    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
+    completion = _with_motion(
+        complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
+    )
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget)
     options = _options(completion, answer)[:MAX_TRIED]

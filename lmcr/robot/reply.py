@@ -103,8 +103,10 @@ def error_outcome(exc: Exception) -> dict:
         out.update(error_kind="absent", absent=exc.absent)
     elif getattr(exc, "frame", None):  # a frame the objects on the table cannot complete
         out.update(error_kind="incomplete", frame=exc.frame)
-    elif type(exc).__name__ == "NoPredicateError":
+    elif any(c.__name__ == "NoPredicateError" for c in type(exc).__mro__):  # by name: no spaCy to import
         out["error_kind"] = "unknown_predicate"
+        if getattr(exc, "predicate", None):  # understood, but no motion for it
+            out["predicate"] = exc.predicate
     return out
 
 
@@ -117,7 +119,7 @@ def _parts(frame: Mapping | Frame) -> tuple[str, dict]:
 def _error(outcome: Mapping, lexicon: Lexicon) -> str:
     kind = outcome.get("error_kind")
     if kind == "unknown_predicate":
-        return _cannot_do(None, lexicon)
+        return _cannot_do(outcome.get("predicate"), lexicon)
     if kind == "absent":
         return f"I see no {outcome['absent']} on the table."  # "no" suits a cup and milk alike
     if kind == "incomplete" and _parts(outcome["frame"])[0] in lexicon.predicates:
@@ -127,7 +129,7 @@ def _error(outcome: Mapping, lexicon: Lexicon) -> str:
 
 def _cannot_do(predicate: str | None, lexicon: Lexicon) -> str:
     """'Sorry, I don't know how to do that. I can blend, brush, ... or sprinkle things.'"""
-    verbs = sorted(lexicon.predicates)
+    verbs = lexicon.hand_written  # what the robot has motions for
     can = ", ".join(verbs[:-1]) + f" or {verbs[-1]}" if len(verbs) > 1 else "".join(verbs)
     return f"Sorry, I don't know how to {predicate or 'do that'}. I can {can} things."
 

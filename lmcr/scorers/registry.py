@@ -65,6 +65,9 @@ def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., 
         from lmcr.lm.score import MixedLM
 
         experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
+        lex = load_lexicon(learned=res.predicates)
+        for _, expert in experts:
+            expert.lex = lex  # the parser's predicates: the eleven and those learned beside the store
         return experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
 
     return build
@@ -91,7 +94,10 @@ def _similar_verbs(res: MethodResources) -> Scorer:
 
     db = store_path(res, "similar_verbs")
     cache = count_cache(res, "similar-verbs", "frame", f"-{NEIGHBOURS}-{MIN_PAIRS}")
-    return SimilarVerbs.cached(db, res.sql_dir, load_lexicon(), res.corpus, res.mixture, cache).score_frames
+    # the eleven's tables: learned predicates are scored by their own counts (`SimilarVerbs.score_frames`)
+    return SimilarVerbs.cached(
+        db, res.sql_dir, load_lexicon(learned=False), res.corpus, res.mixture, cache
+    ).score_frames
 
 
 def _similar_verbs_fingerprint(res: MethodResources) -> str:

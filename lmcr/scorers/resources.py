@@ -33,6 +33,9 @@ class MethodResources:
     seed: int = 0
     mixture: Mixture = Mixture()  # per-corpus weights of the `all` setting (lmcr/scorers/mixture.py)
     context_weight: float = CONTEXT_WEIGHT  # the context term's, chosen with the mixture (scorers/context_pmi.py)
+    # the learned predicate table the parser reads (the LMs score its predicates with its templates);
+    # True: the workspace's, from the environment
+    predicates: Path | bool = True
 
     @property
     def mixed(self) -> bool:
@@ -63,8 +66,9 @@ def store_corpus_hash(db: Path, linearization: str) -> str:
 
 
 def robot_terms() -> set[str]:
-    """The predicates and the detector's object vocabulary: indexed up front by count-based scorers."""
-    lex = load_lexicon()
+    """The hand-written predicates and the detector's object vocabulary: indexed up front by count-based
+    scorers (other terms are counted when first asked for)."""
+    lex = load_lexicon(learned=False)
     return set(lex.predicates) | set(lex.objects)
 
 

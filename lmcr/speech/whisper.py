@@ -83,7 +83,7 @@ def packaged_model(dest: Path) -> Path:
 def prompt_parts(lexicon: Lexicon) -> list[str]:
     """The decoder's previous text in the order it is kept: the predicates and the object names as two
     lists, then requests generated from the lexicon, written as sentences."""
-    verbs = ", ".join(verb.capitalize() for verb in sorted(lexicon.predicates))
+    verbs = ", ".join(verb.capitalize() for verb in lexicon.hand_written)
     requests = [f"{form[0].upper()}{form[1:]}." for form in request_forms(lexicon, PROMPT_REQUESTS, PROMPT_SEED)]
     return [f"{verbs}. {', '.join(sorted(lexicon.objects))}.", *requests]
 

@@ -80,6 +80,18 @@ def _singular(token: Token) -> str:
     return lemma if token.tag_ in NOUN_TAGS and lemma.isalpha() else token.lower_
 
 
+def noun_gerund(token: Token) -> bool:
+    """A gerund that is the last word of a name ("the steak seasoning", "the dish rack drying"): tagged as a
+    verb hung on the noun right before it, with nothing of its own but a particle. Not a verb of the request."""
+    return (
+        token.tag_ == "VBG"
+        and token.dep_ == "acl"
+        and token.head.i == token.i - 1
+        and token.head.tag_.startswith("NN")
+        and all(c.dep_ == "prt" for c in token.children)
+    )
+
+
 def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = None) -> tuple[str, int, int] | None:
     """(value, start_char, end_char) of the argument headed by `token`, or None if it names nothing."""
     head = resolve_head(token, lex)
@@ -101,5 +113,10 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
             break
         parts.insert(0, child)
     start = parts[0].idx if parts else head.idx
+    # "the steak seasoning": a gerund that ends the name is its head word
+    gerund = next((c for c in head.children if noun_gerund(c)), None)
+    if gerund is not None:
+        value = " ".join([p.lower_ for p in parts] + [head.lower_, gerund.lower_])
+        return value, start, gerund.idx + len(gerund)
     value = " ".join([p.lower_ for p in parts] + [_singular(head)])
     return value, start, head.idx + len(head)

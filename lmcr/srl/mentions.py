@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from spacy.tokens import Doc, Span, Token
 
 from lmcr.lexicon import Lexicon, PredicateSpec
-from lmcr.srl.arguments import argument_value, resolve_head
+from lmcr.srl.arguments import argument_value, noun_gerund, resolve_head
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
 
@@ -16,6 +16,11 @@ OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
 NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})
 SKIPPED_LEMMAS = frozenset({"be", "have", "do", "let", "go", "will", "would", "can", "could", "should"})
 PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
+# Adverbs that complete a phrasal verb where the parser calls them adverbs ("put the milk away"); the
+# parser's own particles (dep prt) count whatever the word. English's closed class, not a verb list.
+ADVERB_PARTICLES = frozenset({"away", "back", "aside", "out", "up", "down", "off"})
+# Where only a noun can stand: a word tagged as a verb there is a noun the tagger misread.
+NOUN_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "attr", "appos"})
 
 
 @dataclass
@@ -56,10 +61,48 @@ def predicate_lemma(token: Token, lex: Lexicon) -> str | None:
     """The predicate a verb token evokes, or None if it is no predicate (aux, adjective, noun, copula)."""
     if not token.tag_.startswith("VB") or token.dep_ in NOT_PREDICATE_DEPS or not token.is_alpha:
         return None
+    if _misread_noun(token):
+        return None
     lemma = lemma_of(token)
     if lemma not in lex.predicates and token.lower_ in lex.predicates:
         lemma = token.lower_  # the lemmatiser follows the tagger, which mis-tags imperatives
     return None if lemma in SKIPPED_LEMMAS else lemma
+
+
+def _is_particle(token: Token) -> bool:
+    return token.dep_ == "prt" or token.dep_ == "advmod" and token.lower_ in ADVERB_PARTICLES
+
+
+def _misread_noun(token: Token) -> bool:
+    """A word tagged as a verb where only a noun can stand: an argument ("put the dish rack/VB/dobj away")
+    or the gerund that ends a name ("the steak seasoning")."""
+    return token.tag_.startswith("VB") and (token.dep_ in NOUN_DEPS or noun_gerund(token))
+
+
+def _particle(verb: Token) -> str | None:
+    """The particle of a phrasal verb: the parser's (dep prt) or an adverb of the closed class after the
+    verb ("put the milk away"); also one the parser hung on a noun it read as a verb inside the object
+    ("put the steak seasoning away", "put the dish rack away")."""
+    for child in verb.children:
+        if child.i > verb.i and _is_particle(child):
+            return child.lower_
+    for obj in (c for c in verb.children if c.dep_ in OBJECT_DEPS):
+        for token in obj.subtree:
+            if token.head.i != verb.i and _misread_noun(token.head) and _is_particle(token):
+                return token.lower_
+    return None
+
+
+def predicate_name(verb: Token, lemma: str, lex: Lexicon) -> tuple[str, PredicateSpec | None]:
+    """The predicate a verb names with its particle ("put away") and its spec: a hand-written predicate
+    ignores particles (its own are part of its spec); a phrasal verb the lexicon lacks falls back to its
+    verb's spec; a verb with no spec keeps its phrasal name (a generic frame of the corpus)."""
+    if lemma in lex.predicates and lemma not in lex.learned:
+        return lemma, lex.predicates[lemma]
+    particle = _particle(verb)
+    name = f"{lemma} {particle}" if particle else lemma
+    spec = lex.predicates.get(name) or lex.predicates.get(lemma)
+    return (spec.name if spec else name), spec
 
 
 def _pobj(prep: Token) -> Token | None:
@@ -229,13 +272,13 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
         lemma = predicate_lemma(token, lex)
         if lemma is None:
             continue
-        spec = lex.predicates.get(lemma)
+        name, spec = predicate_name(token, lemma, lex)
         args = _collect(token, lex, spec)
         if not args.objects and not args.preps:
             args.objects = _right_node_object(token)
         frames.append(
             _known_frame(token, spec, args, lex, compounds)
             if spec
-            else _generic_frame(token, lemma, args, lex, compounds)
+            else _generic_frame(token, name, args, lex, compounds)
         )
     return sorted(frames, key=lambda f: f.start)

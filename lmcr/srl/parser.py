@@ -23,7 +23,7 @@ from spacy.tokens import Doc, Span, Token
 from lmcr.errors import LMCRError
 from lmcr.files import read_resource
 from lmcr.jsonl import check_text
-from lmcr.lexicon import Lexicon, load_lexicon
+from lmcr.lexicon import PREDICATES_FILE, Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import LazyLemmas
 from lmcr.srl.mentions import FrameMention, extract_frames
@@ -150,7 +150,7 @@ class FrameParser:
     """Parses text into frames: one spaCy pass, a second pass for misread imperatives, then rules."""
 
     nlp: Language
-    lex: Lexicon = field(default_factory=load_lexicon)
+    lex: Lexicon = field(default_factory=lambda: load_lexicon(learned=False))  # the eleven unless told
     compounds: Compounds | None = None
     priors: RolePriors | None = None
     stats: ParseStats = field(default_factory=ParseStats)
@@ -338,8 +338,8 @@ FIRST_WORDS_FILE = "first_words.json"  # the table the frame build's shards star
 
 
 def load_parser(model: str | None = None, resources: Path | None = None) -> FrameParser:
-    """A parser with the learned compounds, role priors and command first words of `resources` where
-    they exist.
+    """A parser with the learned compounds, role priors, command first words and predicates (the eleven
+    and those learned from the corpus) of `resources` where they exist.
 
     They are built by the frames stage (`lmcr frames`); without them only noun-tagged modifiers
     join a name, a lone object of an alternating verb keeps its syntactic default role, and a first
@@ -350,7 +350,8 @@ def load_parser(model: str | None = None, resources: Path | None = None) -> Fram
         compounds = Compounds.load(resources / COMPOUNDS_FILE)
     if resources is not None and (resources / PRIORS_FILE).exists():
         priors = RolePriors.load(resources / PRIORS_FILE)
-    parser = FrameParser(load_nlp(model), compounds=compounds, priors=priors)
+    learned = resources / PREDICATES_FILE if resources is not None else False
+    parser = FrameParser(load_nlp(model), load_lexicon(learned=learned), compounds=compounds, priors=priors)
     if resources is not None and (resources / FIRST_WORDS_FILE).exists():
         parser.forget_first_words(read_first_words(resources / FIRST_WORDS_FILE))
     return parser
@@ -389,7 +390,18 @@ def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]
 
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
     known = [f for f in frames if f.known]
-    if not known:
-        verbs = ", ".join(sorted(parser.lex.predicates))
-        raise NoPredicateError(f"no known predicate in {text!r}: the robot can {verbs}")
-    return known[0]
+    if known:
+        return known[0]
+    refused = [f.predicate for f in frames if f.predicate in parser.lex.refused]
+    if refused:
+        name, seen = refused[0], parser.lex.refused[refused[0]]
+        raise NoPredicateError(
+            f"no known predicate in {text!r}: the corpora say too little about {name!r} to learn what it needs"
+            f" ({seen:,} frames)"
+        )
+    if parser.lex.learned:
+        raise NoPredicateError(
+            f"no known predicate in {text!r}: none of the {len(parser.lex.predicates):,} verbs the robot learned"
+            " from its corpora (`lmcr predicates` lists them)"
+        )
+    raise NoPredicateError(f"no known predicate in {text!r}: the robot can {', '.join(parser.lex.hand_written)}")

@@ -1,0 +1,325 @@
+"""Predicates learned from the frame corpus: every verb and phrasal verb ("put away", "dispose of") the
+corpora use often enough, with its roles, the prepositions that introduce each, how often each is stated
+(its valence) and the sentence the sentence LM scores for it.
+
+The frame build parses every verb: a verb outside the hand-written lexicon gets a generic frame whose
+slots are its direct object and its prepositional phrases, named by the preposition ("put the milk away
+in the fridge": predicate `put away`, slots object=milk, in=fridge). Learning turns slots into roles:
+
+- English decides which roles a preposition can introduce (`PREP_ROLES`: "with" an Instrument, "into" a
+  Destination, "in" either; "of" the Theme of a prepositional verb, "dispose of it"). That is grammar,
+  the same for every verb, not knowledge of objects.
+- The corpus decides among them, and whether the slot holds things at all: a slot's fillers are compared
+  (cosine of filler counts) with the fillers the eleven robot predicates' roles take in the same corpus.
+  "bake in the oven" reads like heat's Instrument, "put in the bowl" like pour's Destination. Only fillers
+  that role takes count as things: "cut into cubes" names none and is no role here, and "bring to a boil"
+  does not make a boil a place things are brought to.
+- A phrasal verb's counts are smoothed towards its base verb's (`PHRASAL_PRIOR` frames of it), so "put
+  away", seldom said with its place, still knows that putting has a Destination.
+
+A predicate's roles are the Theme and its most often stated other role (its valence: what a request leaves
+missing when unsaid). A verb with fewer than `MIN_FRAMES` frames, or whose best role is stated in under
+`MIN_RATE` of them, is not learned; it is listed with its evidence so that a request using it is refused
+by name. The hand-written predicates keep their entries (the lexicon overrides the learned table).
+
+The table is a resource of the frame build: `predicates.json` beside the other learned SRL resources, and
+the store's `learned_predicates` / `learned_predicate_slots` (which the count model reads through the
+`robot_fillers` view).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter, defaultdict
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import duckdb
+
+from lmcr.files import atomic_path
+from lmcr.lexicon import PREDICATES_FILE, Lexicon
+
+VERSION = 1
+# Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
+PREP_ROLES: dict[str, tuple[str, ...]] = {
+    "into": ("Destination",),
+    "onto": ("Destination",),
+    "to": ("Destination",),
+    "inside": ("Destination", "Instrument"),
+    "in": ("Destination", "Instrument"),
+    "on": ("Destination", "Instrument"),
+    "over": ("Destination",),
+    "under": ("Destination",),
+    "at": ("Destination", "Instrument"),
+    "with": ("Instrument",),
+    "using": ("Instrument",),
+    "from": ("Source",),
+    "off": ("Source",),
+    "of": ("Theme",),
+}
+OBJECT_SLOT = "Theme"  # the generic frame's direct object
+MIN_FRAMES = 20  # frames a verb needs before it is learned
+MIN_RATE = 0.02  # how often its best role must be stated
+MIN_SHARE = 0.2  # share of a slot's fillers that must be things (robot-role fillers) for it to fill a role
+MIN_POOL = 2  # times a word fills a robot role before it counts as a thing
+PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb starts from
+TOP_FILLERS = 300  # fillers per slot compared (the rest carry little of a cosine)
+REFUSED_LISTED = 5  # frames a refused verb needs to be listed with its evidence
+
+
+@dataclass(frozen=True)
+class LearnedPredicate:
+    """One learned predicate: its name ("put away"), base verb and particle, evidence, role rates, which
+    slot fills each role, and the spec the parser and the scorers use."""
+
+    name: str
+    base: str
+    particle: str | None
+    frames: int
+    rates: dict[str, float]  # role -> share of frames stating it (smoothed for phrasal verbs)
+    slots: dict[str, str]  # slot (Theme, or a preposition) -> role
+    roles: tuple[str, str]
+    theme_prep: str | None  # "of" for a prepositional verb ("dispose of")
+    sentence: str
+
+    def spec_json(self) -> dict:
+        """The entry in the lexicon's own format (`lexicon.json`)."""
+        other = self.roles[1]
+        preps = {other: sorted((s for s, r in self.slots.items() if r == other and s != OBJECT_SLOT))}
+        if self.theme_prep:
+            preps["Theme"] = [self.theme_prep]
+        return {
+            "roles": list(self.roles),
+            "object": "Theme",
+            "with": other if self.slots.get("with") == other else None,
+            "preps": preps,
+            "particles": [self.particle] if self.particle else [],
+            "sentence": self.sentence,
+        }
+
+
+@dataclass
+class LearnedTable:
+    """The learned predicates and the verbs refused for too little evidence (name -> frames)."""
+
+    predicates: dict[str, LearnedPredicate] = field(default_factory=dict)
+    refused: dict[str, int] = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {
+            "version": VERSION,
+            "settings": self.settings,
+            "predicates": {
+                name: {**asdict(p), **{"spec": p.spec_json()}} for name, p in sorted(self.predicates.items())
+            },
+            "refused": dict(sorted(self.refused.items())),
+        }
+
+    def save(self, path: Path) -> None:
+        with atomic_path(path) as tmp:
+            tmp.write_text(json.dumps(self.to_json(), indent=1), encoding="utf-8")
+
+
+def _cosine(a: Counter, b: Counter) -> float:
+    dot = sum(n * b[k] for k, n in a.items() if k in b)
+    norm = math.sqrt(sum(n * n for n in a.values())) * math.sqrt(sum(n * n for n in b.values()))
+    return dot / norm if norm else 0.0
+
+
+def _slot_counts(con: duckdb.DuckDBPyConnection) -> tuple[Counter, dict[tuple[str, str], Counter]]:
+    """Frames per generic predicate, and the top fillers of each of its slots that English lets name a role."""
+    frames = Counter(dict(con.execute("select predicate, count(*) from frames where not known group by 1").fetchall()))
+    rows = con.execute(
+        """
+        with filled as (
+            select f.predicate, r.role as slot, r.value, count(*) as n
+            from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no)
+            where not f.known and r.value is not null and r.role in (select unnest($slots))
+            group by all
+        )
+        select predicate, slot, value, n from filled
+        qualify row_number() over (partition by predicate, slot order by n desc, value) <= $top
+        """,
+        {"slots": [OBJECT_SLOT, *PREP_ROLES], "top": TOP_FILLERS},
+    ).fetchall()
+    fillers: dict[tuple[str, str], Counter] = defaultdict(Counter)
+    for predicate, slot, value, n in rows:
+        fillers[(predicate, slot)][value] = n
+    return frames, fillers
+
+
+def _slot_totals(con: duckdb.DuckDBPyConnection) -> Counter:
+    """(predicate, slot) -> frames stating it, over all fillers."""
+    rows = con.execute(
+        "select f.predicate, r.role, count(*)"
+        " from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no)"
+        " where not f.known and r.value is not null group by all"
+    ).fetchall()
+    return Counter({(p, s): n for p, s, n in rows})
+
+
+def _role_pools(con: duckdb.DuckDBPyConnection) -> dict[str, Counter]:
+    """What each role of the robot predicates is filled with in the corpus ('any': every role)."""
+    pools: dict[str, Counter] = defaultdict(Counter)
+    for role, value, n in con.execute(
+        "select r.role, r.value, count(*) from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no)"
+        " where f.known and r.value is not null group by all"
+    ).fetchall():
+        pools[role][value] += n
+        pools["any"][value] += n
+    return pools
+
+
+def _label(slot: str, fillers: Counter, total: int, pools: dict[str, Counter], min_share: float) -> tuple[str, float]:
+    """The role a slot fills and how many of its frames name a thing in it: the object is the Theme; a
+    preposition's candidate roles (`PREP_ROLES`) are decided by whose fillers it shares (cosine), and only
+    fillers that role takes in the robot frames count as things ("cut into cubes" names none). A slot whose
+    things are under `min_share` of it fills no role ("", 0)."""
+    if slot == OBJECT_SLOT:
+        return "Theme", float(total)
+    candidates = PREP_ROLES[slot]
+    role = max(candidates, key=lambda r: (_cosine(fillers, pools[r]), -candidates.index(r)))
+    things = sum(n for value, n in fillers.items() if pools[role][value] >= MIN_POOL)
+    return (role, float(things)) if total and things / total >= min_share else ("", 0.0)
+
+
+def _split(name: str) -> tuple[str, str | None]:
+    base, _, particle = name.partition(" ")
+    return base, particle or None
+
+
+def learn_predicates(
+    con: duckdb.DuckDBPyConnection,
+    lex: Lexicon,
+    min_frames: int = MIN_FRAMES,
+    min_rate: float = MIN_RATE,
+    min_share: float = MIN_SHARE,
+) -> LearnedTable:
+    """The learned table of the store's frame corpus (see the module's docstring)."""
+    frames, fillers = _slot_counts(con)
+    totals, pools = _slot_totals(con), _role_pools(con)
+    labelled = {key: _label(key[1], counter, totals[key], pools, min_share) for key, counter in fillers.items()}
+    slots_of: dict[str, dict[str, str]] = defaultdict(dict)
+    for (predicate, slot), (role, _) in labelled.items():
+        if role:
+            slots_of[predicate][slot] = role
+    raw_rates: dict[str, Counter] = defaultdict(Counter)
+    for (predicate, _slot), (role, things) in labelled.items():
+        if role and frames[predicate]:
+            raw_rates[predicate][role] += things / frames[predicate]
+    table = LearnedTable(
+        settings={
+            "min_frames": min_frames,
+            "min_rate": min_rate,
+            "min_share": min_share,
+            "phrasal_prior": PHRASAL_PRIOR,
+        }
+    )
+    for name, n in frames.items():
+        base, particle = _split(name)
+        if name in lex.predicates or base in lex.predicates:
+            continue  # the hand-written lexicon wins
+        rates = _smoothed(raw_rates[name], n, raw_rates.get(base) if particle else None)
+        learned = _predicate(name, n, rates, dict(sorted(slots_of[name].items())), totals, min_rate)
+        if n >= min_frames and learned is not None:
+            table.predicates[name] = learned
+        elif n >= REFUSED_LISTED:
+            table.refused[name] = n
+    return table
+
+
+def _smoothed(own: Counter, n: int, base: Counter | None) -> dict[str, float]:
+    """A verb's role rates; a phrasal verb's pulled towards its base verb's by PHRASAL_PRIOR frames."""
+    if base is None:
+        return dict(own)
+    roles = set(own) | set(base)
+    return {r: (own[r] * n + base[r] * PHRASAL_PRIOR) / (n + PHRASAL_PRIOR) for r in roles}
+
+
+def _predicate(
+    name: str, n: int, rates: dict[str, float], slots: dict[str, str], totals: Counter, min_rate: float
+) -> LearnedPredicate | None:
+    """The predicate of a verb's evidence, or None when no role besides the Theme is stated often enough."""
+    base, particle = _split(name)
+    others = {r: v for r, v in rates.items() if r != "Theme"}
+    if not others:
+        return None
+    role = max(sorted(others), key=lambda r: others[r])
+    if others[role] < min_rate:
+        return None
+    # A prepositional verb: its "of" phrase, more usual than a direct object, is the Theme ("dispose of it").
+    theme_prep = "of" if totals[(name, "of")] > totals[(name, OBJECT_SLOT)] and slots.get("of") == "Theme" else None
+    preps = sorted((s for s, r in slots.items() if r == role), key=lambda s: -totals[(name, s)])
+    if not preps:  # the role comes from the base verb alone: its most usual preposition for it
+        preps = [next(p for p in PREP_ROLES if role in PREP_ROLES[p])]
+    theme = f"{theme_prep} {{Theme}}" if theme_prep else "{Theme}"
+    middle = f" {particle}" if particle else ""
+    sentence = f"{base} {theme}{middle} {preps[0]} the {{{role}}}"
+    if theme_prep:
+        sentence = f"{base}{middle} {theme} {preps[0]} the {{{role}}}"
+    return LearnedPredicate(
+        name=name,
+        base=base,
+        particle=particle,
+        frames=n,
+        rates={r: round(v, 4) for r, v in sorted(rates.items())},
+        slots=dict(sorted(slots.items())),
+        roles=("Theme", role),
+        theme_prep=theme_prep,
+        sentence=sentence,
+    )
+
+
+def publish_predicates(con: duckdb.DuckDBPyConnection, table: LearnedTable, path: Path, build: str) -> None:
+    """The learned table into the store (one transaction: the tables and the count view change together)
+    and `path` (written under a temporary name, then renamed)."""
+    from lmcr.store import transaction
+
+    with transaction(con):
+        con.execute("delete from learned_predicate_slots")
+        con.execute("delete from learned_predicates")
+        rows = [
+            (
+                p.name,
+                p.base,
+                p.particle,
+                p.frames,
+                *p.roles,
+                p.rates.get(p.roles[1], 0.0),
+                p.theme_prep,
+                p.sentence,
+                build,
+            )
+            for p in table.predicates.values()
+        ]
+        slots = [(p.name, s, role) for p in table.predicates.values() for s, role in p.slots.items() if role in p.roles]
+        if rows:  # DuckDB's executemany refuses an empty list
+            con.executemany("insert into learned_predicates values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", rows)
+        if slots:
+            con.executemany("insert into learned_predicate_slots values (?, ?, ?)", slots)
+    table.settings["build"] = build
+    table.save(path)
+
+
+def learned_build(path: Path) -> str | None:
+    """The frame build a saved table was learned from (None when there is none, or of another version)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data.get("settings", {}).get("build") if data.get("version") == VERSION else None
+
+
+def refresh_predicates(
+    con: duckdb.DuckDBPyConnection, lex: Lexicon, srl_dir: Path, build: str | None, force: bool = False
+) -> LearnedTable | None:
+    """Learn and publish the table when the frame build `build` has none yet (or `force`); None when it
+    was up to date or there is no build."""
+    path = srl_dir / PREDICATES_FILE
+    if build is None or not force and learned_build(path) == build:
+        return None
+    table = learn_predicates(con, lex)
+    publish_predicates(con, table, path, build)
+    return table

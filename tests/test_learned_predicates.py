@@ -1,0 +1,226 @@
+"""Predicates learned from the frame corpus: roles from prepositions and fillers, valence, phrasal verbs,
+prepositional verbs, refusal for too little evidence, the published table, and the parser and the count
+model using it. A tiny store built by hand; no spaCy model needed except where a test says so."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from lmcr.frame import Frame
+from lmcr.frame_corpus.predicates import MIN_FRAMES, learn_predicates, publish_predicates, refresh_predicates
+from lmcr.lexicon import PREDICATES_FILE, load_lexicon
+from lmcr.scorers.frame_counts import FrameCountScorer
+from lmcr.store import connect
+from lmcr.workspace import Workspace
+
+SQL = Workspace.from_env().sql_dir
+HAND = load_lexicon(learned=False)
+
+
+def _frame(rows: list, roles: list, predicate: str, slots: dict[str, str], known: bool = False) -> None:
+    key = ("household", f"d{len(rows)}", 0, 0)
+    rows.append((*key, predicate, known))
+    roles += [(*key, slot, value) for slot, value in slots.items()]
+
+
+def _store(tmp_path, frames: list[tuple[str, dict, bool]]):
+    con = connect(tmp_path / "lmcr.duckdb", SQL)
+    rows, roles = [], []
+    for predicate, slots, known in frames:
+        _frame(rows, roles, predicate, slots, known)
+    con.executemany(
+        "insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
+        "values (?, ?, ?, ?, ?, ?, 0, 1)",
+        rows,
+    )
+    con.executemany(
+        "insert into frame_roles (corpus, doc_id, sent_id, frame_no, role, value) values (?, ?, ?, ?, ?, ?)", roles
+    )
+    return con
+
+
+def _kitchen() -> list[tuple[str, dict, bool]]:
+    """Robot frames that say what containers and appliances are, and generic frames of four verbs."""
+    robot = [("pour", {"Theme": "milk", "Destination": "bowl"}, True)] * 30
+    robot += [("pour", {"Theme": "water", "Destination": "glass"}, True)] * 20
+    robot += [("heat", {"Theme": "soup", "Instrument": "microwave"}, True)] * 20
+    robot += [("heat", {"Theme": "oil", "Instrument": "oven"}, True)] * 20
+    generic = [("put", {"Theme": "milk", "in": "bowl"}, False)] * 25
+    generic += [("put", {"Theme": "cup", "in": "glass"}, False)] * 5
+    generic += [("put away", {"Theme": "milk"}, False)] * 30  # seldom says where: the base verb does
+    generic += [("bake", {"Theme": "cake", "in": "oven"}, False)] * 20
+    generic += [("bake", {"Theme": "bread", "in": "microwave"}, False)] * 5
+    generic += [("cut", {"Theme": "bread", "into": "cube"}, False)] * 30  # no thing: no role
+    generic += [("dispose", {"of": "milk", "in": "bowl"}, False)] * 25
+    generic += [("juggle", {"Theme": "egg", "in": "bowl"}, False)] * 3  # too little evidence
+    return robot + generic
+
+
+def test_roles_come_from_prepositions_and_the_robot_roles_fillers(tmp_path):
+    table = learn_predicates(_store(tmp_path, _kitchen()), HAND)
+    put, bake = table.predicates["put"], table.predicates["bake"]
+    # "put in the bowl" reads like pour's Destination, "bake in the oven" like heat's Instrument
+    assert put.roles == ("Theme", "Destination") and put.slots == {"Theme": "Theme", "in": "Destination"}
+    assert bake.roles == ("Theme", "Instrument") and bake.sentence == "bake {Theme} in the {Instrument}"
+    assert put.sentence == "put {Theme} in the {Destination}"
+    # "cut into cubes": no thing fills it, so cut states no role but its Theme and is not learned
+    assert "cut" not in table.predicates and table.refused["cut"] == 30
+    assert "juggle" not in table.refused and "juggle" not in table.predicates  # under 5 frames: not listed
+
+
+def test_a_phrasal_verb_takes_its_base_verbs_valence_and_a_prepositional_verb_its_theme(tmp_path):
+    table = learn_predicates(_store(tmp_path, _kitchen()), HAND)
+    away = table.predicates["put away"]
+    assert (away.base, away.particle, away.roles) == ("put", "away", ("Theme", "Destination"))
+    assert 0 < away.rates["Destination"] < table.predicates["put"].rates["Destination"]
+    assert away.sentence == "put {Theme} away into the {Destination}"
+    dispose = table.predicates["dispose"]
+    assert dispose.theme_prep == "of" and dispose.sentence == "dispose of {Theme} in the {Destination}"
+    assert dispose.spec_json()["preps"] == {"Destination": ["in"], "Theme": ["of"]}
+
+
+def test_the_hand_written_eleven_are_never_learned_and_evidence_bounds_what_is(tmp_path):
+    con = _store(tmp_path, _kitchen() + [("pour", {"Theme": "milk", "in": "bowl"}, False)] * 40)
+    table = learn_predicates(con, HAND)
+    assert not set(table.predicates) & set(HAND.predicates)
+    assert MIN_FRAMES > 3 and "juggle" not in table.predicates
+    strict = learn_predicates(con, HAND, min_frames=26)
+    assert "put" in strict.predicates and "bake" not in strict.predicates and strict.refused["bake"] == 25
+
+
+def test_the_published_table_merges_into_the_lexicon_and_the_count_model(tmp_path):
+    con = _store(tmp_path, _kitchen())
+    srl = tmp_path / "srl"
+    srl.mkdir()
+    assert refresh_predicates(con, HAND, srl, "build-1") is not None
+    assert refresh_predicates(con, HAND, srl, "build-1") is None  # up to date: not learned again
+    assert refresh_predicates(con, HAND, srl, "build-2") is not None
+    lex = load_lexicon(learned=srl / PREDICATES_FILE)
+    assert lex.learned == {"put", "put away", "bake", "dispose"}
+    assert lex.hand_written == sorted(HAND.predicates) and lex.predicates["pour"] == HAND.predicates["pour"]
+    assert lex.predicates["put away"].particles == {"away"} and lex.refused == {"cut": 30}
+    rows = con.execute("select predicate, role2, build from learned_predicates order by 1").fetchall()
+    assert rows[0] == ("bake", "Instrument", "build-2")
+    con.close()
+    counts = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL)
+    # the learned predicate's "in" slot is counted as its Destination, beside the eleven's roles
+    assert counts.filler[("put", "Destination", "bowl")] == 25 and counts.filler[("pour", "Destination", "bowl")] == 30
+    bowl, glass = (Frame.of("put", {"Theme": "milk", "Destination": d}) for d in ("bowl", "glass"))
+    assert counts.score_frame(bowl) > counts.score_frame(glass)
+
+
+def test_a_republished_table_replaces_the_old_one_whole(tmp_path):
+    con = _store(tmp_path, _kitchen())
+    path = tmp_path / PREDICATES_FILE
+    publish_predicates(con, learn_predicates(con, HAND), path, "b1")
+    publish_predicates(con, learn_predicates(con, HAND, min_frames=10_000), path, "b2")
+    assert con.execute("select count(*) from learned_predicates").fetchone() == (0,)
+    assert con.execute("select count(*) from learned_predicate_slots").fetchone() == (0,)
+    saved = json.loads(path.read_text())
+    assert saved["predicates"] == {} and saved["settings"]["build"] == "b2"
+
+
+def test_a_broken_table_is_one_line_naming_it(tmp_path):
+    from lmcr.errors import LMCRError
+
+    path = tmp_path / PREDICATES_FILE
+    path.write_text(json.dumps({"predicates": {"put": {"spec": {"roles": ["Theme"]}}}}))
+    with pytest.raises(LMCRError, match=f"{path}: cannot read the learned predicate table"):
+        load_lexicon(learned=path)
+
+
+@pytest.fixture(scope="module")
+def learned_parser(tmp_path_factory):
+    """The real parser with the table learned from `_kitchen` (put, put away, bake, dispose; cut refused)."""
+    from lmcr.srl.parser import FrameParser, load_nlp
+
+    tmp = tmp_path_factory.mktemp("learned")
+    con = _store(tmp, _kitchen())
+    publish_predicates(con, learn_predicates(con, HAND), tmp / PREDICATES_FILE, "b")
+    con.close()
+    return FrameParser(load_nlp(), load_lexicon(learned=tmp / PREDICATES_FILE))
+
+
+def _prefer(*order: str):
+    return lambda frames, context="": [
+        -min(order.index(v) if v in order else 99 for v in r.values()) for _, r in frames
+    ]
+
+
+@pytest.mark.model
+@pytest.mark.parametrize(
+    "instruction, predicate, roles",
+    [
+        ("put the milk away", "put away", {"Theme": "milk", "Destination": None}),
+        ("could you put away the milk?", "put away", {"Theme": "milk", "Destination": None}),
+        ("please put the steak seasoning away", "put away", {"Theme": "steak seasoning", "Destination": None}),
+        ("put the milk in the bowl", "put", {"Theme": "milk", "Destination": "bowl"}),
+        ("dispose of it in the bowl", "dispose", {"Theme": "it", "Destination": "bowl"}),
+        ("bake the cake", "bake", {"Theme": "cake", "Instrument": None}),
+        ("pour me some water", "pour", {"Theme": "water", "Destination": None}),  # the eleven unchanged
+    ],
+)
+def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, instruction, predicate, roles):
+    from lmcr.srl.parser import parse_instruction
+
+    frame = parse_instruction(learned_parser, instruction)
+    assert (frame.predicate, frame.roles) == (predicate, roles)
+
+
+@pytest.mark.model
+def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_parser):
+    from lmcr.complete import CompletionConfig, complete
+
+    out = complete(learned_parser, _prefer("fridge", "bowl"), "put the milk away", ["milk", "bowl", "fridge", "oven"])
+    assert out.frame.to_json() == {"predicate": "put away", "roles": {"Theme": "milk", "Destination": "fridge"}}
+    assert out.missing_roles == ("Destination",) and out.prediction_set == ("fridge",)
+    close = complete(
+        learned_parser,
+        lambda f, c="": [0.0] * len(f),
+        "bake the cake",
+        ["cake", "oven", "microwave"],
+        CompletionConfig(),
+    )
+    assert close.question == "Should I bake cake in the oven or the microwave?"
+    # a pronoun Theme and the Destination both open: pairs are scored, as for "pour it"
+    both = complete(learned_parser, _prefer("peel", "bowl"), "dispose of it", ["peel", "bowl"])
+    assert both.missing_roles == ("Theme", "Destination") and both.frame.role_map == {
+        "Theme": "peel",
+        "Destination": "bowl",
+    }
+
+
+@pytest.mark.model
+def test_a_verb_with_too_little_evidence_is_refused_by_name(learned_parser):
+    from lmcr.srl.parser import NoPredicateError, parse_instruction
+
+    with pytest.raises(NoPredicateError, match=r"say too little about 'cut' to learn what it needs \(30 frames\)"):
+        parse_instruction(learned_parser, "cut the bread")
+    with pytest.raises(NoPredicateError, match="none of the 15 verbs the robot learned"):
+        parse_instruction(learned_parser, "sing a song")
+
+
+def test_the_predicates_command_reports_coverage_and_one_predicate(tmp_path, monkeypatch):
+    from typer.testing import CliRunner
+
+    from lmcr.cli import app
+
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    con = _store(tmp_path, _kitchen())
+    con.execute("insert into frame_builds values ('b1', 'instruction', 1, 1, 1, 1, 1, 0, 0, 1.0, 1.0, now())")
+    con.close()
+    runner = CliRunner()
+    listed = runner.invoke(app, ["predicates"])
+    assert listed.exit_code == 0, listed.output
+    assert "4 learned, 1 verbs refused" in listed.output and "put away" in listed.output
+    assert (tmp_path / "srl" / PREDICATES_FILE).exists()
+    one = runner.invoke(app, ["predicates", "Put  Away"])
+    assert one.exit_code == 0 and "put {Theme} away into the {Destination}" in one.output
+    assert "refused, 30 frames" in runner.invoke(app, ["predicates", "cut"]).output
+    unknown = runner.invoke(app, ["predicates", "juggle"])
+    assert unknown.exit_code == 1 and "error: no predicate 'juggle'" in unknown.output
+    empty = tmp_path / "empty"
+    monkeypatch.setenv("LMCR_DATA_DIR", str(empty))
+    assert "no store yet" in runner.invoke(app, ["predicates"]).output and not empty.exists()
