@@ -130,10 +130,11 @@ def softmax(scores: list[float], temperature: float) -> list[float]:
     return [w / total for w in weights]
 
 
-def _candidate_frames(missing: list[str], objects: list[str]) -> list[dict[str, str]]:
-    """One filling per object (or ordered object pair) for the missing roles."""
+def _candidate_frames(missing: list[str], objects: list[str], open_roles: tuple[str, ...] = ()) -> list[dict[str, str]]:
+    """One filling per object (or ordered object pair) for the missing roles; one missing role that may be
+    any of `open_roles` gets a filling per role and object."""
     if len(missing) == 1:
-        return [{missing[0]: o} for o in objects]
+        return [{role: o} for role in open_roles or missing for o in objects]
     return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
 
 
@@ -168,7 +169,7 @@ def _served(
     obj = vessel and _grounded(vessel, set(detected))
     if not obj or obj in frame.roles.values() or obj in taken.values():
         return {}
-    template = parser.lex.predicates[frame.predicate].sentence
+    template = parser.lex.predicates[frame.predicate].template(frame.roles)
     into = [r for r, v in frame.roles.items() if v is None and r not in taken and f"into the {{{r}}}" in template]
     return {into[0]: obj} if into else {}
 
@@ -187,18 +188,21 @@ def _ground(
     return grounded, unresolved
 
 
-def _question(template: str, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
+def _question(spec, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
     """'Should I pour milk into the bowl, the glass or the plate?': the predicate's sentence template with
-    the choices in the missing slot (one missing role), or one filled template per choice (two)."""
+    the choices in the missing slot (one missing role, the same for every choice), or one filled template
+    per choice (two roles, or choices that fill different roles: "cut bread with the knife or cut bread
+    into the bowl")."""
 
     def either(items: list[str]) -> str:
         return ", ".join(items[:-1]) + f" or {items[-1]}" if len(items) > 1 else items[0]
 
-    if len(missing) == 1:
-        role = missing[0]
+    filled = [_filled(roles, c.objects) for c in choices]
+    if len(missing) == 1 and all(missing[0] in c.objects for c in choices):
+        role, template = missing[0], spec.template(filled[0])
         slot = template.replace(f"the {{{role}}}", f"{{{role}}}")  # each choice brings its own "the"
         return "Should I " + slot.format(**{**roles, role: either([f"the {c.objects[role]}" for c in choices])}) + "?"
-    return "Should I " + either([template.format(**{**roles, **c.objects}) for c in choices]) + "?"
+    return "Should I " + either([spec.template(f).format(**f) for f in filled]) + "?"
 
 
 def complete(
@@ -250,27 +254,53 @@ def complete(
     missing = [r for r, v in roles.items() if v is None]
     if not missing:
         return replace(read, frame=Frame.of(frame.predicate, roles), instances=_instances(roles, ids_of))
+    spec = parser.lex.predicates[frame.predicate]
     pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
-    fillings = _candidate_frames(missing, pool)
-    scores = scorer([Frame.of(frame.predicate, {**roles, **f}) for f in fillings], context)
+    fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing))
+    scores = scorer([Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], context)
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
     candidates = tuple(
-        Candidate(f[missing[0]], f, round(s, 4), round(p, 4), tuple(ids_of[f[missing[0]]]))
+        Candidate(_first(f), f, round(s, 4), round(p, 4), tuple(ids_of[_first(f)]))
         for f, s, p in ranked[: len(ranked) if len(missing) == 1 else config.max_listed]
     )
-    chosen = {**roles, **candidates[0].objects}
+    chosen = _filled(roles, candidates[0].objects)
     in_set = [c for c in candidates if c.probability >= config.set_threshold]
-    template = parser.lex.predicates[frame.predicate].sentence
+    missing = [r for r in chosen if r not in roles or roles[r] is None]  # the role the objects chose
     return replace(
         read,
         frame=Frame.of(frame.predicate, chosen),
         missing_roles=tuple(missing),
         candidates=candidates,
-        question=_ask(template, roles, missing, read, candidates, in_set, config.max_choices),
+        question=_ask(spec, roles, missing, read, candidates, in_set, config.max_choices),
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )
+
+
+def _open_roles(spec, roles: dict[str, str | None], missing: list[str]) -> tuple[str, ...]:
+    """The roles one missing role may be: a learned predicate's open roles when its second role is the
+    missing one ("cut the bread": into the bowl, or with the knife), else just that role."""
+    if len(missing) == 1 and spec.alternatives and missing[0] == spec.roles[1]:
+        return spec.open_roles
+    return tuple(missing)
+
+
+def _filled(roles: dict[str, str | None], filling: dict[str, str]) -> dict[str, str]:
+    """The roles with a filling, in the frame's order: an alternative open role stands in the place of the
+    missing role it replaces ("cut the bread": Theme, then Instrument instead of Destination)."""
+    rest, out = dict(filling), {}
+    for role, value in roles.items():
+        if value is not None:
+            out[role] = value
+        elif rest:
+            chosen = role if role in rest else next(iter(rest))
+            out[chosen] = rest.pop(chosen)
+    return out
+
+
+def _first(filling: dict[str, str]) -> str:
+    return next(iter(filling.values()))
 
 
 def _pool(
@@ -304,7 +334,7 @@ def _pool(
 
 
 def _ask(
-    template: str,
+    spec,
     roles: dict[str, str | None],
     missing: list[str],
     read: Completion,
@@ -322,7 +352,7 @@ def _ask(
     # One likely object is confirmed alone, unless it stands for a word we replaced: then offer others.
     one = len(in_set) == 1 and not read.unresolved
     choices = (in_set if len(in_set) > 1 or one else list(candidates))[: max(max_choices, 2)]
-    question = _question(template, roles, missing, choices)
+    question = _question(spec, roles, missing, choices)
     if read.unresolved:
         return f"I see no {' or '.join(read.unresolved.values())}. {question}"
     return question

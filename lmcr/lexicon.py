@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
@@ -46,6 +47,28 @@ class PredicateSpec:
     alternating: bool
     sentence: str  # "pour {Theme} into the {Destination}": the sentence-LM linearisation
     past: str | None = None  # the verb's simple past where it is irregular ("put"); else English's regular rule
+    # a learned predicate's other open roles: role -> its sentence ("cut {Theme} with the {Instrument}" beside
+    # "cut {Theme} into the {Destination}"); a request states one of them, or completion lets the objects choose
+    alternatives: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def open_roles(self) -> tuple[str, ...]:
+        """The roles besides the object role a frame of it can have: its second role, then the alternatives."""
+        return (self.other(self.object_role), *self.alternatives)
+
+    def roles_for(self, stated: Iterable[str]) -> tuple[str, str]:
+        """The two roles of a frame whose prepositional phrases use `stated` prepositions: the spec's, unless
+        only an alternative role is stated ("cut the bread with a knife": Theme, Instrument)."""
+        found = [self.prep_role(p) for p in stated]
+        if self.roles[1] in found or not self.alternatives:
+            return self.roles
+        alternative = next((r for r in found if r in self.alternatives), None)
+        return (self.roles[0], alternative) if alternative else self.roles
+
+    def template(self, roles: Iterable[str]) -> str:
+        """The sentence for a frame with these roles (an alternative role's own, else the spec's)."""
+        other = next((r for r in roles if r in self.alternatives), None)
+        return self.alternatives[other] if other else self.sentence
 
     def prep_role(self, prep: str) -> str | None:
         """The role a prepositional phrase headed by `prep` fills, if any."""
@@ -95,6 +118,7 @@ def _spec(name: str, spec: dict) -> PredicateSpec:
         alternating=bool(spec.get("alternating")),
         sentence=spec["sentence"],
         past=spec.get("past"),
+        alternatives=dict(spec.get("alternatives") or {}),
     )
 
 

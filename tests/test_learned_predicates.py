@@ -55,6 +55,9 @@ def _kitchen() -> list[tuple[str, dict, bool]]:
     generic += [("cut", {"Theme": "bread", "into": "cube"}, False)] * 30  # no thing: no role
     generic += [("dispose", {"of": "milk", "in": "bowl"}, False)] * 25
     generic += [("juggle", {"Theme": "egg", "in": "bowl"}, False)] * 3  # too little evidence
+    # warmed in the microwave mostly, sometimes into a bowl: two open roles
+    generic += [("warm", {"Theme": "soup", "in": "microwave"}, False)] * 20
+    generic += [("warm", {"Theme": "milk", "into": "glass"}, False)] * 10
     return robot + generic
 
 
@@ -81,6 +84,16 @@ def test_a_phrasal_verb_takes_its_base_verbs_valence_and_a_prepositional_verb_it
     assert dispose.spec_json()["preps"] == {"Destination": ["in"], "Theme": ["of"]}
 
 
+def test_a_verb_with_two_open_roles_keeps_both_with_their_sentences(tmp_path):
+    warm = learn_predicates(_store(tmp_path, _kitchen()), HAND).predicates["warm"]
+    assert warm.roles == ("Theme", "Instrument") and warm.alternatives == {
+        "Destination": "warm {Theme} into the {Destination}"
+    }
+    spec = warm.spec_json()
+    assert spec["preps"] == {"Instrument": ["in"], "Destination": ["into"]}
+    assert warm.rates == {"Theme": 1.0, "Instrument": 0.6667, "Destination": 0.3333}
+
+
 def test_the_hand_written_eleven_are_never_learned_and_evidence_bounds_what_is(tmp_path):
     con = _store(tmp_path, _kitchen() + [("pour", {"Theme": "milk", "in": "bowl"}, False)] * 40)
     table = learn_predicates(con, HAND)
@@ -98,7 +111,7 @@ def test_the_published_table_merges_into_the_lexicon_and_the_count_model(tmp_pat
     assert refresh_predicates(con, HAND, srl, "build-1") is None  # up to date: not learned again
     assert refresh_predicates(con, HAND, srl, "build-2") is not None
     lex = load_lexicon(learned=srl / PREDICATES_FILE)
-    assert lex.learned == {"put", "put away", "bake", "dispose"}
+    assert lex.learned == {"put", "put away", "bake", "dispose", "warm"}
     assert lex.hand_written == sorted(HAND.predicates) and lex.predicates["pour"] == HAND.predicates["pour"]
     assert lex.predicates["put away"].particles == {"away"} and lex.refused == {"cut": 30}
     rows = con.execute("select predicate, role2, build from learned_predicates order by 1").fetchall()
@@ -160,6 +173,8 @@ def _prefer(*order: str):
         ("dispose of it in the bowl", "dispose", {"Theme": "it", "Destination": "bowl"}),
         ("bake the cake", "bake", {"Theme": "cake", "Instrument": None}),
         ("pour me some water", "pour", {"Theme": "water", "Destination": None}),  # the eleven unchanged
+        ("warm the milk into a glass", "warm", {"Theme": "milk", "Destination": "glass"}),  # the stated role
+        ("warm the soup", "warm", {"Theme": "soup", "Instrument": None}),
     ],
 )
 def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, instruction, predicate, roles):
@@ -193,12 +208,33 @@ def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_par
 
 
 @pytest.mark.model
+def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parser):
+    from lmcr.complete import complete
+
+    likes = {("Destination", "glass"): 2.0, ("Instrument", "microwave"): 1.0}  # a stand-in that reads roles
+
+    def by_role(frames, context=""):
+        return [sum(likes.get(pair, 0.0) for pair in f.roles) for f in frames]
+
+    into = complete(learned_parser, by_role, "warm the soup", ["soup", "microwave", "glass"])
+    assert into.frame.to_json() == {"predicate": "warm", "roles": {"Theme": "soup", "Destination": "glass"}}
+    assert into.missing_roles == ("Destination",)
+    assert [(c.object, c.objects) for c in into.candidates[:2]] == [
+        ("glass", {"Destination": "glass"}),
+        ("microwave", {"Instrument": "microwave"}),
+    ]
+    even = complete(learned_parser, lambda f, c="": [0.0] * len(f), "warm the soup", ["soup", "microwave"])
+    assert even.question == "Should I warm soup in the microwave or warm soup into the microwave?"
+    assert even.to_json()["frame"]["roles"] == {"Theme": "soup", "Instrument": "microwave"}
+
+
+@pytest.mark.model
 def test_a_verb_with_too_little_evidence_is_refused_by_name(learned_parser):
     from lmcr.srl.parser import NoPredicateError, parse_instruction
 
     with pytest.raises(NoPredicateError, match=r"say too little about 'cut' to learn what it needs \(30 frames\)"):
         parse_instruction(learned_parser, "cut the bread")
-    with pytest.raises(NoPredicateError, match="none of the 15 verbs the robot learned"):
+    with pytest.raises(NoPredicateError, match="none of the 16 verbs the robot learned"):
         parse_instruction(learned_parser, "sing a song")
 
 
@@ -214,7 +250,7 @@ def test_the_predicates_command_reports_coverage_and_one_predicate(tmp_path, mon
     runner = CliRunner()
     listed = runner.invoke(app, ["predicates"])
     assert listed.exit_code == 0, listed.output
-    assert "4 learned, 1 verbs refused" in listed.output and "put away" in listed.output
+    assert "5 learned, 1 verbs refused" in listed.output and "put away" in listed.output
     assert (tmp_path / "srl" / PREDICATES_FILE).exists()
     one = runner.invoke(app, ["predicates", "Put  Away"])
     assert one.exit_code == 0 and "put {Theme} away into the {Destination}" in one.output
@@ -224,3 +260,24 @@ def test_the_predicates_command_reports_coverage_and_one_predicate(tmp_path, mon
     empty = tmp_path / "empty"
     monkeypatch.setenv("LMCR_DATA_DIR", str(empty))
     assert "no store yet" in runner.invoke(app, ["predicates"]).output and not empty.exists()
+
+
+def test_rating_tasks_can_ask_about_a_learned_predicate(tmp_path, monkeypatch):
+    from lmcr.annotate.tasks import HitBatchError, corpus_frames, protocol_frames, render
+
+    monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
+    con = _store(tmp_path, _kitchen())
+    refresh_predicates(con, HAND, tmp_path / "srl", "b1")
+    frames = protocol_frames(0, 1, ("put away",))
+    assert frames and {f.predicate for f in frames} == {"put away"}
+    assert {tuple(r for r, _ in f.roles) for f in frames} == {("Theme", "Destination"), ("Destination", "Theme")}
+    assert render(frames[0]).startswith("Put the ") and " away into the " in render(frames[0])
+    # from the corpus: the learned predicate's frames with both roles stated, its slots named by role
+    found = sorted(corpus_frames(con, 10, 0, ("put",)), key=lambda f: f.roles)
+    assert found == [
+        Frame("put", (("Destination", "bowl"), ("Theme", "milk"))),
+        Frame("put", (("Destination", "glass"), ("Theme", "cup"))),
+    ]
+    assert {f.predicate for f in protocol_frames(0, 1)} == set(HAND.predicates)  # default: the eleven
+    with pytest.raises(HitBatchError, match="unknown predicate 'juggle'"):
+        protocol_frames(0, 1, ("juggle",))

@@ -50,6 +50,8 @@ class TaskConfig:
     n_frames: int | None = None  # corpus / disagreement: how many frames (default: all protocol frames)
     seed: int = 0
     batch: str = "batch"
+    # the predicates asked about: the hand-written eleven by default, or any learned ones ("put away")
+    verbs: tuple[str, ...] = ()
 
 
 def render(frame: Frame) -> str:
@@ -60,25 +62,35 @@ def render(frame: Frame) -> str:
     return text[0].upper() + text[1:] + "."
 
 
-def protocol_frames(seed: int, fixed_per_role: int) -> list[Frame]:
+def task_verbs(verbs: tuple[str, ...] = ()) -> list[str]:
+    """The predicates a batch asks about: `verbs` (each a hand-written or learned predicate, else
+    HitBatchError naming it), or the hand-written eleven."""
+    lex = load_lexicon()
+    unknown = [v for v in verbs if v not in lex.predicates]
+    if unknown:
+        raise HitBatchError(f"unknown predicate {unknown[0]!r}: not hand-written, and not learned (`lmcr predicates`)")
+    return sorted(verbs) or lex.hand_written
+
+
+def protocol_frames(seed: int, fixed_per_role: int, verbs: tuple[str, ...] = ()) -> list[Frame]:
     lex = load_lexicon()
     rng = random.Random(seed)
     frames = []
-    for verb, spec in sorted((v, lex.predicates[v]) for v in lex.hand_written):
+    for verb, spec in ((v, lex.predicates[v]) for v in task_verbs(verbs)):
         for role in spec.roles:
             for fixed in rng.sample(lex.objects, fixed_per_role):
                 frames += [Frame.of(verb, {role: fixed, spec.other(role): o}) for o in lex.objects if o != fixed]
     return frames
 
 
-def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int) -> list[Frame]:
+def corpus_frames(con: duckdb.DuckDBPyConnection, n: int, seed: int, verbs: tuple[str, ...] = ()) -> list[Frame]:
     lex = load_lexicon()
+    # robot_fillers names a learned predicate's slots by role, as a rating names them
     rows = con.execute(
-        "select f.predicate, list(r.role order by r.role), list(r.value order by r.role) from frames f "
-        "join frame_roles r using (corpus, doc_id, sent_id, frame_no) where f.predicate in (select unnest(?)) "
-        "group by f.corpus, f.doc_id, f.sent_id, f.frame_no, f.predicate "
-        "having count(r.value) = 2 and bool_and(r.value not in (select unnest(?)))",
-        [lex.hand_written, sorted(lex.object_pronouns)],
+        "select predicate, list(role order by role), list(value order by role) from robot_fillers "
+        "where predicate in (select unnest(?)) group by corpus, doc_id, sent_id, frame_no, predicate "
+        "having count(value) = 2 and count(distinct role) = 2 and bool_and(value not in (select unnest(?)))",
+        [task_verbs(verbs), sorted(lex.object_pronouns)],
     ).fetchall()
     distinct = sorted({(p, tuple(zip(roles, values))) for p, roles, values in rows})
     picked = random.Random(seed).sample(distinct, min(n, len(distinct)))
@@ -207,9 +219,9 @@ def generate_tasks(
     if config.mode not in MODES:
         raise HitBatchError(f"mode must be one of {MODES}, not {config.mode!r}")
     check_output_dir(out_dir)  # before the gold items are recorded: a refused folder changes nothing
-    pool = protocol_frames(config.seed, config.fixed_per_role)
+    pool = protocol_frames(config.seed, config.fixed_per_role, config.verbs)
     if config.mode == "corpus":
-        pool = corpus_frames(con, config.n_frames or len(pool), config.seed)
+        pool = corpus_frames(con, config.n_frames or len(pool), config.seed, config.verbs)
     rated = already_rated(con)
     pool = [f for f in dict.fromkeys(pool) if f.id not in rated]
     if config.mode == "disagreement":

@@ -57,6 +57,9 @@ def annotate_tasks(
     ),
     n_frames: int | None = typer.Option(None, min=1, help="Frames to ask about (corpus / disagreement)."),
     methods: str = typer.Option("sentence_lm,frame_lm", help="Scorers compared by the disagreement mode."),
+    verbs: str = typer.Option(
+        "", help="Comma-separated predicates to ask about, hand-written or learned ('put away'); default the eleven."
+    ),
     batch: str = typer.Option("batch", help="Batch name recorded with the gold items."),
     seed: int = typer.Option(0, **SEED, help="Seed of the frame order and HIT layout."),
     title: str = typer.Option(HitSettings.title, help="HIT title workers see in the marketplace."),
@@ -82,7 +85,13 @@ def annotate_tasks(
 
     ws = Workspace.from_env(db=db)
     config = TaskConfig(
-        mode=mode, per_hit=per_hit, gold_per_hit=gold_per_hit, n_frames=n_frames, seed=seed, batch=batch
+        mode=mode,
+        per_hit=per_hit,
+        gold_per_hit=gold_per_hit,
+        n_frames=n_frames,
+        seed=seed,
+        batch=batch,
+        verbs=tuple(" ".join(v.lower().split()) for v in split_names(verbs)),
     )
     settings = HitSettings(
         title=title,

@@ -66,6 +66,9 @@ MIN_POOL = 2  # times a word fills a robot role before it counts as a thing
 PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb starts from
 TOP_FILLERS = 300  # fillers per slot compared (the rest carry little of a cosine)
 REFUSED_LISTED = 5  # frames a refused verb needs to be listed with its evidence
+OPEN_ROLES = ("Destination", "Instrument")  # the roles a request can leave for the robot to choose
+THEME_PREPS = ("of",)  # prepositions that can introduce the Theme of a prepositional verb
+PREP_THEME_RATIO = 0.5  # ... when the verb has them at least this often per direct object
 
 
 @dataclass(frozen=True)
@@ -82,20 +85,24 @@ class LearnedPredicate:
     roles: tuple[str, str]
     theme_prep: str | None  # "of" for a prepositional verb ("dispose of")
     sentence: str
+    # other roles a request may leave missing instead (stated often enough too): role -> its sentence;
+    # completion lets the objects decide ("cut the bread": with the knife, or into the bowl)
+    alternatives: dict[str, str] = field(default_factory=dict)
 
     def spec_json(self) -> dict:
-        """The entry in the lexicon's own format (`lexicon.json`)."""
-        other = self.roles[1]
-        preps = {other: sorted((s for s, r in self.slots.items() if r == other and s != OBJECT_SLOT))}
+        """The entry in the lexicon's own format (`lexicon.json`), with the other open roles' sentences."""
+        roles = [self.roles[1], *self.alternatives]
+        preps = {role: sorted((s for s, r in self.slots.items() if r == role and s != OBJECT_SLOT)) for role in roles}
         if self.theme_prep:
             preps["Theme"] = [self.theme_prep]
         return {
             "roles": list(self.roles),
             "object": "Theme",
-            "with": other if self.slots.get("with") == other else None,
+            "with": self.slots.get("with") if self.slots.get("with") in roles else None,
             "preps": preps,
             "particles": [self.particle] if self.particle else [],
             "sentence": self.sentence,
+            "alternatives": dict(self.alternatives),
         }
 
 
@@ -179,7 +186,11 @@ def _label(slot: str, fillers: Counter, total: int, pools: dict[str, Counter], m
     things are under `min_share` of it fills no role ("", 0)."""
     if slot == OBJECT_SLOT:
         return "Theme", float(total)
+    if slot in THEME_PREPS:  # whether it is the Theme's is the verb's evidence (`_predicate`)
+        return "Theme", float(total)
     candidates = PREP_ROLES[slot]
+    if candidates == ("Instrument",):  # "with": English leaves no other role; tools the eleven never use count
+        return "Instrument", float(total)
     role = max(candidates, key=lambda r: (_cosine(fillers, pools[r]), -candidates.index(r)))
     things = sum(n for value, n in fillers.items() if pools[role][value] >= MIN_POOL)
     return (role, float(things)) if total and things / total >= min_share else ("", 0.0)
@@ -241,24 +252,29 @@ def _smoothed(own: Counter, n: int, base: Counter | None) -> dict[str, float]:
 def _predicate(
     name: str, n: int, rates: dict[str, float], slots: dict[str, str], totals: Counter, min_rate: float
 ) -> LearnedPredicate | None:
-    """The predicate of a verb's evidence, or None when no role besides the Theme is stated often enough."""
+    """The predicate of a verb's evidence, or None when no role a request can leave missing is stated often
+    enough."""
     base, particle = _split(name)
-    others = {r: v for r, v in rates.items() if r != "Theme"}
-    if not others:
+    open_roles = sorted((r for r in OPEN_ROLES if rates.get(r, 0.0) >= min_rate), key=lambda r: -rates[r])
+    if not open_roles:
         return None
-    role = max(sorted(others), key=lambda r: others[r])
-    if others[role] < min_rate:
-        return None
-    # A prepositional verb: its "of" phrase, more usual than a direct object, is the Theme ("dispose of it").
-    theme_prep = "of" if totals[(name, "of")] > totals[(name, OBJECT_SLOT)] and slots.get("of") == "Theme" else None
-    preps = sorted((s for s, r in slots.items() if r == role), key=lambda s: -totals[(name, s)])
-    if not preps:  # the role comes from the base verb alone: its most usual preposition for it
-        preps = [next(p for p in PREP_ROLES if role in PREP_ROLES[p])]
+    # A prepositional verb: its "of" phrase, about as usual as a direct object, is the Theme ("dispose of
+    # it"); elsewhere an of-phrase belongs to a measure the parser hung on the verb ("a pot of water").
+    theme_prep = next(
+        (p for p in THEME_PREPS if totals[(name, p)] >= PREP_THEME_RATIO * totals[(name, OBJECT_SLOT)]), None
+    )
+    slots = {s: r for s, r in slots.items() if s not in THEME_PREPS or s == theme_prep}
     theme = f"{theme_prep} {{Theme}}" if theme_prep else "{Theme}"
     middle = f" {particle}" if particle else ""
-    sentence = f"{base} {theme}{middle} {preps[0]} the {{{role}}}"
-    if theme_prep:
-        sentence = f"{base}{middle} {theme} {preps[0]} the {{{role}}}"
+    templates = {}
+    for role in open_roles:
+        preps = sorted((s for s, r in slots.items() if r == role), key=lambda s: -totals[(name, s)])
+        prep = preps[0] if preps else next(p for p in PREP_ROLES if role in PREP_ROLES[p])  # from the base verb
+        templates[role] = (
+            f"{base}{middle} {theme} {prep} the {{{role}}}"
+            if theme_prep
+            else f"{base} {theme}{middle} {prep} the {{{role}}}"
+        )
     return LearnedPredicate(
         name=name,
         base=base,
@@ -266,9 +282,10 @@ def _predicate(
         frames=n,
         rates={r: round(v, 4) for r, v in sorted(rates.items())},
         slots=dict(sorted(slots.items())),
-        roles=("Theme", role),
+        roles=("Theme", open_roles[0]),
         theme_prep=theme_prep,
-        sentence=sentence,
+        sentence=templates[open_roles[0]],
+        alternatives={r: templates[r] for r in open_roles[1:]},
     )
 
 

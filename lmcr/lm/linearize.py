@@ -39,15 +39,17 @@ def frame_text(predicate: str, roles: dict[str, str | None], lex: Lexicon | None
 
 
 def sentence_text(predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:
-    """'pour water into the cup': the lexicon's sentence template with every role filled."""
+    """'pour water into the cup': the lexicon's sentence template with every role filled (a learned
+    predicate's template for the roles the frame has)."""
     lex = lex or load_lexicon()
     spec = lex.predicates.get(predicate)
     if spec is None:
         raise KeyError(f"no sentence template for predicate {predicate!r}")
-    missing = [r for r in spec.roles if not roles.get(r)]
+    template = spec.template(roles)
+    missing = [r for r in re.findall(r"\{(\w+)\}", template) if not roles.get(r)]
     if missing:  # a bug: scorers are only given complete frames
         raise ValueError(f"cannot linearise {predicate} with {missing} unfilled")
-    return spec.sentence.format(**roles)
+    return template.format(**roles)
 
 
 def linearize(linearization: str, predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:

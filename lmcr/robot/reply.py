@@ -54,7 +54,7 @@ def phrase(frame: Mapping | Frame, lexicon: Lexicon | None = None, tense: str = 
         value = roles.get(match.group(2))
         return f"the {value}" if value else "anything"
 
-    text = _SLOT.sub(filled, spec.sentence)
+    text = _SLOT.sub(filled, spec.template(roles))
     if tense == "past":
         verb, _, rest = text.partition(" ")
         text = f"{past_tense(verb, spec.past)} {rest}".strip()

@@ -233,7 +233,8 @@ def _right_node_object(verb: Token) -> list[Token]:
 def _known_frame(
     verb: Token, spec: PredicateSpec, args: _Args, lex: Lexicon, compounds: Compounds | None
 ) -> FrameMention:
-    frame = FrameMention(spec.name, {role: None for role in spec.roles}, True, verb.idx, verb.idx + len(verb))
+    roles = spec.roles_for(prep for prep, _ in args.preps)  # "cut the bread with a knife": its Instrument
+    frame = FrameMention(spec.name, {role: None for role in roles}, True, verb.idx, verb.idx + len(verb))
 
     def fill(role: str, token: Token) -> bool:
         found = argument_value(token, lex, compounds)
@@ -245,12 +246,13 @@ def _known_frame(
     # Two phrases for one role: the more usual preposition names it, then the first in the text.
     for prep, obj in sorted(args.preps, key=lambda p: (spec.prep_rank(p[0]), p[1].i)):
         role = spec.prep_role(prep)
-        if role:
+        if role in frame.roles:
             fill(role, obj)
     if args.objects:
         obj = args.objects[0]
-        role = spec.object_role if frame.roles[spec.object_role] is None else spec.other(spec.object_role)
-        if fill(role, obj) and spec.alternating and not args.particles and frame.roles[spec.other(role)] is None:
+        other = {roles[0]: roles[1], roles[1]: roles[0]}  # the frame's roles: an alternative's may differ
+        role = spec.object_role if frame.roles[spec.object_role] is None else other[spec.object_role]
+        if fill(role, obj) and spec.alternating and not args.particles and frame.roles[other[role]] is None:
             frame.ambiguous_object = role
     return frame
 
