@@ -141,7 +141,7 @@ def execute(
                 arm.on_step = recorder.tick
             recorder.shot(f"{frame.predicate} {held.id} -> {target.id}: start")
         out.update(run_plan(result, held, target, [o for o in scene.present if o not in (held, target)], planner))
-        out["set_down_first"] = result.first.geometry.held.id if result.first else None
+        out.update(_set_down(result))
         if recorder is not None:  # what was poured or put down, once it has come to rest
             recorder.shot(f"after: {'success' if out['success'] else 'failed'}")
         out["arm"] = result.arm.side
@@ -211,7 +211,17 @@ def _plan(planner: Planner, scene: Scene, frame: Frame, objects: dict[str, Scene
     if moved is None:
         return direct
     rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
-    return rearranged if isinstance(rearranged, Plan) else direct
+    return replace(rearranged, instead_of=direct) if isinstance(rearranged, Plan) else direct
+
+
+def _set_down(plan: Plan) -> dict:
+    """What was set down elsewhere first (`set_down_first`, None when nothing) and why the task alone was not
+    planned (`set_down_because`: its reason, whether it was out of reach, what was in the way)."""
+    if plan.first is None:
+        return {"set_down_first": None}
+    why = plan.instead_of
+    because = {"reason": why.reason, "out_of_reach": why.out_of_reach, "blocker": why.blocker} if why else None
+    return {"set_down_first": plan.first.geometry.held.id, "set_down_because": because}
 
 
 def _chosen(candidate: Candidate | None, answer: dict[str, str] | None) -> str | None:

@@ -50,6 +50,7 @@ class Plan:
     geometry: Geometry
     task: Task
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
+    instead_of: Infeasible | None = None  # with `first`: why the task alone was not planned
 
     @property
     def fingers(self) -> list[float]:
