@@ -183,9 +183,23 @@ def _ground(
     if not vocabulary:
         return roles, {}
     known = set(vocabulary) | set(detected)
-    grounded = {r: v and _grounded(v, known) for r, v in roles.items()}
+    grounded = {r: v and (_grounded(v, known) or _named_by_head(v, detected)) for r, v in roles.items()}
     unresolved = {r: v for r, v in roles.items() if v and grounded[r] is None}
     return grounded, unresolved
+
+
+def _named_by_head(value: str, detected: list[str]) -> str | None:
+    """The one detected object a stated filler names by its head word or its letters: "the chips" with
+    kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull; None when no object
+    or several match (which of them is then the robot's question)."""
+    head = value.split()[-1]
+    squeezed = value.replace(" ", "")
+    found = {
+        o
+        for o in detected
+        if o.replace(" ", "") == squeezed or o.split()[-1] in (head, head + "s", head + "es") and len(o.split()) > 1
+    }
+    return found.pop() if len(found) == 1 else None
 
 
 def _question(spec, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
@@ -258,6 +272,8 @@ def complete(
     pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing))
     scores = scorer([Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], context)
+    if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
+        scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
     candidates = tuple(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 from collections.abc import Iterable
@@ -50,6 +51,15 @@ class PredicateSpec:
     # a learned predicate's other open roles: role -> its sentence ("cut {Theme} with the {Instrument}" beside
     # "cut {Theme} into the {Destination}"); a request states one of them, or completion lets the objects choose
     alternatives: dict[str, str] = field(default_factory=dict)
+    # how often each open role is stated with it (a learned predicate's valence; empty for the eleven)
+    rates: dict[str, float] = field(default_factory=dict)
+
+    def open_role_prior(self, role: str) -> float:
+        """log of how much likelier a request leaves `role` open than the second role, by how often each is
+        stated (0 for the second role itself, and for a predicate without learned rates)."""
+        if not self.rates or role == self.roles[1]:
+            return 0.0
+        return math.log(max(self.rates.get(role, 0.0), 1e-6) / max(self.rates.get(self.roles[1], 0.0), 1e-6))
 
     @property
     def open_roles(self) -> tuple[str, ...]:
@@ -119,6 +129,7 @@ def _spec(name: str, spec: dict) -> PredicateSpec:
         sentence=spec["sentence"],
         past=spec.get("past"),
         alternatives=dict(spec.get("alternatives") or {}),
+        rates={role: float(rate) for role, rate in (spec.get("rates") or {}).items()},
     )
 
 

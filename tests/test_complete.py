@@ -250,3 +250,14 @@ def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_pa
     path.write_text(json.dumps(lines[0]) + "\n" + '{"instruction": "pour it"}\n', encoding="utf-8")
     with pytest.raises(InputError, match=r"instructions.jsonl:2"):
         load_instructions(path)
+
+
+def test_a_stated_thing_grounds_in_the_one_object_its_head_word_names(parser):
+    """"the soda" is the orange soda on the table, "redbull" the red bull; with two kinds of chips "the
+    chips" names neither, and the robot asks."""
+    soda = complete(parser, scorer, "pour the soda", ["orange soda", "cup", "bowl"])
+    assert soda.frame.role_map["Theme"] == "orange soda" and not soda.unresolved
+    bull = complete(parser, scorer, "pour the redbull", ["red bull", "cup"])
+    assert bull.frame.role_map["Theme"] == "red bull"
+    chips = complete(parser, scorer, "pour the chips into the bowl", ["kettle chips", "multigrain chips", "bowl"])
+    assert chips.unresolved == {"Theme": "chip"} and chips.question.startswith("I see no chip.")

@@ -175,6 +175,8 @@ def _prefer(*order: str):
         ("pour me some water", "pour", {"Theme": "water", "Destination": None}),  # the eleven unchanged
         ("warm the milk into a glass", "warm", {"Theme": "milk", "Destination": "glass"}),  # the stated role
         ("warm the soup", "warm", {"Theme": "soup", "Instrument": None}),
+        # what is said to the robot, not what the speaker did
+        ("I put the milk away already. Can you bake the cake?", "bake", {"Theme": "cake", "Instrument": None}),
     ],
 )
 def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, instruction, predicate, roles):
@@ -209,7 +211,7 @@ def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_par
 
 @pytest.mark.model
 def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parser):
-    from lmcr.complete import complete
+    from lmcr.complete import CompletionConfig, complete
 
     likes = {("Destination", "glass"): 2.0, ("Instrument", "microwave"): 1.0}  # a stand-in that reads roles
 
@@ -223,9 +225,21 @@ def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parse
         ("glass", {"Destination": "glass"}),
         ("microwave", {"Instrument": "microwave"}),
     ]
+    # a scorer with no opinion: the role stated twice as often with "warm" is twice as likely left open
     even = complete(learned_parser, lambda f, c="": [0.0] * len(f), "warm the soup", ["soup", "microwave"])
-    assert even.question == "Should I warm soup in the microwave or warm soup into the microwave?"
-    assert even.to_json()["frame"]["roles"] == {"Theme": "soup", "Instrument": "microwave"}
+    assert [(c.objects, c.probability) for c in even.candidates] == [
+        ({"Instrument": "microwave"}, pytest.approx(2 / 3, abs=1e-3)),
+        ({"Destination": "microwave"}, pytest.approx(1 / 3, abs=1e-3)),
+    ]
+    assert even.to_json()["frame"]["roles"] == {"Theme": "soup", "Instrument": "microwave"} and even.question is None
+    unsure = complete(
+        learned_parser,
+        lambda f, c="": [0.0] * len(f),
+        "warm the soup",
+        ["soup", "microwave"],
+        CompletionConfig(set_threshold=0.3),
+    )
+    assert unsure.question == "Should I warm soup in the microwave or warm soup into the microwave?"
 
 
 @pytest.mark.model

@@ -103,6 +103,7 @@ class LearnedPredicate:
             "particles": [self.particle] if self.particle else [],
             "sentence": self.sentence,
             "alternatives": dict(self.alternatives),
+            "rates": {role: self.rates.get(role, 0.0) for role in roles},
         }
 
 

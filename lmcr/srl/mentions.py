@@ -15,6 +15,8 @@ from lmcr.srl.lemmas import lemma as lemma_of
 OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
 NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})
 SKIPPED_LEMMAS = frozenset({"be", "have", "do", "let", "go", "will", "would", "can", "could", "should"})
+# forms of "be" the lemmatiser leaves as they are when the tagger misreads them
+BE_FORMS = frozenset({"is", "are", "was", "were", "am", "been", "being"})
 PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
 # Adverbs that complete a phrasal verb where the parser calls them adverbs ("put the milk away"); the
 # parser's own particles (dep prt) count whatever the word. English's closed class, not a verb list.
@@ -35,6 +37,8 @@ class FrameMention:
     spans: dict[str, tuple[int, int]] = field(default_factory=dict)
     # Set when a lone object of an alternating verb got its role by default ("rub the steak").
     ambiguous_object: str | None = None
+    # Said to the robot: an imperative or "can you ...", not "I drank it" or "the one was eaten".
+    addressed: bool = True
 
     def missing(self) -> list[str]:
         return [role for role, value in self.roles.items() if value is None]
@@ -46,7 +50,14 @@ class FrameMention:
         """The same frame with character offsets moved (for text that was re-parsed with a prefix)."""
         spans = {r: (s + offset, e + offset) for r, (s, e) in self.spans.items()}
         return FrameMention(
-            self.predicate, self.roles, self.known, self.start + offset, self.end + offset, spans, self.ambiguous_object
+            self.predicate,
+            self.roles,
+            self.known,
+            self.start + offset,
+            self.end + offset,
+            spans,
+            self.ambiguous_object,
+            self.addressed,
         )
 
 
@@ -66,7 +77,7 @@ def predicate_lemma(token: Token, lex: Lexicon) -> str | None:
     lemma = lemma_of(token)
     if lemma not in lex.predicates and token.lower_ in lex.predicates:
         lemma = token.lower_  # the lemmatiser follows the tagger, which mis-tags imperatives
-    return None if lemma in SKIPPED_LEMMAS else lemma
+    return None if lemma in SKIPPED_LEMMAS or lemma in BE_FORMS else lemma
 
 
 def _is_particle(token: Token) -> bool:
@@ -266,6 +277,13 @@ def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds
     return frame
 
 
+def _addressed(verb: Token) -> bool:
+    """Whether the verb is said to the robot: no subject of its own (an imperative, or one coordinated
+    with it) or "you" ("can you dispose of it"), not "I drank it" or "the crispy one was eaten"."""
+    subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass")]
+    return all(c.lower_ == "you" for c in subjects)
+
+
 def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[FrameMention]:
     """Every predicate occurrence in `doc`, in text order; `compounds` (learned) decides adjective-tagged
     modifiers, without it only noun-tagged modifiers join a name."""
@@ -278,9 +296,11 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
         args = _collect(token, lex, spec)
         if not args.objects and not args.preps:
             args.objects = _right_node_object(token)
-        frames.append(
+        frame = (
             _known_frame(token, spec, args, lex, compounds)
             if spec
             else _generic_frame(token, name, args, lex, compounds)
         )
+        frame.addressed = _addressed(token)
+        frames.append(frame)
     return sorted(frames, key=lambda f: f.start)

@@ -391,10 +391,9 @@ def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
     known = [f for f in frames if f.known]
     if known:
-        # the robot's own predicates first ("I'd love some wine, could you pour it?"), then a learned one that
-        # leaves something to do, then the first
-        hand_written = [f for f in known if f.predicate not in parser.lex.learned]
-        return (hand_written or [f for f in known if f.missing()] or known)[0]
+        # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
+        # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do; else the first
+        return min(known, key=lambda f: (f.predicate in parser.lex.learned, not f.addressed, not f.missing()))
     refused = [f.predicate for f in frames if f.predicate in parser.lex.refused]
     if refused:
         name, seen = refused[0], parser.lex.refused[refused[0]]
