@@ -253,7 +253,7 @@ def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_pa
 
 
 def test_a_stated_thing_grounds_in_the_one_object_its_head_word_names(parser):
-    """"the soda" is the orange soda on the table, "redbull" the red bull; with two kinds of chips "the
+    """ "the soda" is the orange soda on the table, "redbull" the red bull; with two kinds of chips "the
     chips" names neither, and the robot asks."""
     soda = complete(parser, scorer, "pour the soda", ["orange soda", "cup", "bowl"])
     assert soda.frame.role_map["Theme"] == "orange soda" and not soda.unresolved
