@@ -120,6 +120,11 @@ def test_the_published_table_merges_into_the_lexicon_and_the_count_model(tmp_pat
     counts = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL)
     # the learned predicate's "in" slot is counted as its Destination, beside the eleven's roles
     assert counts.filler[("put", "Destination", "bowl")] == 25 and counts.filler[("pour", "Destination", "bowl")] == 30
+    # an alternative open role is counted too: warm's Destination beside its Instrument
+    assert (
+        counts.filler[("warm", "Destination", "glass")] == 10
+        and counts.filler[("warm", "Instrument", "microwave")] == 20
+    )
     bowl, glass = (Frame.of("put", {"Theme": "milk", "Destination": d}) for d in ("bowl", "glass"))
     assert counts.score_frame(bowl) > counts.score_frame(glass)
 

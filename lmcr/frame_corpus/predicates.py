@@ -312,7 +312,12 @@ def publish_predicates(con: duckdb.DuckDBPyConnection, table: LearnedTable, path
             )
             for p in table.predicates.values()
         ]
-        slots = [(p.name, s, role) for p in table.predicates.values() for s, role in p.slots.items() if role in p.roles]
+        slots = [
+            (p.name, s, r)
+            for p in table.predicates.values()
+            for s, r in p.slots.items()
+            if r in (*p.roles, *p.alternatives)
+        ]
         if rows:  # DuckDB's executemany refuses an empty list
             con.executemany("insert into learned_predicates values (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)", rows)
         if slots:
