@@ -300,3 +300,25 @@ def test_rating_tasks_can_ask_about_a_learned_predicate(tmp_path, monkeypatch):
     assert {f.predicate for f in protocol_frames(0, 1)} == set(HAND.predicates)  # default: the eleven
     with pytest.raises(HitBatchError, match="unknown predicate 'juggle'"):
         protocol_frames(0, 1, ("juggle",))
+
+
+@pytest.mark.model
+def test_the_robot_refuses_a_learned_verb_it_has_no_motion_for_in_one_line(learned_parser, tmp_path):
+    import pybullet as p
+
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import NoMotionError, execute
+    from lmcr.robot.reply import error_outcome, say
+    from lmcr.robot.scene import scene_from_json
+
+    scene = scene_from_json({"objects": [{"label": "milk"}, {"label": "bowl"}, {"label": "cup"}]}, "scene")
+    try:
+        with pytest.raises(NoMotionError, match=r"no motion for 'put away' yet \(it can blend, brush, "):
+            execute("put the milk away", scene, learned_parser, _prefer("bowl"), CompletionConfig(), tmp_path)
+    finally:
+        p.disconnect()
+    reply = say(error_outcome(NoMotionError("put away")), learned_parser.lex)
+    assert (
+        reply
+        == "Sorry, I don't know how to put away. I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or sprinkle things."
+    )
