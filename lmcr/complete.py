@@ -130,11 +130,11 @@ def softmax(scores: list[float], temperature: float) -> list[float]:
     return [w / total for w in weights]
 
 
-def _candidate_frames(missing: list[str], objects: list[str], open_roles: tuple[str, ...] = ()) -> list[dict[str, str]]:
+def _candidate_frames(missing: list[str], objects: list[str], open_roles: tuple[str, ...]) -> list[dict[str, str]]:
     """One filling per object (or ordered object pair) for the missing roles; one missing role that may be
-    any of `open_roles` gets a filling per role and object."""
+    any of `open_roles` (`_open_roles`) gets a filling per role and object."""
     if len(missing) == 1:
-        return [{role: o} for role in open_roles or missing for o in objects]
+        return [{role: o} for role in open_roles for o in objects]
     return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
 
 

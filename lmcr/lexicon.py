@@ -23,6 +23,12 @@ _OBJECT_NAME_RE = re.compile(r"[^\W\d_]+(?:[ '-][^\W\d_]+){0,3}")
 MAX_OBJECT_NAME_CHARS = 40
 
 
+def normalize_name(name: str) -> str:
+    """A predicate or object name as the lexicon keys it: lowercase, one space between words ("Put  Away"
+    -> "put away")."""
+    return " ".join(name.lower().split())
+
+
 def is_object_name(label: str) -> bool:
     """True when `label` (lowercase, single spaces) could name an object: words of letters, not too long,
     not only function words."""

@@ -159,7 +159,9 @@ def predicates(
 
 def _show_predicate(verb: str, rows: list[dict], lex) -> None:
     """One predicate's row, a refused verb's evidence, or an error naming the verb."""
-    name = " ".join(verb.lower().split())
+    from lmcr.lexicon import normalize_name
+
+    name = normalize_name(verb)
     found = [r for r in rows if r["predicate"] == name]
     if found:
         print_rows(f"learned predicate {name!r}", found)

@@ -82,6 +82,7 @@ def annotate_tasks(
 ) -> None:
     """Write an MTurk batch of plausibility-rating HITs with gold checks, its template and a preview."""
     from lmcr.annotate.tasks import TaskConfig, generate_tasks
+    from lmcr.lexicon import normalize_name
 
     ws = Workspace.from_env(db=db)
     config = TaskConfig(
@@ -91,7 +92,7 @@ def annotate_tasks(
         n_frames=n_frames,
         seed=seed,
         batch=batch,
-        verbs=tuple(" ".join(v.lower().split()) for v in split_names(verbs)),
+        verbs=tuple(normalize_name(v) for v in split_names(verbs)),
     )
     settings = HitSettings(
         title=title,

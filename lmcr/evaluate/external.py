@@ -37,6 +37,7 @@ from pathlib import Path
 from lmcr.complete import CompletionConfig, CompletionError, complete
 from lmcr.errors import one_line
 from lmcr.jsonl import InputError, check_text, read_jsonl
+from lmcr.lexicon import normalize_name as normalize
 from lmcr.scorers.registry import Scorer
 from lmcr.srl.parser import FrameParser, NoPredicateError
 
@@ -109,11 +110,6 @@ def read_sets(folder: Path) -> dict[str, list[ExternalItem]]:
     if not files:
         raise InputError(f"{folder}: no request sets (*.jsonl)")
     return {path.stem: read_items(path) for path in files}
-
-
-def normalize(name: str) -> str:
-    """A predicate or object name compared: lowercase, one space between words."""
-    return " ".join(name.lower().split())
 
 
 def right_predicate(read: str | None, verb: str) -> bool:

@@ -13,14 +13,17 @@ in the fridge": predicate `put away`, slots object=milk, in=fridge). Learning tu
   (cosine of filler counts) with the fillers the eleven robot predicates' roles take in the same corpus.
   "bake in the oven" reads like heat's Instrument, "put in the bowl" like pour's Destination. Only fillers
   that role takes count as things: "cut into cubes" names none and is no role here, and "bring to a boil"
-  does not make a boil a place things are brought to.
+  does not make a boil a place things are brought to. A with-phrase is an Instrument whatever it holds
+  (the eleven's Instruments are no tools, so a knife would not count).
 - A phrasal verb's counts are smoothed towards its base verb's (`PHRASAL_PRIOR` frames of it), so "put
   away", seldom said with its place, still knows that putting has a Destination.
 
 A predicate's roles are the Theme and its most often stated other role (its valence: what a request leaves
-missing when unsaid). A verb with fewer than `MIN_FRAMES` frames, or whose best role is stated in under
-`MIN_RATE` of them, is not learned; it is listed with its evidence so that a request using it is refused
-by name. The hand-written predicates keep their entries (the lexicon overrides the learned table).
+missing when unsaid); every other role of `OPEN_ROLES` stated in `MIN_RATE` of its frames is an alternative
+open role with its own sentence, and completion lets the objects choose among them. A verb with fewer than
+`MIN_FRAMES` frames, or none of whose open roles is stated in `MIN_RATE` of them, is not learned; it is
+listed with its evidence so that a request using it is refused by name. The hand-written predicates keep
+their entries (the lexicon overrides the learned table).
 
 The table is a resource of the frame build: `predicates.json` beside the other learned SRL resources, and
 the store's `learned_predicates` / `learned_predicate_slots` (which the count model reads through the
@@ -67,7 +70,8 @@ PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb st
 TOP_FILLERS = 300  # fillers per slot compared (the rest carry little of a cosine)
 REFUSED_LISTED = 5  # frames a refused verb needs to be listed with its evidence
 OPEN_ROLES = ("Destination", "Instrument")  # the roles a request can leave for the robot to choose
-THEME_PREPS = ("of",)  # prepositions that can introduce the Theme of a prepositional verb
+# prepositions that can introduce the Theme of a prepositional verb ("of")
+THEME_PREPS = tuple(prep for prep, roles in PREP_ROLES.items() if roles == ("Theme",))
 PREP_THEME_RATIO = 0.5  # ... when the verb has them at least this often per direct object
 
 
@@ -136,8 +140,9 @@ def _cosine(a: Counter, b: Counter) -> float:
     return dot / norm if norm else 0.0
 
 
-def _slot_counts(con: duckdb.DuckDBPyConnection) -> tuple[Counter, dict[tuple[str, str], Counter]]:
-    """Frames per generic predicate, and the top fillers of each of its slots that English lets name a role."""
+def _slot_counts(con: duckdb.DuckDBPyConnection) -> tuple[Counter, dict[tuple[str, str], Counter], Counter]:
+    """Frames per generic predicate; the top fillers of each of its slots that English lets name a role; and
+    how many frames state each such slot, over all its fillers (one scan of the frames for both)."""
     frames = Counter(dict(con.execute("select predicate, count(*) from frames where not known group by 1").fetchall()))
     rows = con.execute(
         """
@@ -147,25 +152,17 @@ def _slot_counts(con: duckdb.DuckDBPyConnection) -> tuple[Counter, dict[tuple[st
             where not f.known and r.value is not null and r.role in (select unnest($slots))
             group by all
         )
-        select predicate, slot, value, n from filled
+        select predicate, slot, value, n, sum(n) over (partition by predicate, slot) as total from filled
         qualify row_number() over (partition by predicate, slot order by n desc, value) <= $top
         """,
         {"slots": [OBJECT_SLOT, *PREP_ROLES], "top": TOP_FILLERS},
     ).fetchall()
     fillers: dict[tuple[str, str], Counter] = defaultdict(Counter)
-    for predicate, slot, value, n in rows:
+    totals: Counter = Counter()
+    for predicate, slot, value, n, total in rows:
         fillers[(predicate, slot)][value] = n
-    return frames, fillers
-
-
-def _slot_totals(con: duckdb.DuckDBPyConnection) -> Counter:
-    """(predicate, slot) -> frames stating it, over all fillers."""
-    rows = con.execute(
-        "select f.predicate, r.role, count(*)"
-        " from frames f join frame_roles r using (corpus, doc_id, sent_id, frame_no)"
-        " where not f.known and r.value is not null group by all"
-    ).fetchall()
-    return Counter({(p, s): n for p, s, n in rows})
+        totals[(predicate, slot)] = int(total)
+    return frames, fillers, totals
 
 
 def _role_pools(con: duckdb.DuckDBPyConnection) -> dict[str, Counter]:
@@ -185,9 +182,7 @@ def _label(slot: str, fillers: Counter, total: int, pools: dict[str, Counter], m
     preposition's candidate roles (`PREP_ROLES`) are decided by whose fillers it shares (cosine), and only
     fillers that role takes in the robot frames count as things ("cut into cubes" names none). A slot whose
     things are under `min_share` of it fills no role ("", 0)."""
-    if slot == OBJECT_SLOT:
-        return "Theme", float(total)
-    if slot in THEME_PREPS:  # whether it is the Theme's is the verb's evidence (`_predicate`)
+    if slot == OBJECT_SLOT or slot in THEME_PREPS:  # an of-phrase's being the Theme's: the verb's evidence
         return "Theme", float(total)
     candidates = PREP_ROLES[slot]
     if candidates == ("Instrument",):  # "with": English leaves no other role; tools the eleven never use count
@@ -210,8 +205,8 @@ def learn_predicates(
     min_share: float = MIN_SHARE,
 ) -> LearnedTable:
     """The learned table of the store's frame corpus (see the module's docstring)."""
-    frames, fillers = _slot_counts(con)
-    totals, pools = _slot_totals(con), _role_pools(con)
+    frames, fillers, totals = _slot_counts(con)
+    pools = _role_pools(con)
     labelled = {key: _label(key[1], counter, totals[key], pools, min_share) for key, counter in fillers.items()}
     slots_of: dict[str, dict[str, str]] = defaultdict(dict)
     for (predicate, slot), (role, _) in labelled.items():
