@@ -10,7 +10,7 @@ from prefect.task_runners import ProcessPoolTaskRunner
 
 from lmcr.ingest import Source, StagedFile, expand_corpora
 from lmcr.ingest.run import corpus_summary, parse_and_stage, plan
-from lmcr.ingest.stage import load_staged
+from lmcr.ingest.stage import load_staged, remove_sources
 from lmcr.workspace import Workspace
 
 
@@ -37,6 +37,16 @@ def load_task(ws: Workspace, staged: list[StagedFile]) -> list[dict]:
         return corpus_summary(con, ws.sql_dir)
 
 
+@task(name="remove-sources")
+def remove_task(ws: Workspace, paths: list[str]) -> list[dict]:
+    """Take ingested sources out of the store, with their sentences (one transaction)."""
+    with ws.connect() as con:
+        removed = remove_sources(con, paths)
+    for row in removed:
+        get_run_logger().info("removed %s: %d sentences", row["source_file"], row["sentences"])
+    return removed
+
+
 @flow(name="ingest", task_runner=ProcessPoolTaskRunner(max_workers=2), log_prints=True)
 def ingest_flow(
     youcook2: list[str] | None = None,
@@ -45,9 +55,13 @@ def ingest_flow(
     fmt: str | None = None,
     db: str | None = None,
     data_dir: str | None = None,
+    remove: list[str] | None = None,
 ) -> list[dict]:
-    """Ingest YouCook2, recipe and household corpora; unchanged sources are skipped; publishes a summary table."""
+    """Ingest YouCook2, recipe and household corpora; unchanged sources are skipped; sources in `remove`
+    are taken out first; publishes a summary table."""
     ws = Workspace.from_env(data_dir=data_dir, db=db)
+    if remove:
+        remove_task(ws, remove)
     sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt)
     with ws.connect() as con:
         todo, skipped = plan(con, sources)

@@ -1,17 +1,29 @@
-"""Scheduled retraining's decision: is anything new, and is the new checkpoint at least as good?
+"""Scheduled retraining: what changed, what that costs, and is the new checkpoint at least as good?
 
 The inputs of a setting are the ingested corpus files (and, for the frame LM, the frame build) plus
-the rating files, each known by its sha256. When they match the last decision's, nothing is trained.
-Otherwise a candidate is trained without promotion, both it and the current checkpoint are scored on
-the rated frames with the evaluation protocol (overall accuracy at lambda, k), and the candidate
-becomes LATEST only if it is not worse. Every decision and both scores go to `retrain_decisions`.
+the rating files, each known by its sha256, and recorded with every decision. What changed since the
+last decision decides what is done (`Change.action`):
+
+- nothing: nothing;
+- only the ratings: no training (ratings do not enter an LM): the current checkpoint is judged on them
+  and completion is calibrated again;
+- corpus files added or changed: the current LM continues on the new text with a replay of the old
+  (`lm.run.continue_setting`), or trains from scratch when its vocabulary would change too much;
+- corpus files removed (or the frame build redone for the frame LM): a full training, since a warm start
+  cannot unlearn text.
+
+A candidate is scored with the current checkpoint on the rated frames by the evaluation protocol
+(overall accuracy at lambda, k) and becomes LATEST only if it is not worse. Every decision, both scores,
+the change, the action and its cost (seconds, tokens trained) go to `retrain_decisions`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import dataclass
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import duckdb
@@ -23,6 +35,8 @@ from lmcr.evaluate.run import calibrate_completion
 from lmcr.evaluate.scenarios import ScenarioError, accuracy, build_scenarios
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
+from lmcr.lm.hyperparams import LMConfig, TrainConfig, WarmStartConfig
+from lmcr.lm.run import continue_setting, tokens_trained, train_setting
 from lmcr.scorers.registry import COMPLETION_METHOD, make_scorer
 from lmcr.scorers.resources import MethodResources
 from lmcr.setting import METHOD_OF, Setting
@@ -55,12 +69,151 @@ def inputs_sha256(con: duckdb.DuckDBPyConnection, linearization: str) -> str:
     return hashlib.sha256(repr((corpus_hash(con, linearization), ratings)).encode()).hexdigest()
 
 
-def last_inputs(con: duckdb.DuckDBPyConnection, setting: Setting) -> str | None:
-    """The inputs hash of the setting's last retrain decision, None before the first."""
+@dataclass(frozen=True)
+class Inputs:
+    """What a decision saw: corpus files (path -> sha256), rating file hashes, and for the frame LM the
+    frame build; `sha256` is `inputs_sha256` of the same store."""
+
+    sha256: str
+    files: dict[str, str] = field(default_factory=dict)
+    ratings: tuple[str, ...] = ()
+    frames: str | None = None
+
+    @classmethod
+    def read(cls, con: duckdb.DuckDBPyConnection, linearization: str) -> Inputs:
+        files = dict(con.execute("select source_file, sha256 from ingested_files order by all").fetchall())
+        ratings = tuple(r for (r,) in con.execute("select sha256 from rating_files order by 1").fetchall())
+        build = con.execute("select fingerprint from frame_builds order by built_at desc limit 1").fetchone()
+        frames = build[0] if build and linearization == "frame" else None
+        return cls(inputs_sha256(con, linearization), files, ratings, frames)
+
+    def to_json(self) -> str:
+        return json.dumps({**asdict(self), "ratings": list(self.ratings)}, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> Inputs:
+        data = json.loads(text)
+        return cls(data["sha256"], dict(data["files"]), tuple(data["ratings"]), data.get("frames"))
+
+
+@dataclass(frozen=True)
+class Change:
+    """What changed between two decisions' inputs; `kind` is the strongest change (see the module)."""
+
+    kind: str  # first | unchanged | ratings | corpus_added | corpus_changed | corpus_removed | frames_rebuilt
+    added: tuple[str, ...] = ()
+    changed: tuple[str, ...] = ()
+    removed: tuple[str, ...] = ()
+    new_ratings: bool = False
+
+    @property
+    def new_sources(self) -> list[str]:
+        """The corpus files whose text is new: added or changed."""
+        return [*self.added, *self.changed]
+
+    def action(self, has_checkpoint: bool) -> str:
+        """none | recalibrate | warm_start | full (see the module docstring)."""
+        if self.kind == "unchanged":
+            return "none"
+        if not has_checkpoint or self.kind in ("first", "corpus_removed", "frames_rebuilt"):
+            return "full"
+        return "recalibrate" if self.kind == "ratings" else "warm_start"
+
+    def describe(self) -> str:
+        """The change in words, for the decision's reason."""
+        parts = [
+            f"{len(files)} corpus file{'s' if len(files) != 1 else ''} {verb} ({_names(files)})"
+            for verb, files in (("added", self.added), ("changed", self.changed), ("removed", self.removed))
+            if files
+        ]
+        if self.kind == "frames_rebuilt":
+            parts.append("the frame corpus was rebuilt")
+        if self.new_ratings:
+            parts.append("new ratings")
+        return {"first": "no earlier decision", "unchanged": "nothing changed"}.get(self.kind, "; ".join(parts))
+
+
+def _names(files: tuple[str, ...], shown: int = 3) -> str:
+    names = [Path(f).name for f in files[:shown]]
+    return ", ".join(names + (["..."] if len(files) > shown else []))
+
+
+def classify(previous: Inputs | None, current: Inputs) -> Change:
+    """The change from the last decision's inputs to the current ones (None before the first decision,
+    or when that decision recorded only a hash)."""
+    if previous is not None and previous.sha256 == current.sha256:
+        return Change("unchanged")
+    if previous is None or not previous.files and not previous.ratings:
+        return Change("first")
+    old, new = previous.files, current.files
+    added = tuple(sorted(f for f in new if f not in old))
+    changed = tuple(sorted(f for f in new if f in old and old[f] != new[f]))
+    removed = tuple(sorted(f for f in old if f not in new))
+    new_ratings = previous.ratings != current.ratings
+    if removed:
+        kind = "corpus_removed"
+    elif changed:
+        kind = "corpus_changed"
+    elif added:
+        kind = "corpus_added"
+    elif previous.frames != current.frames:
+        kind = "frames_rebuilt"
+    else:
+        kind = "ratings"
+    return Change(kind, added, changed, removed, new_ratings)
+
+
+def last_inputs(con: duckdb.DuckDBPyConnection, setting: Setting) -> Inputs | None:
+    """The inputs of the setting's last retrain decision (only their hash for decisions recorded before
+    the inputs were), None before the first."""
     row = con.execute(
-        "select inputs_sha256 from retrain_decisions where setting = ? order by decided_at desc limit 1", [setting.name]
+        "select inputs_sha256, inputs_json from retrain_decisions where setting = ? order by decided_at desc limit 1",
+        [setting.name],
     ).fetchone()
-    return row[0] if row else None
+    if not row:
+        return None
+    return Inputs.from_json(row[1]) if row[1] else Inputs(row[0])
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A trained, unpromoted checkpoint and what making it cost."""
+
+    path: Path
+    action: str  # warm_start | full
+    reason: str
+    seconds: float
+    tokens_trained: int
+
+
+def train_candidate(
+    open_store: Callable[[], duckdb.DuckDBPyConnection],
+    checkpoints: Path,
+    setting: Setting,
+    change: Change,
+    model_config: LMConfig,
+    train_config: TrainConfig,
+    warm: WarmStartConfig = WarmStartConfig(),
+    on_epoch: Callable[[dict], None] | None = None,
+) -> Candidate:
+    """Train a candidate for `change`: a warm start where its action is one and the start is not refused,
+    else a full training; published without promotion."""
+    started = time.perf_counter()
+    why = change.describe()
+    if change.action(has_checkpoint=(checkpoints / setting.name / "LATEST").exists()) == "warm_start":
+        warm_start = continue_setting(open_store, checkpoints, setting, change.new_sources, warm, on_epoch)
+        if warm_start.path is not None:
+            return _candidate(warm_start.path, "warm_start", f"{why}: {warm_start.reason}", started)
+        why = f"{why}: trained from scratch, {warm_start.reason}"
+    else:
+        why = f"{why}: trained from scratch"
+    path = train_setting(open_store, checkpoints, setting, model_config, train_config, on_epoch=on_epoch, promote=False)
+    return _candidate(path, "full", why, started)
+
+
+def _candidate(path: Path, action: str, reason: str, started: float) -> Candidate:
+    metrics = json.loads((path / "metrics.json").read_text(encoding="utf-8"))
+    return Candidate(path, action, reason, time.perf_counter() - started, tokens_trained(metrics["history"]))
 
 
 def checkpoint_accuracy(version: Path, rated: list[RatedFrame], config: RetrainConfig) -> float:
@@ -110,53 +263,125 @@ def recalibrate(
 def decide(
     con: duckdb.DuckDBPyConnection,
     checkpoints: Path,
-    candidate: Path,
+    candidate: Candidate,
     rated: list[RatedFrame],
     config: RetrainConfig,
-    inputs: str,
+    inputs: Inputs,
+    change: Change,
     db: Path | None = None,
     calibration_dir: Path | None = None,
 ) -> dict:
-    """Promote `candidate` if it scores at least as well as the current LATEST; record the decision.
-    With `db` and `calibration_dir`, a promoted candidate is first calibrated for completion on the
-    same rated frames, so completion never falls back to uncalibrated defaults after a promotion."""
-    setting_dir = checkpoints / config.setting.name
-    current = ckpt.resolve(setting_dir) if (setting_dir / "LATEST").exists() else None
-    cand_acc = checkpoint_accuracy(candidate, rated, config)
-    cur_acc = checkpoint_accuracy(current, rated, config) if current and current != candidate else None
+    """Promote the candidate if it scores at least as well as the current LATEST; record the decision
+    with its change, action and cost. With `db` and `calibration_dir`, a promoted candidate is first
+    calibrated for completion on the same rated frames, so completion never falls back to uncalibrated
+    defaults after a promotion."""
+    started = time.perf_counter()
+    current = current_checkpoint(checkpoints, config.setting)
+    cand_acc = checkpoint_accuracy(candidate.path, rated, config)
+    cur_acc = checkpoint_accuracy(current, rated, config) if current and current != candidate.path else None
     if cur_acc is None or cand_acc >= cur_acc:
         decision = "promoted"
         reason = "no current checkpoint" if cur_acc is None else f"not worse: {cand_acc:.3f} >= {cur_acc:.3f}"
     else:
         decision, reason = "kept", f"candidate worse: {cand_acc:.3f} < {cur_acc:.3f}"
     row = {
-        "setting": config.setting.name,
-        "inputs_sha256": inputs,
+        **_decision_row(config, inputs, change, candidate.action),
         "decision": decision,
-        "reason": reason,
-        "candidate": str(candidate),
+        "reason": f"{reason}; {candidate.reason}",
+        "candidate": str(candidate.path),
         "current": str(current) if current else None,
         "candidate_accuracy": cand_acc,
         "current_accuracy": cur_acc,
+        "tokens_trained": candidate.tokens_trained,
     }
     if decision == "promoted" and db is not None and calibration_dir is not None:
-        row["calibration"] = json.dumps(recalibrate(candidate, rated, config, db, calibration_dir), sort_keys=True)
+        calibration = recalibrate(candidate.path, rated, config, db, calibration_dir)
+        row["calibration"] = json.dumps(calibration, sort_keys=True)
+    row["seconds"] = candidate.seconds + time.perf_counter() - started
     record(con, row)  # recorded first: LATEST never moves without its decision on record
     if decision == "promoted":
-        ckpt.set_latest(checkpoints, config.setting, candidate.name)
+        ckpt.set_latest(checkpoints, config.setting, candidate.path.name)
     return row
 
 
+def rejudge(
+    con: duckdb.DuckDBPyConnection,
+    checkpoints: Path,
+    rated: list[RatedFrame],
+    config: RetrainConfig,
+    inputs: Inputs,
+    change: Change,
+    db: Path,
+    calibration_dir: Path,
+) -> dict:
+    """New ratings only: judge the current checkpoint on them and calibrate completion again; nothing is
+    trained and LATEST stays. Recorded as `recalibrated`."""
+    started = time.perf_counter()
+    current = current_checkpoint(checkpoints, config.setting)
+    accuracy_now = checkpoint_accuracy(current, rated, config)
+    calibration = recalibrate(current, rated, config, db, calibration_dir)
+    row = {
+        **_decision_row(config, inputs, change, "recalibrate"),
+        "decision": "recalibrated",
+        "reason": f"{change.describe()}: ratings do not enter LM training; {current.name} judged "
+        f"({accuracy_now:.3f}) and completion calibrated again",
+        "current": str(current),
+        "current_accuracy": accuracy_now,
+        "calibration": json.dumps(calibration, sort_keys=True),
+        "tokens_trained": 0,
+        "seconds": time.perf_counter() - started,
+    }
+    record(con, row)
+    return row
+
+
+def record_unchanged(con: duckdb.DuckDBPyConnection, config: RetrainConfig, inputs: Inputs) -> dict:
+    """Record that nothing changed since the last decision."""
+    row = {
+        **_decision_row(config, inputs, Change("unchanged"), "none"),
+        "decision": "unchanged",
+        "reason": "corpus and ratings unchanged since the last decision",
+        "tokens_trained": 0,
+        "seconds": 0.0,
+    }
+    record(con, row)
+    return row
+
+
+def current_checkpoint(checkpoints: Path, setting: Setting) -> Path | None:
+    """The version LATEST names for the setting, None before the first."""
+    setting_dir = checkpoints / setting.name
+    return ckpt.resolve(setting_dir) if (setting_dir / "LATEST").exists() else None
+
+
+def _decision_row(config: RetrainConfig, inputs: Inputs, change: Change, action: str) -> dict:
+    return {
+        "setting": config.setting.name,
+        "inputs_sha256": inputs.sha256,
+        "inputs_json": inputs.to_json(),
+        "change": change.kind,
+        "action": action,
+    }
+
+
+DECISION_COLUMNS = (
+    "setting",
+    "inputs_sha256",
+    "decision",
+    "reason",
+    "candidate",
+    "current",
+    "candidate_accuracy",
+    "current_accuracy",
+    "calibration",
+    "change",
+    "action",
+    "seconds",
+    "tokens_trained",
+    "inputs_json",
+)
+
+
 def record(con: duckdb.DuckDBPyConnection, row: dict) -> None:
-    cols = [
-        "setting",
-        "inputs_sha256",
-        "decision",
-        "reason",
-        "candidate",
-        "current",
-        "candidate_accuracy",
-        "current_accuracy",
-        "calibration",
-    ]
-    insert_rows(con, "retrain_decisions", [{c: row.get(c) for c in cols}])
+    """One retrain_decisions row (columns the row lacks stay null)."""
+    insert_rows(con, "retrain_decisions", [{c: row.get(c) for c in DECISION_COLUMNS}])

@@ -99,6 +99,35 @@ def test_document_id_clash_is_refused(con, paths, sample_dir, tmp_path):
     corpus_summary(con, paths.sql_dir)
 
 
+def test_a_removed_source_takes_its_rows_and_nothing_else(con, paths, sample_dir, monkeypatch):
+    from typer.testing import CliRunner
+
+    from lmcr.cli import app
+    from lmcr.ingest.stage import remove_sources
+
+    ingest_sources(con, sample_sources(sample_dir), paths.staging)
+    jsonl = str(sample_dir / "recipes_json" / "recipes_sample.jsonl")
+    sentences = con.execute("select count(*) from sentences where source_file = ?", [jsonl]).fetchone()[0]
+    total = con.execute("select count(*) from sentences").fetchone()[0]
+    with pytest.raises(IngestError, match="not an ingested source: nothing removed"):
+        remove_sources(con, [jsonl, str(sample_dir / "nowhere.jsonl")])
+    assert con.execute("select count(*) from sentences").fetchone()[0] == total  # all or nothing
+    removed = remove_sources(con, [jsonl])
+    assert [(r["source_file"], r["sentences"]) for r in removed] == [(jsonl, sentences)]
+    assert con.execute("select count(*) from sentences").fetchone()[0] == total - sentences > 0
+    assert con.execute("select count(*) from documents where source_file = ?", [jsonl]).fetchone()[0] == 0
+    corpus_summary(con, paths.sql_dir)  # contracts hold after the removal
+    con.close()
+
+    # The CLI removes by the same file under another spelling of its path, in one line per source.
+    monkeypatch.chdir(sample_dir)
+    result = CliRunner().invoke(app, ["ingest", "--remove", "feeding_america/sample_book.xml", "--db", str(paths.db)])
+    assert result.exit_code == 0, result.output
+    assert "removed" in result.output and "sample_book.xml" in result.output
+    again = CliRunner().invoke(app, ["ingest", "--remove", "feeding_america/sample_book.xml", "--db", str(paths.db)])
+    assert again.exit_code == 1 and "not an ingested source" in again.output and "Traceback" not in again.output
+
+
 @pytest.mark.shared
 def test_real_youcook2_and_one_cookbook(con, paths, shared_dir):
     data = shared_dir / "data"

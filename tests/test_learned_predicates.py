@@ -264,7 +264,10 @@ def test_the_predicates_command_reports_coverage_and_one_predicate(tmp_path, mon
 
     monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
     con = _store(tmp_path, _kitchen())
-    con.execute("insert into frame_builds values ('b1', 'instruction', 1, 1, 1, 1, 1, 0, 0, 1.0, 1.0, now())")
+    con.execute(
+        "insert into frame_builds (fingerprint, kinds, shards, sentences, words, frames, known_frames, reparsed, "
+        "reparse_kept, wall_s, words_per_s) values ('b1', 'instruction', 1, 1, 1, 1, 1, 0, 0, 1.0, 1.0)"
+    )
     con.close()
     runner = CliRunner()
     listed = runner.invoke(app, ["predicates"])

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 from contextlib import closing
 from pathlib import Path
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 from spacy.tokens import Doc
@@ -15,6 +17,7 @@ from typer.testing import CliRunner
 from lmcr.checkout import REPO_ROOT
 from lmcr.cli import app
 from lmcr.files import ResourceError
+from lmcr.frame_corpus import shards as shard_module
 from lmcr.frame_corpus.build import build_frame_corpus, process_pool
 from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.frame_corpus.shards import Shard, ShardJob, learn_first_words, parse_shard
@@ -205,31 +208,38 @@ def test_the_builds_first_words_let_a_parser_reread_a_command_taken_for_a_subjec
 
 def _shard(tmp_path, number: int, texts: list[str]) -> Shard:
     path = tmp_path / f"input-{number}.parquet"
-    occurrences = [[{"corpus": "recipes", "doc_id": f"d{number}", "sent_id": i}] for i in range(len(texts))]
-    pq.write_table(pa.table({"text": texts, "occurrences": occurrences}), path)
+    keys = [hashlib.md5(t.encode()).hexdigest() for t in texts]
+    pq.write_table(pa.table({"text_key": keys, "text": texts}), path)
     return Shard(number, str(path), f"shard{number}", len(texts), sum(len(t.split()) for t in texts))
 
 
-def test_a_shard_parses_the_same_whichever_shards_the_worker_parsed_before(tmp_path):
+def test_a_shard_parses_the_same_whichever_shards_the_worker_parsed_before(tmp_path, monkeypatch):
     warm, target = _shard(tmp_path, 0, WARM_UP), _shard(tmp_path, 1, [LONG_SPRINKLE])
     first = parse_shard(target, ShardJob(str(tmp_path / "a"), None, str(tmp_path / "none.json")))
     parse_shard(warm, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
     again = parse_shard(target, ShardJob(str(tmp_path / "b"), None, str(tmp_path / "none.json")))
     assert not again.cached and pq.read_table(again.frames_path) == pq.read_table(first.frames_path)
+    # After them in one shard, parsed in batches of 4: each batch starts from the job's table, so the same frames.
+    monkeypatch.setattr(shard_module, "PARSE_CHUNK", 4)
+    both = _shard(tmp_path, 2, WARM_UP + [LONG_SPRINKLE])
+    together = pq.read_table(parse_shard(both, ShardJob(str(tmp_path / "c"), None, "")).frames_path)
+    key = hashlib.md5(LONG_SPRINKLE.encode()).hexdigest()
+    assert together.filter(pc.equal(together["text_key"], key)) == pq.read_table(first.frames_path)
 
 
 def test_every_shard_starts_from_the_first_words_learned_on_a_sample(tmp_path):
     (tmp_path / "out").mkdir()
     shards = [_shard(tmp_path, 0, WARM_UP), _shard(tmp_path, 1, [LONG_SPRINKLE])]
-    job = learn_first_words(shards, ShardJob(str(tmp_path / "out"), None, str(tmp_path / "none.json")), sample=100)
+    sample = WARM_UP + [LONG_SPRINKLE]
+    job = learn_first_words(sample, ShardJob(str(tmp_path / "out"), None, str(tmp_path / "none.json")))
     assert json.loads(Path(job.first_words).read_text())["sprinkle"][0] >= len(WARM_UP) - 1  # repaired
-    assert learn_first_words(shards, job, sample=100) == job  # the same sample: the same table, not learned again
+    assert learn_first_words(sample, job) == job  # the same sample: the same table, not learned again
     table = Path(job.first_words).read_text()
     Path(job.first_words).write_text(table[:20])  # damaged: learned again
-    assert learn_first_words(shards, job, sample=100) == job and Path(job.first_words).read_text() == table
+    assert learn_first_words(sample, job) == job and Path(job.first_words).read_text() == table
     result = parse_shard(shards[1], job)  # the sample taught "sprinkle": read as a command at once
     assert "sprinkle" in pq.read_table(result.frames_path).column("predicate").to_pylist()
-    half = learn_first_words(shards, job, sample=2)  # every 7th text: a sample of its own, a table of its own
+    half = learn_first_words(sample[::7], job)  # every 7th text: a sample of its own, a table of its own
     assert half.first_words != job.first_words and Path(half.first_words).exists()
 
 

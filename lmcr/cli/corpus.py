@@ -45,18 +45,25 @@ def ingest(
         None, help="Force the text encoding of Meal-Master files (cp437, latin-1, ...)."
     ),
     workers: int = typer.Option(2, **WORKERS, help="Parallel parser processes."),
+    remove: list[str] = typer.Option(
+        [], "--remove", help="An ingested source to take out of the store, with its sentences (repeatable)."
+    ),
     db: Path | None = typer.Option(None, help="DuckDB store (default $LMCR_DB or data/lmcr.duckdb)."),
 ) -> None:
-    """Ingest cooking and household corpora into the sentence table; unchanged inputs are skipped."""
+    """Ingest cooking and household corpora into the sentence table; unchanged inputs are skipped.
+    `--remove` takes sources out first (their frames go with the next `lmcr frames`)."""
     from lmcr.ingest import expand_corpora
     from lmcr.ingest.run import corpus_summary, ingest_sources
+    from lmcr.ingest.stage import remove_sources
 
-    if not youcook2 and not recipes and not household:
-        fail("nothing to ingest: give --youcook2, --recipes and/or --household PATH")
+    if not youcook2 and not recipes and not household and not remove:
+        fail("nothing to ingest: give --youcook2, --recipes and/or --household PATH (or --remove PATH)")
     ws = Workspace.from_env(db=db)
     started = time.perf_counter()
     sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt, encoding)
     con = ws.connect()
+    for row in remove_sources(con, remove) if remove else []:
+        console.print(f"removed {row['source_file']}: {row['sentences']:,} sentences")
     with progress_bar("ingesting sources", len(sources)) as progress:
         loaded, skipped = ingest_sources(
             con,
@@ -84,7 +91,7 @@ def ingest(
 @app.command()
 def frames(
     kinds: str = typer.Option(",".join(FrameCorpusConfig.kinds), help="Sentence kinds to parse."),
-    shard_size: int = typer.Option(FrameCorpusConfig.shard_size, min=1, help="Sentences per worker shard."),
+    shard_size: int = typer.Option(FrameCorpusConfig.shard_size, min=1, help="Distinct texts per worker shard."),
     workers: int = typer.Option(2, **WORKERS, help="Parser processes."),
     model: str | None = typer.Option(None, help=SPACY_MODEL_HELP),
     db: Path | None = typer.Option(None, help="DuckDB store."),
@@ -100,14 +107,17 @@ def frames(
         model=model or ws.spacy_model,
     )
     con = ws.connect()
-    sentences = con.execute("select count(*) from sentences where list_contains(?, kind)", [list(config.kinds)])
-    with progress_bar("parsing shards", -(-sentences.fetchone()[0] // shard_size)) as progress:
+    with progress_bar("parsing shards", None) as progress:  # its total: the shards of new texts (on_start)
         build = build_frame_corpus(
             con,
             ws.staging,
             ws.srl_dir,
             config,
-            process_pool(workers, on_shard=lambda r: advance(progress)),
+            process_pool(
+                workers,
+                on_shard=lambda r: advance(progress),
+                on_start=lambda shards: progress.update(progress.task_ids[0], total=shards),
+            ),
             log=lambda message: progress.update(progress.task_ids[0], description=message),
         )
     check_contracts(con, ws.sql_dir, prefix="frames_")
@@ -115,9 +125,11 @@ def frames(
     if build is None:
         console.print("frame corpus unchanged (skipped)")
     else:
+        resources = "kept the last build's" if build["resources_reused"] else "learned new"
         console.print(
-            f"{build['sentences']:,} sentences, {build['words']:,} words in {build['wall_s']:.1f}s: "
-            f"{build['words_per_s']:,.0f} words/s; imperative re-parses kept "
+            f"{build['sentences']:,} sentences ({build['texts']:,} distinct texts); {resources} compounds and "
+            f"first words; parsed {build['texts_parsed']:,} new texts, {build['words_parsed']:,} words in "
+            f"{build['wall_s']:.1f}s: {build['words_per_s']:,.0f} words/s; imperative re-parses kept "
             f"{build['kept']:,}/{build['reparsed']:,}"
         )
 

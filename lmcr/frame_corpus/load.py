@@ -1,11 +1,14 @@
-"""Loading parsed shards into the store: one transaction that replaces the frame tables, learns role
-priors from the unambiguous frames, resolves the ambiguous ones and records the build."""
+"""Loading the parsed texts into the store: one transaction that replaces the frame tables (each sentence
+gets the frames of its text), learns role priors from the unambiguous frames, resolves the ambiguous ones
+and records the build."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import duckdb
 
-from lmcr.frame_corpus.shards import ShardResult
+from lmcr.frame_corpus.shards import FRAME_SCHEMA, ROLE_SCHEMA, parsed_texts
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.mentions import FrameMention
 from lmcr.srl.priors import RolePriors
@@ -73,34 +76,52 @@ def resolve_ambiguous(con: duckdb.DuckDBPyConnection, priors: RolePriors) -> int
     return len(flipped)
 
 
-def load_frames(con: duckdb.DuckDBPyConnection, results: list[ShardResult], build: dict) -> RolePriors:
-    """Replace the frame tables with the parsed shards, resolve ambiguous objects, record the build:
-    one transaction, so a failure leaves the previous corpus in place."""
+def _read_parsed(con: duckdb.DuckDBPyConnection, table: str, files: list[str]) -> None:
+    """Insert the rows of every sentence whose text has rows in `files` (keyed by text) into `table`."""
+    columns = [name for name in (FRAME_SCHEMA if table == "frames" else ROLE_SCHEMA).names if name != "text_key"]
+    con.execute(
+        f"insert into {table} (corpus, doc_id, sent_id, {', '.join(columns)}) "
+        f"select o.corpus, o.doc_id, o.sent_id, {', '.join('p.' + c for c in columns)} "
+        "from read_parquet(?) p join _frame_occurrences o using (text_key)",
+        [files],
+    )
+
+
+def load_frames(con: duckdb.DuckDBPyConnection, parsed: Path, build: dict) -> RolePriors:
+    """Replace the frame tables with the frames of every sentence of the build's kinds, from the texts
+    parsed in the setup's folder `parsed`; resolve ambiguous objects; record the build: one transaction,
+    so a failure leaves the previous corpus in place."""
+    shards = [Path(path).name.removeprefix("texts-") for path in parsed_texts(parsed)]
     with transaction(con):
         con.execute("delete from frame_roles")
         con.execute("delete from frames")
-        if results:
-            con.execute("insert into frames select * from read_parquet(?)", [[r.frames_path for r in results]])
-            con.execute("insert into frame_roles select * from read_parquet(?)", [[r.roles_path for r in results]])
+        if shards:
+            con.execute(
+                "create or replace temp table _frame_occurrences as select corpus, doc_id, sent_id, "
+                "md5(text) as text_key from sentences where list_contains(?, kind)",
+                [list(build["kinds"])],
+            )
+            _read_parsed(con, "frames", [str(parsed / f"frames-{name}") for name in shards])
+            _read_parsed(con, "frame_roles", [str(parsed / f"roles-{name}") for name in shards])
+            con.execute("drop table _frame_occurrences")
         priors = learn_priors(con)
         resolve_ambiguous(con, priors)
         known = con.execute("select count(*) filter (where known), count(*) from frames").fetchone()
         con.execute("delete from frame_builds where fingerprint = ?", [build["fingerprint"]])
-        insert_rows(
-            con,
-            "frame_builds",
-            [
-                {
-                    **{k: build[k] for k in ("fingerprint", "sentences", "words", "reparsed", "wall_s", "words_per_s")},
-                    "kinds": ",".join(build["kinds"]),
-                    "shards": len(results),
-                    "frames": known[1],
-                    "known_frames": known[0],
-                    "reparse_kept": build["kept"],
-                }
-            ],
-        )
+        insert_rows(con, "frame_builds", [_build_row(build, known)])
     return priors
+
+
+def _build_row(build: dict, known: tuple[int, int]) -> dict:
+    names = ("fingerprint", "parser_setup", "resources_reused", "shards", "sentences", "words", "texts")
+    names += ("texts_parsed", "words_parsed", "reparsed", "wall_s", "words_per_s")
+    return {
+        **{name: build[name] for name in names},
+        "kinds": ",".join(build["kinds"]),
+        "frames": known[1],
+        "known_frames": known[0],
+        "reparse_kept": build["kept"],
+    }
 
 
 def last_build(con: duckdb.DuckDBPyConnection) -> str | None:

@@ -124,11 +124,37 @@ def already_loaded(con: duckdb.DuckDBPyConnection, source: Source, sha256: str) 
     return row is not None
 
 
-def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
+def _delete_rows(con: duckdb.DuckDBPyConnection, source_file: str) -> None:
     for table in ("documents", "sentences"):
-        con.execute(f"delete from {table} where source_file = ?", [staged.source_file])
-    con.execute("delete from quarantine where stage = 'ingest' and source_file = ?", [staged.source_file])
-    con.execute("delete from ingested_files where source_file = ?", [staged.source_file])
+        con.execute(f"delete from {table} where source_file = ?", [source_file])
+    con.execute("delete from quarantine where stage = 'ingest' and source_file = ?", [source_file])
+    con.execute("delete from ingested_files where source_file = ?", [source_file])
+
+
+def remove_sources(con: duckdb.DuckDBPyConnection, paths: list[str]) -> list[dict]:
+    """Remove ingested sources (as stored, or the same file by absolute path) with their documents,
+    sentences and quarantined records, in one transaction; returns the removed `ingested_files` rows.
+    Their frames go with the next frame build. A path that was never ingested is an IngestError and
+    nothing is removed."""
+    stored = {key: Path(key).resolve() for (key,) in con.execute("select source_file from ingested_files").fetchall()}
+    keys = []
+    for path in paths:
+        match = path if path in stored else next((k for k, p in stored.items() if p == Path(path).resolve()), None)
+        if match is None:
+            raise IngestError(str(path), None, "not an ingested source: nothing removed")
+        keys.append(match)
+    removed = []
+    with transaction(con):
+        for key in dict.fromkeys(keys):
+            cursor = con.execute("select * from ingested_files where source_file = ?", [key])
+            names = [d[0] for d in cursor.description]
+            removed.append(dict(zip(names, cursor.fetchone())))
+            _delete_rows(con, key)
+    return removed
+
+
+def _replace_rows(con: duckdb.DuckDBPyConnection, staged: StagedFile) -> None:
+    _delete_rows(con, staged.source_file)
     clash = con.execute(
         "select d.doc_id, d.source_file from documents d join read_parquet(?) p using (doc_id) limit 1",
         [staged.parquet["documents"]],

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import duckdb
 
@@ -15,11 +15,13 @@ from lmcr.setting import Setting, check_corpus
 
 @dataclass
 class TrainingText:
-    """Token sequences split by document into train and validation, plus what they came from."""
+    """Token sequences split by document into train and validation, plus what they came from;
+    `train_docs` is the document of each training sequence (a warm start picks the new ones by it)."""
 
     train: list[list[str]]
     val: list[list[str]]
     provenance: dict
+    train_docs: list[str] = field(default_factory=list)
 
 
 def _corpus_filter(corpus: str) -> str:
@@ -76,6 +78,7 @@ def training_text(
     return TrainingText(
         train=[seq for (_, seq), h in zip(pairs, held) if not h],
         val=[seq for (_, seq), h in zip(pairs, held) if h],
+        train_docs=[doc for (doc, _), h in zip(pairs, held) if not h],
         provenance={
             "linearization": linearization,
             "corpus": setting.corpus,

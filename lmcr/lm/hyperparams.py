@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 MIN_FREQ = 3  # words seen fewer times in the training text share <unk>
+MAX_VOCAB = 30_000  # the most frequent words kept
 
 
 @dataclass(frozen=True)
@@ -54,6 +55,27 @@ class TrainConfig:
     # Keep a/an/the in the training text (and hence in what the model scores)? False makes recipe prose
     # and terse household narrations ("pour milk into cup") one register; see `lm.linearize`.
     articles: bool = False
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class WarmStartConfig:
+    """How a retrain continues the current checkpoint on new text instead of starting from random weights.
+
+    The new documents' sequences are trained together with `replay` times as many old ones drawn at
+    random: without the old text in the mix, the model drifts towards the new collection's wording and
+    forgets the rest. The vocabulary stays the checkpoint's; when the vocabulary rebuilt from the whole
+    corpus would differ from it in more than `max_vocab_change` of its words (added or dropped), new
+    words would be left as `<unk>` and the retrain trains from scratch instead.
+    """
+
+    replay: float = 1.0
+    epochs: int = 2
+    lr: float = 1e-3  # below training's 3e-3: the weights start near a minimum, a fresh Adam would overshoot
+    max_vocab_change: float = 0.05
+    seed: int = 1234
 
     def to_json(self) -> dict:
         return asdict(self)

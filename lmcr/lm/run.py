@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import json
+import random
 import uuid
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import duckdb
@@ -15,7 +16,7 @@ from lmcr.checkout import git_commit
 from lmcr.errors import LMCRError
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import TrainingText, corpus_hash, training_text
-from lmcr.lm.hyperparams import MIN_FREQ, LMConfig, TrainConfig
+from lmcr.lm.hyperparams import MAX_VOCAB, MIN_FREQ, LMConfig, TrainConfig, WarmStartConfig
 from lmcr.lm.model import RecurrentLM
 from lmcr.lm.train import train_lm
 from lmcr.lm.vocab import Vocab
@@ -40,7 +41,7 @@ def train_setting(
     model_config: LMConfig | None = None,
     train_config: TrainConfig = TrainConfig(),
     min_freq: int = MIN_FREQ,
-    max_vocab: int = 30_000,
+    max_vocab: int = MAX_VOCAB,
     on_epoch: Callable[[dict], None] | None = None,
     promote: bool = True,
     skip_unchanged: bool = False,
@@ -73,38 +74,128 @@ def train_setting(
     history = train_lm(
         model, [vocab.encode(s) for s in text.train], [vocab.encode(s) for s in text.val], train_config, on_epoch
     )
+    provenance = {
+        **text.provenance,
+        "train_config": train_config.to_json(),
+        "min_freq": min_freq,
+        "max_vocab": max_vocab,
+    }
+    return _publish_run(open_store, checkpoints, setting, model, vocab, text, history, provenance, promote)
+
+
+@dataclass(frozen=True)
+class WarmStart:
+    """A warm start's outcome: the published candidate, or no path and why the setting needs a full run."""
+
+    path: Path | None
+    vocab_change: float
+    reason: str
+
+
+def continue_setting(
+    open_store: Callable[[], duckdb.DuckDBPyConnection],
+    checkpoints: Path,
+    setting: Setting,
+    new_sources: list[str],
+    config: WarmStartConfig = WarmStartConfig(),
+    on_epoch: Callable[[dict], None] | None = None,
+) -> WarmStart:
+    """Continue the setting's LATEST checkpoint on the sequences of `new_sources` (ingested source files)
+    mixed with a replay of the old ones, keeping its vocabulary; publish the result unpromoted. Refused
+    (no path) when the vocabulary rebuilt from the whole corpus would change too much, or when the new
+    files add no training sequence."""
+    base = ckpt.load(checkpoints / setting.name)
+    train_config = TrainConfig(**base.provenance["train_config"])
+    min_freq = base.provenance.get("min_freq", MIN_FREQ)
+    max_vocab = base.provenance.get("max_vocab", MAX_VOCAB)
+    with open_store() as con:
+        text = training_text(con, setting, articles=base.articles)
+        new_docs = documents_of(con, new_sources)
+    rebuilt = Vocab.build(text.train, min_freq=min_freq, max_size=max_vocab)
+    change = vocab_change(base.vocab, rebuilt)
+    if change > config.max_vocab_change:
+        return WarmStart(None, change, f"the vocabulary would change by {change:.1%} (> {config.max_vocab_change:.0%})")
+    new = [seq for seq, doc in zip(text.train, text.train_docs) if doc in new_docs]
+    if not new:
+        return WarmStart(None, change, "the new files add no training sequence")
+    old = [seq for seq, doc in zip(text.train, text.train_docs) if doc not in new_docs]
+    replayed = random.Random(config.seed).sample(old, min(len(old), round(config.replay * len(new))))
+    steps = replace(
+        train_config, max_epochs=config.epochs, lr=config.lr, seed=config.seed, max_minutes=None, patience=config.epochs
+    )
+    model = base.model
+    history = train_lm(
+        model, [base.vocab.encode(s) for s in new + replayed], [base.vocab.encode(s) for s in text.val], steps, on_epoch
+    )
+    provenance = {
+        **text.provenance,
+        "train_config": train_config.to_json(),  # the recipe of the weights it continues
+        "min_freq": min_freq,
+        "max_vocab": max_vocab,
+        "warm_start": {
+            "from": base.path.name,
+            "new_sequences": len(new),
+            "replayed": len(replayed),
+            "vocab_change": change,
+            **config.to_json(),
+        },
+    }
+    path = _publish_run(open_store, checkpoints, setting, model, base.vocab, text, history, provenance, promote=False)
+    reason = f"continued {base.path.name} on {len(new):,} new and {len(replayed):,} old sequences"
+    return WarmStart(path, change, reason)
+
+
+def documents_of(con: duckdb.DuckDBPyConnection, source_files: list[str]) -> set[str]:
+    """The document ids loaded from these source files."""
+    rows = con.execute("select distinct doc_id from documents where list_contains(?, source_file)", [source_files])
+    return {doc for (doc,) in rows.fetchall()}
+
+
+def vocab_change(old: Vocab, new: Vocab) -> float:
+    """Share of `old`'s words that `new` drops or adds (the symmetric difference over `old`'s size)."""
+    return len(set(old.words) ^ set(new.words)) / max(1, len(old.words))
+
+
+def _publish_run(
+    open_store: Callable[[], duckdb.DuckDBPyConnection],
+    checkpoints: Path,
+    setting: Setting,
+    model: RecurrentLM,
+    vocab: Vocab,
+    text: TrainingText,
+    history: list[dict],
+    provenance: dict,
+    promote: bool,
+) -> Path:
+    """Publish a trained model with its metrics and provenance, record the run, promote when asked."""
     run_id = uuid.uuid4().hex[:12]
-    best = min(row["val_ppl"] for row in history)
     metrics = {
-        "best_val_ppl": best,
+        "best_val_ppl": min(row["val_ppl"] for row in history),
         "history": history,
         "train_sequences": len(text.train),
         "val_sequences": len(text.val),
+        "tokens_trained": tokens_trained(history),
     }
     provenance = {
-        **text.provenance,
+        **provenance,
         "code_version": code_version(),
-        "train_config": train_config.to_json(),
-        "min_freq": min_freq,
         "run_id": run_id,
+        "model_config": replace(model.config, vocab_size=0).to_json(),
     }
     # Publish unpromoted, record the run, then promote: LATEST never names a version without its
     # lm_runs row, whatever fails or is killed in between.
-    path = ckpt.publish(
-        checkpoints,
-        setting,
-        model.cpu(),
-        vocab,
-        metrics,
-        {**provenance, "model_config": replace(model.config, vocab_size=0).to_json()},
-        promote=False,
-        articles=train_config.articles,
-    )
+    articles = TrainConfig(**provenance["train_config"]).articles
+    path = ckpt.publish(checkpoints, setting, model.cpu(), vocab, metrics, provenance, promote=False, articles=articles)
     with open_store() as con:
         record_run(con, run_id, text, len(vocab), history, path)
     if promote:
         ckpt.set_latest(checkpoints, setting, path.name)
     return path
+
+
+def tokens_trained(history: list[dict]) -> int:
+    """Tokens the training steps went through, over every epoch of a run's history."""
+    return int(sum(row["tokens_per_s"] * row["seconds"] for row in history))
 
 
 def up_to_date(
