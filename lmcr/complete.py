@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
@@ -175,31 +176,62 @@ def _served(
 
 
 def _ground(
-    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str]
+    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str], said: str = ""
 ) -> tuple[dict[str, str | None], dict[str, str]]:
     """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
     the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
-    objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept."""
+    objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept.
+    `said` is the instruction: an object whose whole label it says names the filler the parser cut
+    short ("put the tank top away": Theme 'tank')."""
     if not vocabulary:
         return roles, {}
-    known = set(vocabulary) | set(detected)
-    grounded = {r: v and (_grounded(v, known) or _named_by_head(v, detected)) for r, v in roles.items()}
+    seen, words = set(detected), set(vocabulary)
+
+    def ground(value: str) -> str | None:  # what the person sees first, then what the robot knows
+        found = _grounded(value, seen) or _named_by_head(value, detected) or _said_in_full(value, detected, said)
+        return found or _grounded(value, words)
+
+    grounded = {r: v and ground(v) for r, v in roles.items()}
     unresolved = {r: v for r, v in roles.items() if v and grounded[r] is None}
     return grounded, unresolved
 
 
+def _same_noun(word: str, other: str) -> bool:
+    """The same noun in either number: carrot / carrots, dish / dishes, patty / patties."""
+    if word == other:
+        return True
+    one, two = sorted((word, other), key=len)
+    return two in (one + "s", one + "es") or (one.endswith("y") and two == one[:-1] + "ies")
+
+
 def _named_by_head(value: str, detected: list[str]) -> str | None:
     """The one detected object a stated filler names by its head word or its letters: "the chips" with
-    kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull; None when no object
-    or several match (which of them is then the robot's question)."""
-    head = value.split()[-1]
+    kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull, the lemma "carrot"
+    for the carrots; None when no object or several match (which of them is then the robot's question)."""
+    words = value.split()
     squeezed = value.replace(" ", "")
-    found = {
-        o
-        for o in detected
-        if o.replace(" ", "") == squeezed or o.split()[-1] in (head, head + "s", head + "es") and len(o.split()) > 1
-    }
+
+    def names(obj: str) -> bool:
+        label = obj.split()
+        if obj.replace(" ", "") == squeezed:
+            return True
+        if label[:-1] == words[:-1] and _same_noun(label[-1], words[-1]):  # the same name, another number
+            return True
+        return len(label) > 1 and _same_noun(label[-1], words[-1])
+
+    found = {o for o in detected if names(o)}
     return found.pop() if len(found) == 1 else None
+
+
+def _said_in_full(value: str, detected: list[str], said: str) -> str | None:
+    """The longest detected object whose whole label the instruction says and whose words hold every
+    word of the filler ("stainless steel" in "put the stainless steel spoon away"), if only one is that
+    long."""
+    text = f" {' '.join(re.findall(r'[a-z0-9]+', said.lower()))} "
+    words = value.split()
+    found = [o for o in detected if f" {o} " in text and all(any(_same_noun(w, x) for x in o.split()) for w in words)]
+    longest = [o for o in found if len(o) == max(map(len, found))] if found else []
+    return longest[0] if len(longest) == 1 else None
 
 
 def _question(spec, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
@@ -246,7 +278,7 @@ def complete(
     roles = {r: referred.get(r) or served.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
-    roles, unresolved = _ground(roles, parser.lex.objects, detected)
+    roles, unresolved = _ground(roles, parser.lex.objects, detected, instruction)
     # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
     # seen: the mug): its phrase is read as context, as the rest of the utterance is.
     context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""

@@ -261,3 +261,26 @@ def test_a_stated_thing_grounds_in_the_one_object_its_head_word_names(parser):
     assert bull.frame.role_map["Theme"] == "red bull"
     chips = complete(parser, scorer, "pour the chips into the bowl", ["kettle chips", "multigrain chips", "bowl"])
     assert chips.unresolved == {"Theme": "chip"} and chips.question.startswith("I see no chip.")
+
+
+def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(parser):
+    """The parser's lemma "carrot" is the carrots on the table, "dish" the dishes, "patty" the mint
+    patties; an object whose whole label the instruction says is what a filler cut short stands for
+    ("the tank top": Theme 'tank'); a detected object comes before the robot's word for it."""
+    from lmcr.complete import _ground, _named_by_head, _said_in_full, _same_noun
+
+    assert _same_noun("carrot", "carrots") and _same_noun("dishes", "dish") and _same_noun("patty", "patties")
+    assert not _same_noun("cup", "cups of") and not _same_noun("pan", "pants")
+    assert _named_by_head("carrot", ["carrots", "counter"]) == "carrots"
+    assert _named_by_head("mint patty", ["mint patties", "corner"]) == "mint patties"
+    assert _named_by_head("plate", ["plates", "plate"]) is None  # two objects: the robot asks
+    said = "put the tank top away"
+    assert _said_in_full("tank", ["tank top", "closet"], said) == "tank top"
+    assert _said_in_full("steel", ["stainless steel spoon", "steel pan"], "put the stainless steel spoon away") == (
+        "stainless steel spoon"
+    )
+    assert _said_in_full("top", ["tank top"], "put the top away") is None  # the label is not said in full
+    roles, unresolved = _ground({"Theme": "egg", "Destination": None}, ("egg", "bowl"), ["eggs", "bowl"], "")
+    assert roles == {"Theme": "eggs", "Destination": None} and not unresolved
+    poured = complete(parser, scorer, "pour the carrots into the bowl", ["carrots", "bowl", "cup"])
+    assert poured.frame.role_map["Theme"] == "carrots" and not poured.unresolved

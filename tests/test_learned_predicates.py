@@ -192,6 +192,18 @@ def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, ins
 
 
 @pytest.mark.model
+@pytest.mark.parametrize(
+    "instruction", ["put the teddy bear away", "put the bay leaves away", "put the granite cutting board away"]
+)
+def test_a_particle_after_an_object_the_parser_misread_still_names_the_phrasal_verb(learned_parser, instruction):
+    """The tagger reads "bear", "leaves", "cutting" as verbs and hangs "away" on them: the particle that
+    follows the object's noun phrase is still the verb's."""
+    from lmcr.srl.parser import parse_instruction
+
+    assert parse_instruction(learned_parser, instruction).predicate == "put away"
+
+
+@pytest.mark.model
 def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_parser):
     from lmcr.complete import CompletionConfig, complete
 

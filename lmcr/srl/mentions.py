@@ -23,6 +23,10 @@ PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
 ADVERB_PARTICLES = frozenset({"away", "back", "aside", "out", "up", "down", "off"})
 # Where only a noun can stand: a word tagged as a verb there is a noun the tagger misread.
 NOUN_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "attr", "appos"})
+# Tags of a noun phrase's words (POS: the possessive 's), and those a particle is tagged with; tags, since
+# the parser's pipeline leaves out the coarse parts of speech.
+NOMINAL_TAGS = frozenset({"DT", "PDT", "JJ", "JJR", "JJS", "NN", "NNS", "NNP", "NNPS", "CD", "POS", "PRP", "PRP$"})
+PARTICLE_TAGS = frozenset({"RB", "RP", "IN"})
 
 
 @dataclass
@@ -101,6 +105,25 @@ def _particle(verb: Token) -> str | None:
         for token in obj.subtree:
             if token.head.i != verb.i and _misread_noun(token.head) and _is_particle(token):
                 return token.lower_
+    return _after_object(verb)
+
+
+def _after_object(verb: Token) -> str | None:
+    """A closed-class particle right after the noun phrase that follows the verb, wherever the parser hung
+    it: "put the teddy bear away" with bear read as a verb of its own clause, "put the bay leaves away"
+    with put the subject of leaves. Inside the phrase a word tagged as a verb counts as a noun when a noun
+    or the particle follows it (the head noun misread, "the granite cutting board")."""
+    doc, i = verb.doc, verb.i + 1
+    while i < len(doc) and (
+        doc[i].tag_ in NOMINAL_TAGS
+        or i > verb.i + 1
+        and doc[i].tag_.startswith("VB")
+        and i + 1 < len(doc)
+        and (doc[i + 1].tag_.startswith("NN") or doc[i + 1].lower_ in ADVERB_PARTICLES)
+    ):
+        i += 1
+    if i > verb.i + 1 and i < len(doc) and doc[i].lower_ in ADVERB_PARTICLES and doc[i].tag_ in PARTICLE_TAGS:
+        return doc[i].lower_
     return None
 
 
