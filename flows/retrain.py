@@ -90,10 +90,12 @@ def retrain_flow(
             frames_flow(db=db, data_dir=data_dir)
     for path in ratings or []:
         ingest_task(path, ws)
+    current = current_checkpoint(ws.checkpoints, config.setting)
     with ws.connect() as con:
         inputs = Inputs.read(con, config.linearization)
-        change = classify(last_inputs(con, config.setting), inputs)
-    action = change.action(has_checkpoint=current_checkpoint(ws.checkpoints, config.setting) is not None)
+        previous = last_inputs(con, config.setting) or (current and Inputs.of_checkpoint(current))
+    change = classify(previous, inputs)
+    action = change.action(has_checkpoint=current is not None)
     if action == "none":
         with ws.connect() as con:
             row = record_unchanged(con, config, inputs)

@@ -78,6 +78,7 @@ class Inputs:
     files: dict[str, str] = field(default_factory=dict)
     ratings: tuple[str, ...] = ()
     frames: str | None = None
+    corpus: str = ""  # `corpus_hash`: what a checkpoint's provenance records of its text
 
     @classmethod
     def read(cls, con: duckdb.DuckDBPyConnection, linearization: str) -> Inputs:
@@ -85,7 +86,14 @@ class Inputs:
         ratings = tuple(r for (r,) in con.execute("select sha256 from rating_files order by 1").fetchall())
         build = con.execute("select fingerprint from frame_builds order by built_at desc limit 1").fetchone()
         frames = build[0] if build and linearization == "frame" else None
-        return cls(inputs_sha256(con, linearization), files, ratings, frames)
+        return cls(inputs_sha256(con, linearization), files, ratings, frames, corpus_hash(con, linearization))
+
+    @classmethod
+    def of_checkpoint(cls, version: Path) -> Inputs:
+        """What a checkpoint trained outside the retrain flow (`lmcr train`, the pipeline) is known to have
+        seen: the hash of its corpus, no ratings."""
+        provenance = json.loads((version / "provenance.json").read_text(encoding="utf-8"))
+        return cls("", corpus=provenance.get("corpus_sha256", ""))
 
     def to_json(self) -> str:
         return json.dumps({**asdict(self), "ratings": list(self.ratings)}, sort_keys=True)
@@ -93,7 +101,8 @@ class Inputs:
     @classmethod
     def from_json(cls, text: str) -> Inputs:
         data = json.loads(text)
-        return cls(data["sha256"], dict(data["files"]), tuple(data["ratings"]), data.get("frames"))
+        files, ratings = dict(data["files"]), tuple(data["ratings"])
+        return cls(data["sha256"], files, ratings, data.get("frames"), data.get("corpus", ""))
 
 
 @dataclass(frozen=True)
@@ -140,9 +149,13 @@ def _names(files: tuple[str, ...], shown: int = 3) -> str:
 
 def classify(previous: Inputs | None, current: Inputs) -> Change:
     """The change from the last decision's inputs to the current ones (None before the first decision,
-    or when that decision recorded only a hash)."""
+    or when that decision recorded only a hash). Before the first decision, the current checkpoint's
+    inputs (`Inputs.of_checkpoint`) stand for the last decision's: a checkpoint trained on the current
+    corpus is judged and calibrated, not trained again."""
     if previous is not None and previous.sha256 == current.sha256:
         return Change("unchanged")
+    if previous is not None and not previous.files and previous.corpus and previous.corpus == current.corpus:
+        return Change("ratings", new_ratings=True)  # a checkpoint trained on this very corpus, not yet judged
     if previous is None or not previous.files and not previous.ratings:
         return Change("first")
     old, new = previous.files, current.files

@@ -56,6 +56,15 @@ def test_a_change_names_its_files_and_a_first_decision_trains_in_full():
     assert restored == inputs({"a": "1"}, frames="f")
 
 
+def test_a_checkpoint_trained_on_the_current_corpus_is_judged_not_trained_again(tmp_path):
+    """Before the first retrain decision, the current checkpoint's corpus hash stands for the last inputs."""
+    (tmp_path / "provenance.json").write_text(json.dumps({"corpus_sha256": "c1"}))
+    baseline = Inputs.of_checkpoint(tmp_path)
+    now = Inputs("h", {"a": "1"}, ("r1",), None, "c1")
+    assert classify(baseline, now).action(has_checkpoint=True) == "recalibrate"
+    assert classify(baseline, Inputs("h", {"a": "2"}, ("r1",), None, "c2")).action(has_checkpoint=True) == "full"
+
+
 def write_recipes(path, numbers):
     path.write_text("".join(json.dumps(RECIPE).replace("{n}", str(n)) + "\n" for n in numbers), encoding="utf-8")
     return str(path)
