@@ -388,12 +388,30 @@ def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]
     return _first_known(parser, text, frames), doc
 
 
+def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
+    """How often the frame's verb states the roles the frame leaves open (the highest of their learned
+    rates; 0 for a hand-written predicate, which has none)."""
+    spec = lex.predicates.get(frame.predicate)
+    rates = spec.rates if spec is not None else {}
+    return max((rates.get(role, 0.0) for role, value in frame.roles.items() if value is None), default=0.0)
+
+
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
     known = [f for f in frames if f.known]
     if known:
         # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
-        # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do; else the first
-        return min(known, key=lambda f: (f.predicate in parser.lex.learned, not f.addressed, not f.missing()))
+        # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then what
+        # leaves open the role its verb states most often ("take the plates and put them": put states a
+        # destination far more often than take); else the first
+        return min(
+            known,
+            key=lambda f: (
+                f.predicate in parser.lex.learned,
+                not f.addressed,
+                not f.missing(),
+                -_open_rate(parser.lex, f),
+            ),
+        )
     refused = [f.predicate for f in frames if f.predicate in parser.lex.refused]
     if refused:
         name, seen = refused[0], parser.lex.refused[refused[0]]
