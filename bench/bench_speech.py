@@ -36,7 +36,7 @@ from lmcr.speech.domain_lm import tokenize  # noqa: E402
 from lmcr.speech.listen import understood_reading  # noqa: E402
 from lmcr.speech.recognize import Recognizer  # noqa: E402
 from lmcr.srl.evaluate import instruction_correct  # noqa: E402
-from lmcr.srl.parser import NoPredicateError, parse_instruction  # noqa: E402
+from lmcr.srl.instruction import NoPredicateError, parse_instruction  # noqa: E402
 from lmcr.workspace import Workspace  # noqa: E402
 
 

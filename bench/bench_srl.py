@@ -22,7 +22,8 @@ from record import add_json_option, write_results
 from lmcr.checkout import REPO_ROOT
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
-from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
+from lmcr.srl.instruction import NoPredicateError, parse_instruction
+from lmcr.srl.parser import load_parser
 from lmcr.workspace import Workspace
 
 

@@ -14,19 +14,19 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import re
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
+from lmcr.grounding import ground_roles, referents, served_vessel
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
-from lmcr.srl.context import antecedents, served_in, utterance_context
-from lmcr.srl.mentions import FrameMention
-from lmcr.srl.parser import FrameParser, read_instruction
+from lmcr.srl.context import utterance_context
+from lmcr.srl.instruction import read_instruction
+from lmcr.srl.parser import FrameParser
 
 
 class CompletionError(LMCRError, ValueError):
@@ -139,101 +139,6 @@ def _candidate_frames(missing: list[str], objects: list[str], open_roles: tuple[
     return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
 
 
-def _grounded(value: str, known: set[str]) -> str | None:
-    """The longest ending of a stated filler that names a known object ("leftover pizza" -> pizza: a
-    modifier the parser kept does not hide the object), or None."""
-    words = value.split()
-    return next((" ".join(words[i:]) for i in range(len(words)) if " ".join(words[i:]) in known), None)
-
-
-def _referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
-    """Pronoun roles that refer back to a detected object the instruction named before them ("I'd love
-    some wine, could you pour it?": Theme wine): the first of `antecedents` that names one and that no
-    other role states."""
-    seen, stated = set(detected), {v for v in frame.roles.values() if v and v not in parser.lex.object_pronouns}
-    referred: dict[str, str] = {}
-    for role in frame.roles:
-        for name in antecedents(doc, frame, role, parser.lex, parser.compounds):
-            obj = _grounded(name, seen)
-            if obj is not None and obj not in stated and obj not in referred.values():
-                referred[role] = obj
-                break
-    return referred
-
-
-def _served(
-    parser: FrameParser, doc, frame: FrameMention, detected: list[str], taken: dict[str, str]
-) -> dict[str, str]:
-    """The open role a vessel is poured into, filled with the vessel the request serves in ("pour me a
-    glass of water": Destination glass) when a detected object names it and no role states it."""
-    vessel = served_in(doc, frame, parser.lex)
-    obj = vessel and _grounded(vessel, set(detected))
-    if not obj or obj in frame.roles.values() or obj in taken.values():
-        return {}
-    template = parser.lex.predicates[frame.predicate].template(frame.roles)
-    into = [r for r, v in frame.roles.items() if v is None and r not in taken and f"into the {{{r}}}" in template]
-    return {into[0]: obj} if into else {}
-
-
-def _ground(
-    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str], said: str = ""
-) -> tuple[dict[str, str | None], dict[str, str]]:
-    """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
-    the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
-    objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept.
-    `said` is the instruction: an object whose whole label it says names the filler the parser cut
-    short ("put the tank top away": Theme 'tank')."""
-    if not vocabulary:
-        return roles, {}
-    seen, words = set(detected), set(vocabulary)
-
-    def ground(value: str) -> str | None:  # what the person sees first, then what the robot knows
-        found = _grounded(value, seen) or _named_by_head(value, detected) or _said_in_full(value, detected, said)
-        return found or _grounded(value, words)
-
-    grounded = {r: v and ground(v) for r, v in roles.items()}
-    unresolved = {r: v for r, v in roles.items() if v and grounded[r] is None}
-    return grounded, unresolved
-
-
-def _same_noun(word: str, other: str) -> bool:
-    """The same noun in either number: carrot / carrots, dish / dishes, patty / patties."""
-    if word == other:
-        return True
-    one, two = sorted((word, other), key=len)
-    return two in (one + "s", one + "es") or (one.endswith("y") and two == one[:-1] + "ies")
-
-
-def _named_by_head(value: str, detected: list[str]) -> str | None:
-    """The one detected object a stated filler names by its head word or its letters: "the chips" with
-    kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull, the lemma "carrot"
-    for the carrots; None when no object or several match (which of them is then the robot's question)."""
-    words = value.split()
-    squeezed = value.replace(" ", "")
-
-    def names(obj: str) -> bool:
-        label = obj.split()
-        if obj.replace(" ", "") == squeezed:
-            return True
-        if label[:-1] == words[:-1] and _same_noun(label[-1], words[-1]):  # the same name, another number
-            return True
-        return len(label) > 1 and _same_noun(label[-1], words[-1])
-
-    found = {o for o in detected if names(o)}
-    return found.pop() if len(found) == 1 else None
-
-
-def _said_in_full(value: str, detected: list[str], said: str) -> str | None:
-    """The longest detected object whose whole label the instruction says and whose words hold every
-    word of the filler ("stainless steel" in "put the stainless steel spoon away"), if only one is that
-    long."""
-    text = f" {' '.join(re.findall(r'[a-z0-9]+', said.lower()))} "
-    words = value.split()
-    found = [o for o in detected if f" {o} " in text and all(any(_same_noun(w, x) for x in o.split()) for w in words)]
-    longest = [o for o in found if len(o) == max(map(len, found))] if found else []
-    return longest[0] if len(longest) == 1 else None
-
-
 def _question(spec, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
     """'Should I pour milk into the bowl, the glass or the plate?': the predicate's sentence template with
     the choices in the missing slot (one missing role, the same for every choice), or one filled template
@@ -271,14 +176,14 @@ def complete(
     ids_of = ids_by_label([labels[k] for k in kept], [(ids or assign_ids(labels))[k] for k in kept])
     detected = list(ids_of)
     pronouns = parser.lex.object_pronouns
-    referred = _referents(parser, doc, frame, detected)
+    referred = referents(parser, doc, frame, detected)
     # "pour me a glass of water": the person asked for the glass as well as the water
-    served = _served(parser, doc, frame, detected, referred)
+    served = served_vessel(parser, doc, frame, detected, referred)
     # "pour it": who knows what, unless "it" points back to an object named before ("some wine")
     roles = {r: referred.get(r) or served.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
-    roles, unresolved = _ground(roles, parser.lex.objects, detected, instruction)
+    roles, unresolved = ground_roles(roles, parser.lex.objects, detected, instruction)
     # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
     # seen: the mug): its phrase is read as context, as the rest of the utterance is.
     context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""

@@ -10,7 +10,8 @@ from lmcr.complete import CompletionConfig, CompletionError, complete
 from lmcr.errors import one_line
 from lmcr.jsonl import InputError, read_jsonl
 from lmcr.scorers.registry import Scorer
-from lmcr.srl.parser import FrameParser, NoPredicateError
+from lmcr.srl.instruction import NoPredicateError
+from lmcr.srl.parser import FrameParser
 
 COMPLETE_FIELDS = {"id": (str, int), "instruction": str, "objects": list}  # a `lmcr complete --input` line
 

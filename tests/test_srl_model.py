@@ -25,15 +25,9 @@ from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import ingest_sources
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
+from lmcr.srl.instruction import NoPredicateError, parse_instruction
 from lmcr.srl.lemmas import LazyLemmas, lemma
-from lmcr.srl.parser import (
-    FIRST_WORDS_FILE,
-    FrameParser,
-    NoPredicateError,
-    load_parser,
-    parse_instruction,
-    read_first_words,
-)
+from lmcr.srl.parser import FIRST_WORDS_FILE, FrameParser, load_parser, read_first_words
 from lmcr.store import check_contracts, connect
 from lmcr.workspace import Workspace
 

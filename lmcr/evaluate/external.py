@@ -39,7 +39,8 @@ from lmcr.errors import one_line
 from lmcr.jsonl import InputError, check_text, read_jsonl
 from lmcr.lexicon import normalize_name as normalize
 from lmcr.scorers.registry import Scorer
-from lmcr.srl.parser import FrameParser, NoPredicateError
+from lmcr.srl.instruction import NoPredicateError
+from lmcr.srl.parser import FrameParser
 
 ITEM_FIELDS = {"id": (str, int), "instruction": str, "objects": list, "missing": str, "expected_any": list, "verb": str}
 # a preposition that introduces the Theme, which a predicate's name may leave off ("dispose of it")

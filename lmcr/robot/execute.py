@@ -29,7 +29,7 @@ from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
 from lmcr.robot.tasks import TASKS
 from lmcr.robot.world import build_world
-from lmcr.srl.parser import NoPredicateError
+from lmcr.srl.instruction import NoPredicateError
 
 MAX_TRIED = 4  # candidates planned at most, in the language model's order, to find one the robot can do
 MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (nearest first)

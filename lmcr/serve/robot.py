@@ -168,7 +168,7 @@ class ServedRobot:
         out of reach but another object is not."""
         from lmcr.robot.execute import execute
         from lmcr.robot.render import Recorder
-        from lmcr.srl.parser import read_instruction
+        from lmcr.srl.instruction import read_instruction
 
         text, labels = check_instruction(instruction), check_labels(objects)
         layout = make_layout(labels, seed)

@@ -8,7 +8,8 @@ from pathlib import Path
 
 from lmcr.jsonl import check_text, read_jsonl
 from lmcr.srl.evaluate import instruction_correct
-from lmcr.srl.parser import FrameParser, NoPredicateError, parse_instruction
+from lmcr.srl.instruction import NoPredicateError, parse_instruction
+from lmcr.srl.parser import FrameParser
 
 SRL_FIELDS = {"id": (str, int), "text": str}  # a `lmcr srl --input` line
 

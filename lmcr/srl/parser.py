@@ -20,9 +20,7 @@ import spacy
 from spacy.language import Language
 from spacy.tokens import Doc, Span, Token
 
-from lmcr.errors import LMCRError
 from lmcr.files import read_resource
-from lmcr.jsonl import check_text
 from lmcr.lexicon import PREDICATES_FILE, Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import LazyLemmas
@@ -328,10 +326,6 @@ class FrameParser:
         return split_off
 
 
-class NoPredicateError(LMCRError, ValueError):
-    """An instruction with none of the robot's predicates."""
-
-
 COMPOUNDS_FILE = "compounds.json"
 PRIORS_FILE = "role_priors.json"
 FIRST_WORDS_FILE = "first_words.json"  # the table the frame build's shards started from
@@ -374,54 +368,3 @@ def _first_word_table(value: object) -> dict[str, list[int]]:
 def read_first_words(path: Path) -> dict[str, list[int]]:
     """The first-word table the frame build published (`FIRST_WORDS_FILE`)."""
     return read_resource(path, "first-word table", _first_word_table)
-
-
-def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
-    """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
-    parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
-    return _first_known(parser, text, parser.parse(check_text(text, "instruction")))
-
-
-def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]:
-    """`parse_instruction`'s frame and the instruction's Doc (for the rest of what it says)."""
-    frames, doc = parser.parse_with_doc(check_text(text, "instruction"))
-    return _first_known(parser, text, frames), doc
-
-
-def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
-    """How often the frame's verb states the roles the frame leaves open (the highest of their learned
-    rates; 0 for a hand-written predicate, which has none)."""
-    spec = lex.predicates.get(frame.predicate)
-    rates = spec.rates if spec is not None else {}
-    return max((rates.get(role, 0.0) for role, value in frame.roles.items() if value is None), default=0.0)
-
-
-def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
-    known = [f for f in frames if f.known]
-    if known:
-        # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
-        # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then what
-        # leaves open the role its verb states most often ("take the plates and put them": put states a
-        # destination far more often than take); else the first
-        return min(
-            known,
-            key=lambda f: (
-                f.predicate in parser.lex.learned,
-                not f.addressed,
-                not f.missing(),
-                -_open_rate(parser.lex, f),
-            ),
-        )
-    refused = [f.predicate for f in frames if f.predicate in parser.lex.refused]
-    if refused:
-        name, seen = refused[0], parser.lex.refused[refused[0]]
-        raise NoPredicateError(
-            f"no known predicate in {text!r}: the corpora say too little about {name!r} to learn what it needs"
-            f" ({seen:,} frames)"
-        )
-    if parser.lex.learned:
-        raise NoPredicateError(
-            f"no known predicate in {text!r}: none of the {len(parser.lex.predicates):,} verbs the robot learned"
-            " from its corpora (`lmcr predicates` lists them)"
-        )
-    raise NoPredicateError(f"no known predicate in {text!r}: the robot can {', '.join(parser.lex.hand_written)}")

@@ -1,0 +1,107 @@
+"""Grounding what an instruction says in what the robot sees: a stated filler names a detected object (by
+its label, its label's last words, the same noun in either number, its head word, or the whole label said
+in the instruction) or a word of the robot's object vocabulary; a pronoun names an object said before it;
+"a glass of water" names the glass it is served in."""
+
+from __future__ import annotations
+
+import re
+
+from lmcr.srl.context import antecedents, served_in
+from lmcr.srl.mentions import FrameMention
+from lmcr.srl.parser import FrameParser
+
+
+def grounded(value: str, known: set[str]) -> str | None:
+    """The longest ending of a stated filler that names a known object ("leftover pizza" -> pizza: a
+    modifier the parser kept does not hide the object), or None."""
+    words = value.split()
+    return next((" ".join(words[i:]) for i in range(len(words)) if " ".join(words[i:]) in known), None)
+
+
+def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
+    """Pronoun roles that refer back to a detected object the instruction named before them ("I'd love
+    some wine, could you pour it?": Theme wine): the first of `antecedents` that names one and that no
+    other role states."""
+    seen, stated = set(detected), {v for v in frame.roles.values() if v and v not in parser.lex.object_pronouns}
+    referred: dict[str, str] = {}
+    for role in frame.roles:
+        for name in antecedents(doc, frame, role, parser.lex, parser.compounds):
+            obj = grounded(name, seen)
+            if obj is not None and obj not in stated and obj not in referred.values():
+                referred[role] = obj
+                break
+    return referred
+
+
+def served_vessel(
+    parser: FrameParser, doc, frame: FrameMention, detected: list[str], taken: dict[str, str]
+) -> dict[str, str]:
+    """The open role a vessel is poured into, filled with the vessel the request serves in ("pour me a
+    glass of water": Destination glass) when a detected object names it and no role states it."""
+    vessel = served_in(doc, frame, parser.lex)
+    obj = vessel and grounded(vessel, set(detected))
+    if not obj or obj in frame.roles.values() or obj in taken.values():
+        return {}
+    template = parser.lex.predicates[frame.predicate].template(frame.roles)
+    into = [r for r, v in frame.roles.items() if v is None and r not in taken and f"into the {{{r}}}" in template]
+    return {into[0]: obj} if into else {}
+
+
+def ground_roles(
+    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str], said: str = ""
+) -> tuple[dict[str, str | None], dict[str, str]]:
+    """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
+    the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
+    objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept.
+    `said` is the instruction: an object whose whole label it says names the filler the parser cut
+    short ("put the tank top away": Theme 'tank')."""
+    if not vocabulary:
+        return roles, {}
+    seen, words = set(detected), set(vocabulary)
+
+    def ground(value: str) -> str | None:  # what the person sees first, then what the robot knows
+        found = grounded(value, seen) or named_by_head(value, detected) or said_in_full(value, detected, said)
+        return found or grounded(value, words)
+
+    named = {r: v and ground(v) for r, v in roles.items()}
+    unresolved = {r: v for r, v in roles.items() if v and named[r] is None}
+    return named, unresolved
+
+
+def same_noun(word: str, other: str) -> bool:
+    """The same noun in either number: carrot / carrots, dish / dishes, patty / patties."""
+    if word == other:
+        return True
+    one, two = sorted((word, other), key=len)
+    return two in (one + "s", one + "es") or (one.endswith("y") and two == one[:-1] + "ies")
+
+
+def named_by_head(value: str, detected: list[str]) -> str | None:
+    """The one detected object a stated filler names by its head word or its letters: "the chips" with
+    kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull, the lemma "carrot"
+    for the carrots; None when no object or several match (which of them is then the robot's question)."""
+    words = value.split()
+    squeezed = value.replace(" ", "")
+
+    def names(obj: str) -> bool:
+        label = obj.split()
+        if obj.replace(" ", "") == squeezed:
+            return True
+        if label[:-1] == words[:-1] and same_noun(label[-1], words[-1]):  # the same name, another number
+            return True
+        return len(label) > 1 and same_noun(label[-1], words[-1])
+
+    found = {o for o in detected if names(o)}
+    return found.pop() if len(found) == 1 else None
+
+
+def said_in_full(value: str, detected: list[str], said: str) -> str | None:
+    """The longest detected object whose whole label the instruction says and whose words hold every
+    word of the filler ("stainless steel" in "put the stainless steel spoon away"), if only one is that
+    long."""
+    text = f" {' '.join(re.findall(r'[a-z0-9]+', said.lower()))} "
+    words = value.split()
+    found = [o for o in detected if f" {o} " in text and all(any(same_noun(w, x) for x in o.split()) for w in words)]
+    longest = [o for o in found if len(o) == max(map(len, found))] if found else []
+    return longest[0] if len(longest) == 1 else None
