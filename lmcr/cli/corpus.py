@@ -20,6 +20,7 @@ from lmcr.cli.common import (
     fail,
     note,
     one_or_batch,
+    open_store,
     print_rows,
     progress_bar,
     write_batch,
@@ -61,24 +62,25 @@ def ingest(
     ws = Workspace.from_env(db=db)
     started = time.perf_counter()
     sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt, encoding)
-    con = ws.connect()
-    for row in remove_sources(con, remove) if remove else []:
-        console.print(f"removed {row['source_file']}: {row['sentences']:,} sentences")
-    with progress_bar("ingesting sources", len(sources)) as progress:
-        loaded, skipped = ingest_sources(
-            con,
-            sources,
-            ws.staging,
-            workers,
-            on_loaded=lambda s: (
-                advance(progress)
-                or progress.console.print(
-                    f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"
-                )
-            ),
-        )
-        advance(progress, len(skipped))
-    summary = corpus_summary(con, ws.sql_dir)
+    with ws.connect() as con:  # closed on every exit: a CLI called in-process must not leave the store open
+        for row in remove_sources(con, remove) if remove else []:
+            console.print(f"removed {row['source_file']}: {row['sentences']:,} sentences")
+        with progress_bar("ingesting sources", len(sources)) as progress:
+            loaded, skipped = ingest_sources(
+                con,
+                sources,
+                ws.staging,
+                workers,
+                on_loaded=lambda s: (
+                    advance(progress)
+                    or progress.console.print(
+                        f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, "
+                        f"{s.records_quarantined} quarantined"
+                    )
+                ),
+            )
+            advance(progress, len(skipped))
+        summary = corpus_summary(con, ws.sql_dir)
     elapsed = time.perf_counter() - started
     print_rows(f"corpus in {ws.db}", summary)
     words = sum(s.words for s in loaded)
@@ -106,7 +108,7 @@ def frames(
         shard_size=shard_size,
         model=model or ws.spacy_model,
     )
-    con = ws.connect()
+    con = open_store(ws)
     with progress_bar("parsing shards", None) as progress:  # its total: the shards of new texts (on_start)
         build = build_frame_corpus(
             con,
@@ -149,7 +151,7 @@ def predicates(
     ws = Workspace.from_env(db=db)
     if not ws.db.exists():
         fail(f"{ws.db}: no store yet (run `lmcr ingest`, then `lmcr frames`)")
-    con = ws.connect()
+    con = open_store(ws)
     build = last_build(con)
     if build is None:
         fail(f"{ws.db}: no frame corpus yet (run `lmcr frames`)")

@@ -9,7 +9,7 @@ from typing import Literal
 import typer
 
 from lmcr.annotate.hits import HitSettings
-from lmcr.cli.common import MTURK_SECONDS, SEED, app, console, fail, print_rows, split_names
+from lmcr.cli.common import MTURK_SECONDS, SEED, app, console, fail, open_store, print_rows, split_names
 from lmcr.workspace import Workspace
 
 annotate_app = typer.Typer(
@@ -28,7 +28,7 @@ def annotate_ingest(
     from lmcr.store import check_contracts
 
     ws = Workspace.from_env(db=db)
-    con = ws.connect()
+    con = open_store(ws)
     rows = [ingest_ratings(con, path) for path in results]
     check_contracts(con, ws.sql_dir, "ratings")
     for r in rows:
@@ -107,7 +107,7 @@ def annotate_tasks(
         locale=locale,
     )
     scorers = {m: ws.scorer(m) for m in split_names(methods)} if mode == "disagreement" else None
-    meta = generate_tasks(ws.connect(), out, config, scorers, settings)
+    meta = generate_tasks(open_store(ws), out, config, scorers, settings)
     console.print(
         f"{meta['frames']:,} frames in {meta['hits']:,} HITs ({meta['gold_items']} gold items of "
         f"{meta['gold_available']} available) -> {out / 'batch.csv'}; check {out / 'preview.html'}"
@@ -130,7 +130,7 @@ def annotate_quality(
     from lmcr.files import atomic_path
 
     ws = Workspace.from_env(db=db)
-    con = ws.connect()
+    con = open_store(ws)
     if not con.execute("select count(*) from ratings").fetchone()[0]:
         fail(f"no ratings in {ws.db}: run `lmcr annotate ingest RESULTS.csv` first")
     print_rows(
