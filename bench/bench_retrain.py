@@ -75,6 +75,9 @@ def main() -> int:
     args = parser.parse_args()
     if not args.data_dir:
         parser.error("give --data-dir or set LMCR_DATA_DIR")
+    for path in (args.ratings, args.add_recipes):
+        if path is not None and not path.is_file():
+            parser.error(f"{path}: no such file")
     os.environ.setdefault("PREFECT_SERVER_ANALYTICS_ENABLED", "false")  # no telemetry from an offline host
     figures = {}
     try:

@@ -33,6 +33,7 @@ from lmcr.evaluate.protocol import EvalConfig, score_rated
 from lmcr.evaluate.ratings import RatedFrame
 from lmcr.evaluate.run import calibrate_completion
 from lmcr.evaluate.scenarios import ScenarioError, accuracy, build_scenarios
+from lmcr.frame_corpus.load import last_build
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm.corpus import corpus_hash
 from lmcr.lm.hyperparams import LMConfig, TrainConfig, WarmStartConfig
@@ -84,8 +85,7 @@ class Inputs:
     def read(cls, con: duckdb.DuckDBPyConnection, linearization: str) -> Inputs:
         files = dict(con.execute("select source_file, sha256 from ingested_files order by all").fetchall())
         ratings = tuple(r for (r,) in con.execute("select sha256 from rating_files order by 1").fetchall())
-        build = con.execute("select fingerprint from frame_builds order by built_at desc limit 1").fetchone()
-        frames = build[0] if build and linearization == "frame" else None
+        frames = last_build(con) if linearization == "frame" else None
         return cls(inputs_sha256(con, linearization), files, ratings, frames, corpus_hash(con, linearization))
 
     @classmethod
@@ -213,7 +213,7 @@ def train_candidate(
     else a full training; published without promotion."""
     started = time.perf_counter()
     why = change.describe()
-    if change.action(has_checkpoint=(checkpoints / setting.name / "LATEST").exists()) == "warm_start":
+    if change.action(has_checkpoint=current_checkpoint(checkpoints, setting) is not None) == "warm_start":
         warm_start = continue_setting(open_store, checkpoints, setting, change.new_sources, warm, on_epoch)
         if warm_start.path is not None:
             return _candidate(warm_start.path, "warm_start", f"{why}: {warm_start.reason}", started)

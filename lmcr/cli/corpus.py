@@ -62,25 +62,24 @@ def ingest(
     ws = Workspace.from_env(db=db)
     started = time.perf_counter()
     sources = expand_corpora({"youcook2": youcook2, "recipes": recipes, "household": household}, fmt, encoding)
-    with ws.connect() as con:  # closed on every exit: a CLI called in-process must not leave the store open
-        for row in remove_sources(con, remove) if remove else []:
-            console.print(f"removed {row['source_file']}: {row['sentences']:,} sentences")
-        with progress_bar("ingesting sources", len(sources)) as progress:
-            loaded, skipped = ingest_sources(
-                con,
-                sources,
-                ws.staging,
-                workers,
-                on_loaded=lambda s: (
-                    advance(progress)
-                    or progress.console.print(
-                        f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, "
-                        f"{s.records_quarantined} quarantined"
-                    )
-                ),
-            )
-            advance(progress, len(skipped))
-        summary = corpus_summary(con, ws.sql_dir)
+    con = open_store(ws)
+    for row in remove_sources(con, remove) if remove else []:
+        console.print(f"removed {row['source_file']}: {row['sentences']:,} sentences")
+    with progress_bar("ingesting sources", len(sources)) as progress:
+        loaded, skipped = ingest_sources(
+            con,
+            sources,
+            ws.staging,
+            workers,
+            on_loaded=lambda s: (
+                advance(progress)
+                or progress.console.print(
+                    f"loaded {Path(s.source_file).name}: {s.sentences:,} sentences, {s.records_quarantined} quarantined"
+                )
+            ),
+        )
+        advance(progress, len(skipped))
+    summary = corpus_summary(con, ws.sql_dir)
     elapsed = time.perf_counter() - started
     print_rows(f"corpus in {ws.db}", summary)
     words = sum(s.words for s in loaded)

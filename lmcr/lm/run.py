@@ -80,7 +80,9 @@ def train_setting(
         "min_freq": min_freq,
         "max_vocab": max_vocab,
     }
-    return _publish_run(open_store, checkpoints, setting, model, vocab, text, history, provenance, promote)
+    return _publish_run(
+        open_store, checkpoints, setting, model, vocab, text, history, provenance, train_config.articles, promote
+    )
 
 
 @dataclass(frozen=True)
@@ -140,7 +142,9 @@ def continue_setting(
             **config.to_json(),
         },
     }
-    path = _publish_run(open_store, checkpoints, setting, model, base.vocab, text, history, provenance, promote=False)
+    path = _publish_run(
+        open_store, checkpoints, setting, model, base.vocab, text, history, provenance, base.articles, promote=False
+    )
     reason = f"continued {base.path.name} on {len(new):,} new and {len(replayed):,} old sequences"
     return WarmStart(path, change, reason)
 
@@ -165,9 +169,11 @@ def _publish_run(
     text: TrainingText,
     history: list[dict],
     provenance: dict,
+    articles: bool,
     promote: bool,
 ) -> Path:
-    """Publish a trained model with its metrics and provenance, record the run, promote when asked."""
+    """Publish a trained model with its metrics and provenance (`articles`: whether its text kept a/an/the),
+    record the run, promote when asked."""
     run_id = uuid.uuid4().hex[:12]
     metrics = {
         "best_val_ppl": min(row["val_ppl"] for row in history),
@@ -184,7 +190,6 @@ def _publish_run(
     }
     # Publish unpromoted, record the run, then promote: LATEST never names a version without its
     # lm_runs row, whatever fails or is killed in between.
-    articles = TrainConfig(**provenance["train_config"]).articles
     path = ckpt.publish(checkpoints, setting, model.cpu(), vocab, metrics, provenance, promote=False, articles=articles)
     with open_store() as con:
         record_run(con, run_id, text, len(vocab), history, path)
