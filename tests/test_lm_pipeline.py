@@ -8,6 +8,7 @@ from contextlib import nullcontext
 import pytest
 from typer.testing import CliRunner
 
+from lmcr.checkout import REPO_ROOT
 from lmcr.cli import app
 from lmcr.frame_corpus.build import build_frame_corpus, process_pool
 from lmcr.frame_corpus.config import FrameCorpusConfig
@@ -96,7 +97,28 @@ def test_train_publish_and_score(sample_store, tmp_path, monkeypatch):
     rows = list(csv.DictReader(out.open()))
     assert float(rows[0]["cooccur"]) > 0 and -3 <= float(rows[0]["word2vec"]) <= 0  # the sample pours water into cups
     assert list((paths.baselines).glob("word2vec-all-*.bin"))  # cached by corpus hash
+    commonsense_column(tmp_path, out, paths, monkeypatch)
     complete_contract(tmp_path)
+
+
+def commonsense_column(tmp_path, out, paths, monkeypatch):
+    """`lmcr score` with the commonsense term: the model trained on the sample's ConceptNet once, cached
+    beside the store, and the term centred over the frames that fill the same roles."""
+    frames = tmp_path / "pour.csv"
+    frames.write_text(
+        "verb,role1,arg1,role2,arg2\npour,Theme,water,Destination,cup\npour,Theme,water,Destination,scissors\n"
+    )
+    edges = REPO_ROOT / "data" / "sample" / "conceptnet" / "edges.txt"
+    args = ["score", "--frames", str(frames), "--out", str(out), "--methods", "frame_counts,frame_counts+commonsense"]
+    result = runner.invoke(app, [*args, "--conceptnet", str(edges), "--vectors", "corpus"])
+    assert result.exit_code == 0, result.output
+    rows = list(csv.DictReader(out.open()))
+    terms = [float(r["frame_counts+commonsense"]) - float(r["frame_counts"]) for r in rows]
+    assert terms[0] == pytest.approx(-terms[1], abs=1e-4) and terms[0] != 0
+    assert len(list(paths.baselines.glob("commonsense-*.pt"))) == 1
+    monkeypatch.delenv("LMCR_CONCEPTNET", raising=False)
+    without = runner.invoke(app, args)
+    assert without.exit_code == 1 and "commonsense needs" in without.output
 
 
 def complete_contract(tmp_path):

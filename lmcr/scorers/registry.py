@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from lmcr.files import file_sha256
 from lmcr.lexicon import load_lexicon
-from lmcr.scorers.caches import count_cache, word_vectors
+from lmcr.scorers.caches import cache_dir, count_cache, word_vectors
 from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir, load_lm
 from lmcr.scorers.resources import (
     MethodResources,
@@ -160,9 +160,9 @@ def _word2vec(res: MethodResources) -> Scorer:
     return VectorScorer(load_vectors(word_vectors(res))).score_frames
 
 
-def _conceptnet_edges(res: MethodResources) -> Path:
+def _conceptnet_edges(res: MethodResources, method: str = "conceptnet") -> Path:
     if res.conceptnet is None:
-        raise MethodUnavailable("conceptnet needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
+        raise MethodUnavailable(f"{method} needs an edge list or Numberbatch file (--conceptnet / $LMCR_CONCEPTNET)")
     return res.conceptnet
 
 
@@ -179,6 +179,24 @@ def _conceptnet_retrofit(res: MethodResources) -> Scorer:
 
     retrofitted = VectorScorer(retrofit(read_edges(_conceptnet_edges(res)), load_vectors(word_vectors(res))))
     return relatedness(retrofitted.vector)
+
+
+def _commonsense(res: MethodResources) -> Scorer:
+    import sys
+
+    from lmcr.scorers.commonsense import WEIGHT, commonsense_scorer, trained_model
+
+    progress = lambda line: print(line, file=sys.stderr)  # noqa: E731 - training shows its epochs
+    model = trained_model(_conceptnet_edges(res, "commonsense"), word_vectors(res), cache_dir(res), progress)
+    return commonsense_scorer(model, WEIGHT)
+
+
+def _commonsense_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.commonsense import WEIGHT, KBCConfig, hash_config
+
+    edges = _conceptnet_edges(res, "commonsense")
+    edges = edges / "train.txt" if edges.is_dir() else edges
+    return f"{file_sha256(edges)}+{file_sha256(word_vectors(res))}*{WEIGHT:g}/{hash_config(KBCConfig())}"
 
 
 def _random(res: MethodResources) -> Scorer:
@@ -201,13 +219,14 @@ SCORERS: dict[str, ScorerSpec] = {
     "conceptnet": ScorerSpec(_conceptnet),
     "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
+    "commonsense": ScorerSpec(_commonsense, _commonsense_fingerprint),  # a term, as rarity
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
     "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
 
 
 METHODS = tuple(SCORERS)
-TERMS = ("rarity", "context_pmi")  # added to methods ('a+rarity'), not compared as methods of their own
+TERMS = ("rarity", "context_pmi", "commonsense")  # added to methods ('a+rarity'), not compared as methods of their own
 # what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
 # its third expert
 EVALUATED = (

@@ -42,22 +42,27 @@ class ConceptNetFileError(LMCRError, ValueError):
     """A ConceptNet edge file that cannot be read, or a line that is no edge."""
 
 
-def read_edges(path: Path) -> list[tuple[str, str, float]]:
-    """(head, tail, weight) from `relation<TAB>head<TAB>tail[<TAB>...]` lines (cn100k, file or folder:
+def _relation(name: str) -> str:
+    """'/r/AtLocation' -> 'AtLocation'; a cn100k name as it is."""
+    return name.rsplit("/", 1)[-1] if name.startswith("/r/") else name
+
+
+def read_triples(path: Path) -> list[tuple[str, str, str]]:
+    """(relation, head, tail) from `relation<TAB>head<TAB>tail[<TAB>...]` lines (cn100k, file or folder:
     its `train.txt`) or ConceptNet assertion CSVs (`uri, rel, /c/en/.., /c/en/.., json`), `.gz` allowed.
     Edges of other languages are left out; a line with fewer than three fields is an error naming it."""
     path = Path(path)
     if path.is_dir():
         path = path / "train.txt"
     opener = gzip.open if path.suffix == ".gz" else open
-    edges = []
+    triples = []
     try:
         with opener(path, "rt", encoding="utf-8") as handle:
             for line, row in enumerate(csv.reader(handle, delimiter="\t", quoting=csv.QUOTE_NONE), 1):
                 if len(row) >= 5 and row[2].startswith("/c/"):  # assertions: uri, rel, start, end, info
-                    head, tail = _concept(row[2]), _concept(row[3])
+                    relation, head, tail = _relation(row[1]), _concept(row[2]), _concept(row[3])
                 elif len(row) >= 3:
-                    head, tail = _concept(row[1]), _concept(row[2])
+                    relation, head, tail = _relation(row[0]), _concept(row[1]), _concept(row[2])
                 elif not row:
                     continue  # a blank line
                 else:
@@ -65,12 +70,17 @@ def read_edges(path: Path) -> list[tuple[str, str, float]]:
                         f"{path}:{line}: {len(row)} tab-separated field(s); an edge is relation, head, tail"
                     )
                 if head and tail and head != tail:
-                    edges.append((head, tail, 1.0))
+                    triples.append((relation, head, tail))
     except (OSError, EOFError, UnicodeDecodeError, csv.Error) as exc:
         raise ConceptNetFileError(f"{path}: not a readable ConceptNet edge file: {one_line(exc, 200)}") from exc
-    if not edges:
+    if not triples:
         raise ConceptNetFileError(f"{path}: no English ConceptNet edges found")
-    return edges
+    return triples
+
+
+def read_edges(path: Path) -> list[tuple[str, str, float]]:
+    """(head, tail, weight 1) of every English edge of `path` (see `read_triples`), relations left out."""
+    return [(head, tail, 1.0) for _, head, tail in read_triples(path)]
 
 
 def embed_graph(
