@@ -11,13 +11,12 @@ seconds it took.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
-from record import add_json_option, write_results
+from record import add_json_option, run_or_exit, write_results
 
-from lmcr.errors import LMCRError
+from lmcr.errors import one_line
 from lmcr.jsonl import InputError
 from lmcr.scorers.baselines.vectors import installed_glove
 from lmcr.scorers.commonsense import accuracy, best_threshold, trained_model
@@ -25,8 +24,12 @@ from lmcr.scorers.commonsense import accuracy, best_threshold, trained_model
 
 def read_labelled(path: Path) -> list[tuple[str, str, str, bool]]:
     """(relation, head, tail, true?) of each `relation<TAB>head<TAB>tail<TAB>0|1` line."""
+    try:
+        text_lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not a readable labelled triple file: {one_line(exc, 200)}") from exc
     out = []
-    for line, text in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+    for line, text in enumerate(text_lines, 1):
         fields = text.split("\t")
         if len(fields) != 4 or fields[3] not in ("0", "1"):
             raise InputError(f"{path}:{line}: expected relation, head, tail and a 0/1 label")
@@ -42,10 +45,7 @@ def main() -> None:
     parser.add_argument("--cache", type=Path, default=Path("build/commonsense"), help=cache_help)
     add_json_option(parser, "bench_commonsense")
     args = parser.parse_args()
-    try:
-        run(args)
-    except LMCRError as exc:
-        sys.exit(f"error: {exc}")
+    run_or_exit(run, args)
 
 
 def run(args: argparse.Namespace) -> None:

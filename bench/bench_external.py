@@ -15,12 +15,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
-from record import add_json_option, write_results
+from record import add_json_option, run_or_exit, write_results
 
-from lmcr.errors import LMCRError
 from lmcr.evaluate.external import read_sets, run_set, summarize
 from lmcr.files import check_output_file
 from lmcr.jsonl import InputError, write_jsonl_atomic
@@ -87,10 +85,7 @@ def main() -> None:
     parser_.add_argument("--out-jsonl", type=Path, default=None, help="one line per item: completion and outcome")
     add_json_option(parser_, "bench_external")
     args = parser_.parse_args()
-    try:
-        run(args)
-    except LMCRError as exc:
-        sys.exit(f"error: {exc}")
+    run_or_exit(run, args)
 
 
 def run(args: argparse.Namespace) -> None:

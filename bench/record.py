@@ -15,8 +15,11 @@ import platform
 import shlex
 import subprocess
 import sys
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
+
+from lmcr.errors import LMCRError
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 RESULTS_DIR = REPO_ROOT / "bench" / "results"
@@ -30,6 +33,14 @@ def add_json_option(parser: argparse.ArgumentParser, name: str) -> None:
         default=str(RESULTS_DIR / f"{name}.json"),
         help=f"write the figures, command and date here (default bench/results/{name}.json; '' for none)",
     )
+
+
+def run_or_exit(run: Callable[[argparse.Namespace], None], args: argparse.Namespace) -> None:
+    """`run(args)`; a project error (bad input, a missing store) ends the benchmark with its one line."""
+    try:
+        run(args)
+    except LMCRError as exc:
+        sys.exit(f"error: {exc}")
 
 
 def command_line() -> str:

@@ -137,3 +137,10 @@ def test_the_model_is_trained_once_per_edge_and_vector_file(tmp_path):
     edges.write_text("\n".join(EDGES[:4]) + "\n")
     trained_model(edges, vectors, tmp_path / "cache", epochs.append, SMALL)
     assert len(epochs) == 2 * SMALL.epochs  # a changed edge file is a new model
+    for missing in (tmp_path / "none.txt", tmp_path / "empty-folder"):
+        (tmp_path / "empty-folder").mkdir(exist_ok=True)
+        with pytest.raises(ValueError, match="cannot be read") as err:
+            trained_model(missing, vectors, tmp_path / "cache", epochs.append, SMALL)
+        assert "\n" not in str(err.value)
+    with pytest.raises(ValueError, match="vectors.bin: cannot be read"):
+        trained_model(edges, tmp_path / "vectors.bin", tmp_path / "cache", epochs.append, SMALL)

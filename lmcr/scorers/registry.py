@@ -192,11 +192,9 @@ def _commonsense(res: MethodResources) -> Scorer:
 
 
 def _commonsense_fingerprint(res: MethodResources) -> str:
-    from lmcr.scorers.commonsense import WEIGHT, KBCConfig, hash_config
+    from lmcr.scorers.commonsense import WEIGHT, model_digest
 
-    edges = _conceptnet_edges(res, "commonsense")
-    edges = edges / "train.txt" if edges.is_dir() else edges
-    return f"{file_sha256(edges)}+{file_sha256(word_vectors(res))}*{WEIGHT:g}/{hash_config(KBCConfig())}"
+    return f"{model_digest(_conceptnet_edges(res, 'commonsense'), word_vectors(res))}*{WEIGHT:g}"
 
 
 def _random(res: MethodResources) -> Scorer:

@@ -47,13 +47,17 @@ def _relation(name: str) -> str:
     return name.rsplit("/", 1)[-1] if name.startswith("/r/") else name
 
 
+def edge_file(path: Path) -> Path:
+    """The file an edge path names: a folder's `train.txt` (cn100k), else the path itself."""
+    path = Path(path)
+    return path / "train.txt" if path.is_dir() else path
+
+
 def read_triples(path: Path) -> list[tuple[str, str, str]]:
     """(relation, head, tail) from `relation<TAB>head<TAB>tail[<TAB>...]` lines (cn100k, file or folder:
     its `train.txt`) or ConceptNet assertion CSVs (`uri, rel, /c/en/.., /c/en/.., json`), `.gz` allowed.
     Edges of other languages are left out; a line with fewer than three fields is an error naming it."""
-    path = Path(path)
-    if path.is_dir():
-        path = path / "train.txt"
+    path = edge_file(path)
     opener = gzip.open if path.suffix == ".gz" else open
     triples = []
     try:
