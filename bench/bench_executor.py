@@ -1,10 +1,15 @@
-"""Benchmark: the Baxter executor on random table layouts, per predicate.
+"""Benchmark: the Baxter executor on random table layouts, per predicate and per motion of the learned verbs.
 
-Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill]
+Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill,place]
        [--urdf PATH] [--holding] [--videos DIR] [--json PATH]
-For each of the 11 predicates, an incomplete instruction on `--placements` random layouts: the two
-objects the frame needs plus `--distractors` random other objects (obstacles, and other candidates for
-the completion), placed at random with a seed. With `--holding` the stated object starts in the robot's
+For each of the 11 predicates, and for a learned verb of each motion that puts a Theme at a Destination
+(place: put away on a shelf, or in a drawer that is opened and shut; dispose: throw out into a bin; hand
+over: hand to a person), and of each class that works with a tool (stir the soup with a spoon, wipe the
+cutting board with a sponge), an incomplete
+instruction on `--placements` random layouts: the two objects the frame needs plus `--distractors` random
+other objects (obstacles, and other candidates for the completion; for the learned verbs drawn from the
+household's receptacles too), placed at random with a seed. The learned verbs need a frame build that
+learned them ($LMCR_DATA_DIR). With `--holding` the stated object starts in the robot's
 hand instead of on the table (for fill and season it is the target: the robot puts it down first).
 The task's own object is given as the answer, so the run measures execution; how often the language
 model (the published checkpoint of $LMCR_DATA_DIR) would have chosen another object is counted beside it.
@@ -30,7 +35,7 @@ from lmcr.jsonl import InputError
 from lmcr.lexicon import load_lexicon
 from lmcr.robot.execute import execute
 from lmcr.robot.render import VIDEO_EVERY, Recorder
-from lmcr.robot.scene import make_scene
+from lmcr.robot.scene import make_scene, robot_objects
 from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
 
@@ -47,8 +52,18 @@ TASKS = {
     "dip": ("dip the strawberry", "strawberry", "chocolate", "Destination"),
     "brush": ("brush the oil", "oil", "bread", "Destination"),
     "rub": ("rub the salt", "salt", "steak", "Destination"),
+    # the motions of the learned verbs, by the Destination's kind (lmcr/robot/household.json)
+    "place": ("put the apple away", "apple", "shelf", "Destination"),
+    "place in a drawer": ("put the apple away", "apple", "drawer", "Destination"),
+    "dispose": ("throw out the banana", "banana", "trash can", "Destination"),
+    "hand over": ("hand me the knife", "knife", "person", "Destination"),
+    # ... and of the learned verbs whose class works with a tool (the Instrument) on the Theme
+    "stir": ("stir the soup", "soup", "spoon", "Instrument"),
+    "wipe": ("wipe the cutting board", "cutting board", "sponge", "Instrument"),
 }
-HELD_IS_STATED = {"pour", "sprinkle", "heat", "fry", "blend", "dump", "dip", "brush", "rub"}
+LEARNED = {"place", "place in a drawer", "dispose", "hand over", "stir", "wipe"}  # distractors: receptacles too
+TOOLS = {"stir", "wipe"}  # the tool is held: the object filled in, not the one stated
+HELD_IS_STATED = {"pour", "sprinkle", "heat", "fry", "blend", "dump", "dip", "brush", "rub", *LEARNED} - TOOLS
 
 
 def failure_reason(out: dict, held: str, target: str) -> str:
@@ -124,6 +139,7 @@ def main() -> None:
     scorer, config = ws.completion_scorer(args.method)
     nlp = ws.parser()
     objects = load_lexicon().objects
+    household_too = sorted(robot_objects())
     times, slowest, reasons, refusals = [], [], collections.Counter(), collections.Counter()
     totals, per_predicate = collections.Counter(), {}
     for predicate in args.predicates.split(","):
@@ -134,7 +150,7 @@ def main() -> None:
                 f"{args.seed}:{predicate}:{k}",
                 stated,
                 expected,
-                objects,
+                household_too if predicate in LEARNED else objects,
                 args.distractors,
                 stated if args.holding else None,
             )
@@ -170,7 +186,7 @@ def main() -> None:
         totals.update(row)
         per_predicate[f"{predicate}: succeeded"] = f"{row['ok']}/{args.placements}"
         print(
-            f"{predicate:9s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
+            f"{predicate:17s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
             f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "
             f"would have chosen another object than {expected!r} {row['other_choice']} times",
             flush=True,

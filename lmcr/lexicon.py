@@ -59,6 +59,8 @@ class PredicateSpec:
     alternatives: dict[str, str] = field(default_factory=dict)
     # how often each open role is stated with it (a learned predicate's valence; empty for the eleven)
     rates: dict[str, float] = field(default_factory=dict)
+    # a learned predicate's class of motion, learned from its fillers ("place", "stir", ...; frame_corpus.predicates)
+    motion: str | None = None
 
     def open_role_prior(self, role: str) -> float:
         """log of how much likelier a request leaves `role` open than the second role, by how often each is
@@ -136,6 +138,7 @@ def _spec(name: str, spec: dict) -> PredicateSpec:
         past=spec.get("past"),
         alternatives=dict(spec.get("alternatives") or {}),
         rates={role: float(rate) for role, rate in (spec.get("rates") or {}).items()},
+        motion=spec.get("motion"),
     )
 
 
@@ -181,6 +184,8 @@ def _learned_table(value: object) -> dict:
             raise ValueError(f"predicate {name!r} has no spec with two roles")
         if not isinstance(spec.get("sentence"), str) or not isinstance(spec.get("object"), str):
             raise ValueError(f"predicate {name!r} has no sentence template or object role")
+        if not isinstance(spec.get("motion"), (str, type(None))):
+            raise ValueError(f"predicate {name!r} has a class of motion that is not a name")
     return value
 
 

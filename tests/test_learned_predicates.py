@@ -329,12 +329,39 @@ def test_the_robot_refuses_a_learned_verb_it_has_no_motion_for_in_one_line(learn
     from lmcr.robot.reply import error_outcome, say
     from lmcr.robot.scene import scene_from_json
 
-    scene = scene_from_json({"objects": [{"label": "milk"}, {"label": "bowl"}, {"label": "cup"}]}, "scene")
+    # baking is said with an Instrument (in the oven): no motion puts a Theme at a Destination there
+    scene = scene_from_json({"objects": [{"label": "cake"}, {"label": "oven"}, {"label": "cup"}]}, "scene")
     try:
-        with pytest.raises(NoMotionError, match=r"no motion for 'put away' yet \(it can blend, brush, "):
-            execute("put the milk away", scene, learned_parser, _prefer("bowl"), CompletionConfig(), tmp_path)
+        with pytest.raises(NoMotionError, match=r"no motion for 'bake' yet \(it can blend, brush, "):
+            execute("bake the cake", scene, learned_parser, _prefer("oven"), CompletionConfig(), tmp_path)
     finally:
         p.disconnect()
-    reply = say(error_outcome(NoMotionError("put away")), learned_parser.lex)
-    can = "I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or sprinkle things."
-    assert reply == f"Sorry, I don't know how to put away. {can}"
+    reply = say(error_outcome(NoMotionError("bake")), learned_parser.lex)
+    can = "I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or sprinkle things"
+    assert reply == f"Sorry, I don't know how to bake. {can}, and put things away, throw them out or hand them over."
+
+
+def test_each_learned_verb_gets_the_class_of_motion_its_fillers_are_most_like(tmp_path):
+    """The classes are named by their prototype verbs (put: place, stir: stir, ...); whisking takes what
+    stirring takes (batter, with a spoon or a whisk), transferring what putting takes (milk into a glass)."""
+    from lmcr.frame_corpus.predicates import MOTION_CLASSES
+
+    frames = _kitchen()
+    frames += [("stir", {"Theme": "batter", "with": "spoon", "in": "bowl"}, False)] * 25
+    frames += [("stir", {"Theme": "egg", "with": "whisk"}, False)] * 10
+    frames += [("whisk", {"Theme": "egg", "with": "whisk", "in": "bowl"}, False)] * 20
+    frames += [("whisk", {"Theme": "batter"}, False)] * 10
+    frames += [("transfer", {"Theme": "milk", "into": "glass"}, False)] * 20
+    frames += [("transfer", {"Theme": "cup", "in": "glass"}, False)] * 5
+    table = learn_predicates(_store(tmp_path, frames), HAND)
+    motions = {name: p.motion for name, p in table.predicates.items()}
+    assert MOTION_CLASSES["place"] == "put" and MOTION_CLASSES["stir"] == "stir"
+    assert motions["put"] == "place" and motions["stir"] == "stir"  # a prototype is its own class
+    assert motions["whisk"] == "stir" and motions["transfer"] == "place" and motions["put away"] == "place"
+    assert table.to_json()["predicates"]["whisk"]["spec"]["motion"] == "stir"
+
+
+def test_without_a_prototype_no_class_is_guessed(tmp_path):
+    frames = [f for f in _kitchen() if f[0] != "put"]
+    table = learn_predicates(_store(tmp_path, frames), HAND)
+    assert table.predicates and all(p.motion is None for p in table.predicates.values())

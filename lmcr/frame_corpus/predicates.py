@@ -35,7 +35,7 @@ from __future__ import annotations
 import json
 import math
 from collections import Counter, defaultdict
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import duckdb
@@ -43,7 +43,7 @@ import duckdb
 from lmcr.files import atomic_path
 from lmcr.lexicon import PREDICATES_FILE, Lexicon
 
-VERSION = 1
+VERSION = 2  # 2: each predicate's class of motion
 # Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
 PREP_ROLES: dict[str, tuple[str, ...]] = {
     "into": ("Destination",),
@@ -69,6 +69,11 @@ MIN_POOL = 2  # times a word fills a robot role before it counts as a thing
 PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb starts from
 TOP_FILLERS = 300  # fillers per slot compared (the rest carry little of a cosine)
 REFUSED_LISTED = 5  # frames a refused verb needs to be listed with its evidence
+# The robot's classes of motion, each named by its own verb (the prototype): a learned verb's class is the
+# prototype its fillers are most like. Only `place` has a motion for any Destination today; the others
+# compete so that "cut the bread into the bowl" is not read as placing it (their motions are to come).
+MOTION_CLASSES = {"place": "put", "cut": "cut", "stir": "stir", "wipe": "wipe", "cover": "cover", "serve": "scoop"}
+CLASS_ROLES = ("Theme", "Destination", "Instrument")  # whose fillers are compared, each role alike
 OPEN_ROLES = ("Destination", "Instrument")  # the roles a request can leave for the robot to choose
 # prepositions that can introduce the Theme of a prepositional verb ("of")
 THEME_PREPS = tuple(prep for prep, roles in PREP_ROLES.items() if roles == ("Theme",))
@@ -92,6 +97,7 @@ class LearnedPredicate:
     # other roles a request may leave missing instead (stated often enough too): role -> its sentence;
     # completion lets the objects decide ("cut the bread": with the knife, or into the bowl)
     alternatives: dict[str, str] = field(default_factory=dict)
+    motion: str | None = None  # its class of motion (`MOTION_CLASSES`), None when no prototype is learned
 
     def spec_json(self) -> dict:
         """The entry in the lexicon's own format (`lexicon.json`), with the other open roles' sentences."""
@@ -108,6 +114,7 @@ class LearnedPredicate:
             "sentence": self.sentence,
             "alternatives": dict(self.alternatives),
             "rates": {role: self.rates.get(role, 0.0) for role in roles},
+            "motion": self.motion,
         }
 
 
@@ -234,7 +241,49 @@ def learn_predicates(
             table.predicates[name] = learned
         elif n >= REFUSED_LISTED:
             table.refused[name] = n
+    for name, motion in motion_classes(table.predicates, fillers).items():
+        table.predicates[name] = replace(table.predicates[name], motion=motion)
     return table
+
+
+def motion_classes(predicates: dict[str, LearnedPredicate], fillers: dict[tuple[str, str], Counter]) -> dict[str, str]:
+    """Each learned predicate's class of motion: the class whose prototype verb (`MOTION_CLASSES`) its
+    fillers are most like, by the mean over `CLASS_ROLES` of the cosine of their PPMI-weighted filler
+    vectors (a role's fillers pooled over the slots that fill it; PPMI against every learned predicate's
+    fillers of that role). A prototype is its own class; classes whose prototype was not learned do not
+    compete."""
+    blocks = {(name, role): _role_fillers(p, role, fillers) for name, p in predicates.items() for role in CLASS_ROLES}
+    totals = {role: Counter() for role in CLASS_ROLES}
+    for (_, role), counts in blocks.items():
+        totals[role].update(counts)
+    vectors = {key: _ppmi(counts, totals[key[1]]) for key, counts in blocks.items()}
+    prototypes = {cls: verb for cls, verb in MOTION_CLASSES.items() if verb in predicates}
+    classes = {}
+    for name in predicates:
+
+        def likeness(cls: str, name: str = name) -> float:
+            return sum(_cosine(vectors[(name, r)], vectors[(prototypes[cls], r)]) for r in CLASS_ROLES) / len(
+                CLASS_ROLES
+            )
+
+        if prototypes:
+            classes[name] = max(prototypes, key=lambda cls: (likeness(cls), cls))
+    return classes
+
+
+def _role_fillers(p: LearnedPredicate, role: str, fillers: dict[tuple[str, str], Counter]) -> Counter:
+    found: Counter = Counter()
+    for slot, filled in p.slots.items():
+        if filled == role:
+            found.update(fillers.get((p.name, slot), {}))
+    return found
+
+
+def _ppmi(counts: Counter, total: Counter) -> Counter:
+    """Positive pointwise mutual information of each filler with the verb, against all verbs' fillers."""
+    n, grand = sum(counts.values()), sum(total.values())
+    weights = Counter({f: math.log((k / n) / (total[f] / grand)) for f, k in counts.items()}) if n else Counter()
+    return Counter({f: w for f, w in weights.items() if w > 0})
 
 
 def _smoothed(own: Counter, n: int, base: Counter | None) -> dict[str, float]:

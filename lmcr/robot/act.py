@@ -9,7 +9,7 @@ import pybullet as p
 from lmcr.robot.arm import relative_pose, settle
 from lmcr.robot.plan import Plan, Planner, pick_steps, shifted
 from lmcr.robot.scene import SceneObject
-from lmcr.robot.tasks import Outcome
+from lmcr.robot.tasks import Outcome, in_palm
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
@@ -37,9 +37,16 @@ def run_plan(
     before = {o.id: p.getBasePositionAndOrientation(o.body)[0] for o in others}  # by id: two cups are two
     target_at = p.getBasePositionAndOrientation(target.body)[0]
     out = Outcome()
-    grasped, released, knocked_during = _act(plan, held, out, others, before, planner)
+    knocked_during: dict[str, str] = {}
+    if plan.opens is not None:  # a drawer pulled open first
+        knocked_during = _act(plan.opens, target, Outcome(), others, before)[2]
+    grasped, released, knocked = _act(plan, held, out, others, before, planner)
+    knocked_during = {**knocked, **knocked_during}  # the step it was first seen moved in
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
+    if plan.shuts is not None and grasped:  # and pushed shut over what was put in
+        knocked_during = {**_act(plan.shuts, target, Outcome(), others, before)[2], **knocked_during}
+        settle(120)
     checks = plan.task.check(held, target, out) if grasped else {"ok": False}
     log = [w for a in plan.moving_arms for w in a.log]  # both parts' waypoints, in order
     within = all(w["error_m"] <= TOLERANCE for w in log)
@@ -125,7 +132,24 @@ def _take_step(arm, segment, plan: Plan, held: SceneObject, out: Outcome) -> tup
         return True, True
     elif step.kind == "spill":
         out.particles += spill(held, plan.geometry.opening, step.particles)
+    elif step.kind == "give":
+        out.taken = take(held, plan.geometry.target)
+    elif step.kind == "hook":
+        arm.hook(held.body, held.link)
+    elif step.kind == "unhook":
+        arm.unhook()
     return True, False
+
+
+def take(held: SceneObject, person: SceneObject) -> bool:
+    """The person's hand closes on the object when it lies in the hand (`tasks.in_palm`): it is then held
+    where it is. False when it does not (the person cannot take what is not in their hand)."""
+    if not in_palm(held, person):
+        return False
+    pose = p.getBasePositionAndOrientation
+    rel_pos, rel_orn = relative_pose(*pose(person.body), *pose(held.body))
+    p.createConstraint(person.body, -1, held.body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn)
+    return True
 
 
 def _replan_if_shifted(arm, plan: Plan, held: SceneObject, planner: Planner) -> Plan | None:

@@ -288,6 +288,22 @@ class Arm:
         robot_collisions(self.robot, body, False)  # held in the hand, it must not push the arm around
         self.held = body
 
+    def hook(self, body: int, link: int) -> None:
+        """Hold a link of `body` (a drawer, by its handle) rigidly where it is relative to the gripper: the
+        arm's motion then pulls or pushes it along its joint."""
+        com_pos, com_orn = p.getLinkState(body, link)[:2]
+        rel_pos, rel_orn = relative_pose(*self.ee_pose(), com_pos, com_orn)
+        self.constraint = p.createConstraint(
+            self.robot, self.ee, body, link, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn
+        )
+        p.changeConstraint(self.constraint, maxForce=500)
+
+    def unhook(self) -> None:
+        """Let go of what `hook` holds."""
+        if self.constraint is not None:
+            p.removeConstraint(self.constraint)
+        self.constraint = None
+
     def release(self, fingers: list[float] | None = None) -> None:
         """Let go, the fingers back to `fingers` (the shape they approached in; open by default); the
         object touches the robot again only once it has dropped away (turned back on while it still

@@ -20,6 +20,7 @@ from lmcr.complete import Candidate, Completion, CompletionConfig, complete
 from lmcr.errors import LMCRError, one_line
 from lmcr.frame import Frame
 from lmcr.jsonl import InputError, check_text, read_jsonl_lines
+from lmcr.lexicon import Lexicon
 from lmcr.robot.act import run_plan
 from lmcr.robot.budget import Budget
 from lmcr.robot.detect import detect
@@ -27,7 +28,7 @@ from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
-from lmcr.robot.tasks import TASKS
+from lmcr.robot.tasks import TASKS, Task, task_for
 from lmcr.robot.world import build_world
 from lmcr.srl.instruction import NoPredicateError
 
@@ -41,15 +42,33 @@ class NoMotionError(NoPredicateError):
 
     def __init__(self, predicate: str):
         can = ", ".join(sorted(TASKS))
-        super().__init__(f"the simulated Baxter has no motion for {predicate!r} yet (it can {can})")
+        super().__init__(
+            f"the simulated Baxter has no motion for {predicate!r} yet (it can {can}, and put a Theme "
+            "at a Destination: place, dispose, hand over)"
+        )
         self.predicate = predicate
 
 
-def _with_motion(completion: Completion) -> Completion:
-    """The completion, when the robot has a motion for its predicate; else NoMotionError."""
-    if completion.frame.predicate not in TASKS:
+def _with_motion(completion: Completion, options: list[tuple[Frame, Candidate | None]], lex: Lexicon) -> list:
+    """The options with the task that carries each out (None when the robot has no motion for it: a
+    learned verb whose class has none, "cut the bread into the bowl"; that one is refused as the robot
+    cannot do it, and the others are offered); NoMotionError when none has one."""
+    found = [(frame, candidate, task_for(frame, _verb_motion(frame, lex))) for frame, candidate in options]
+    if all(task is None for _, _, task in found):
         raise NoMotionError(completion.frame.predicate)
-    return completion
+    return found
+
+
+def _verb_motion(frame: Frame, lex: Lexicon) -> str | None:
+    """The class of motion learned for the frame's predicate (None for the eleven, and unknown ones)."""
+    spec = lex.predicates.get(frame.predicate)
+    return spec.motion if spec is not None else None
+
+
+def _no_motion(frame: Frame) -> Infeasible:
+    """Why a frame the robot has no motion for is not planned (its open role is not one it can act on)."""
+    roles = ", ".join(f"{role} {value}" for role, value in frame.role_map.items())
+    return Infeasible(f"the robot has no motion to {frame.predicate} with {roles}")
 
 
 class ExecutionError(LMCRError, ValueError):
@@ -89,27 +108,20 @@ def execute(
     _connect()
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
-    completion = _with_motion(
-        complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
-    )
+    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
+    options = _with_motion(completion, _options(completion, answer), parser.lex)[:MAX_TRIED]
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget)
-    options = _options(completion, answer)[:MAX_TRIED]
-    tried = []  # (frame, candidate, role -> object, plan or why not)
-    for frame, candidate in options:
-        for objects in _assignments(scene, frame, {d.id for d in seen})[:MAX_INSTANCES]:
-            tried.append((frame, candidate, objects, _plan(planner, scene, frame, objects)))
-            if isinstance(tried[-1][3], Plan) or planner.stopped:
-                break
-        if isinstance(tried[-1][3], Plan) or planner.stopped:
-            break
+    tried = _search(planner, scene, options, {d.id for d in seen})
     planned = time.perf_counter()
     # the language model's choice, as the first of its objects the robot can act on (else the nearest)
     first = [t for t in tried if t[0] is options[0][0]]
     frame, candidate, objects, result = next((t for t in first if isinstance(t[3], Plan)), first[0])
+    task = next(t for f, _, t in options if f is frame)
     role = _chosen_role(completion, candidate, answer)
     out = {
         "frame": frame.to_json(),
+        "motion": None if task is None else task.motion or frame.predicate,  # a learned verb's: place, ...
         "chosen_object": _chosen(candidate, answer),
         "chosen_id": objects[role].id if role in objects else None,
         "role_ids": {r: o.id for r, o in objects.items()},
@@ -128,9 +140,8 @@ def execute(
     if isinstance(result, Infeasible):
         if planner.stopped:
             result = replace(result, reason=f"{result.reason} ({planner.stopped})")
-        out.update(_refusal(out, result, tried))
+        out.update(_refusal(out, result, tried, parser.lex))
     else:
-        task = TASKS[frame.predicate]
         held, target = objects[task.held_role], objects[task.target_role]
         if recorder is not None:
             recorder.target, recorder.held = target.id, held.id
@@ -156,22 +167,40 @@ def execute(
     return out
 
 
+def _search(planner: Planner, scene: Scene, options: list, seen: set[str]) -> list[tuple]:
+    """Plan the options (frame, candidate, task) in order, each with its nearest object combinations, until
+    one is feasible or the budget is spent: (frame, candidate, role -> object, plan or why not) for each
+    one tried. A frame the robot has no motion for is not planned (`_no_motion`)."""
+    tried = []
+    for frame, candidate, task in options:
+        if task is None:
+            tried.append((frame, candidate, {}, _no_motion(frame)))
+            continue
+        for objects in _assignments(scene, frame, task, seen)[:MAX_INSTANCES]:
+            tried.append((frame, candidate, objects, _plan(planner, scene, task, objects)))
+            if isinstance(tried[-1][3], Plan) or planner.stopped:
+                break
+        if isinstance(tried[-1][3], Plan) or planner.stopped:
+            break
+    return tried
+
+
 def _options(completion: Completion, answer: dict[str, str] | None) -> list[tuple[Frame, Candidate | None]]:
     """The frames worth planning, best first: the answered one, else one per candidate in the language
     model's order (just the completed frame when nothing was missing)."""
     frame = completion.frame
-    if answer:
-        return [(Frame.of(frame.predicate, {**frame.role_map, **answer}), None)]
+    if answer:  # the roles the person stated, and the answer (not the role the completion chose instead)
+        stated = {r: v for r, v in frame.role_map.items() if r not in completion.missing_roles}
+        return [(Frame.of(frame.predicate, {**stated, **answer}), None)]
     if not completion.candidates:
         return [(frame, None)]
     return [(Frame.of(frame.predicate, {**frame.role_map, **c.objects}), c) for c in completion.candidates]
 
 
-def _assignments(scene: Scene, frame: Frame, seen: set[str]) -> list[dict[str, SceneObject]]:
+def _assignments(scene: Scene, frame: Frame, task: Task, seen: set[str]) -> list[dict[str, SceneObject]]:
     """The objects the frame's two roles may be done with (role -> object; one per role, never one object
     for both), nearest first: the reach from the robot's edge to the held object (none when it is in the
     hand) plus its carry to the target. An object is one the camera saw or the one in the hand."""
-    task = TASKS[frame.predicate]
     roles = frame.role_map
     choices = []
     for role in (task.held_role, task.target_role):
@@ -194,12 +223,13 @@ def _assignments(scene: Scene, frame: Frame, seen: set[str]) -> list[dict[str, S
     return [{task.held_role: held, task.target_role: target} for held, target in pairs]
 
 
-def _plan(planner: Planner, scene: Scene, frame: Frame, objects: dict[str, SceneObject]) -> Plan | Infeasible:
-    task = TASKS[frame.predicate]
+def _plan(planner: Planner, scene: Scene, task: Task, objects: dict[str, SceneObject]) -> Plan | Infeasible:
     held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
+    if target.joint >= 0:  # a drawer: opened, filled and shut by one arm
+        return planner.plan_drawer(task, held, target, holding)
     direct = planner.plan(task, held, target, holding)
     if isinstance(direct, Plan) or planner.stopped:
         return direct
@@ -252,7 +282,7 @@ def _ranking(completion: Completion, tried: list) -> list[dict]:
     return sorted(rows, key=lambda r: -(r["probability"] * (r["feasible"] is not False)))
 
 
-def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
+def _refusal(out: dict, result: Infeasible, tried: list, lexicon: Lexicon) -> dict:
     """Why nothing moved (`out` the result so far), and the question to ask when another candidate is
     feasible (`suggestion` its objects by label, `suggestion_ids` by id)."""
     why = {"reason": result.reason, "out_of_reach": result.out_of_reach, "blocker": result.blocker or None}
@@ -261,7 +291,7 @@ def _refusal(out: dict, result: Infeasible, tried: list) -> dict:
         return why
     c, objects = alternative
     offer = {"suggestion": dict(c.objects), "suggestion_ids": {role: objects[role].id for role in c.objects}}
-    return {**why, **offer, "question": say({**out, **why, **offer})}
+    return {**why, **offer, "question": say({**out, **why, **offer}, lexicon)}
 
 
 BATCH_FIELDS = {"id": (str, int), "instruction": str}

@@ -21,9 +21,21 @@ import pybullet as p
 from lmcr.robot.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose, rotation_error
 from lmcr.robot.budget import Budget
 from lmcr.robot.collision import Carried, Clearance
+from lmcr.robot.household import household
 from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
-from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, world_xy
-from lmcr.robot.tasks import GRIP_GAP, Geometry, Step, Task, Variant, put_down, variants
+from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, height, world_xy
+from lmcr.robot.tasks import (
+    GRIP_GAP,
+    SLIDE,
+    Geometry,
+    Step,
+    Task,
+    Variant,
+    put_down,
+    slide_point,
+    slide_steps,
+    variants,
+)
 
 SIDES = ("left", "right")
 # an object the grasp pushed further than this (or turned more) is not where the plan has it in the hand
@@ -51,6 +63,8 @@ class Plan:
     task: Task
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
     instead_of: Infeasible | None = None  # with `first`: why the task alone was not planned
+    opens: Plan | None = None  # run before the task: the target drawer pulled open (`plan_drawer`)
+    shuts: Plan | None = None  # run after it: the drawer pushed shut
 
     @property
     def fingers(self) -> list[float]:
@@ -66,7 +80,7 @@ class Plan:
     def moving_arms(self) -> list[Arm]:
         """The arms that move, in order: the first part's, then the task's (once when they are one)."""
         lead = self.first.arm if self.first else self.arm
-        return [lead] + ([self.arm] if self.arm is not lead else [])
+        return [lead] + ([self.arm] if self.arm is not lead else [])  # a drawer's parts use the task's arm
 
 
 @dataclass
@@ -204,6 +218,73 @@ class Planner:
                 best = rest if rest.progress >= best.progress else best
         return best
 
+    def plan_drawer(self, task: Task, held: SceneObject, target: SceneObject, holding: bool) -> Plan | Infeasible:
+        """Into a drawer: pull it open, do the task with it open, push it shut, all three with one arm (the
+        nearer first; the other parked), each part planned in the world the one before leaves (the held
+        object lying in the drawer for the push). Refused at once when the held object is too tall for the
+        drawer to shut over it. A spent budget ends the search."""
+        slide = household()[target.label].slide
+        if height(held.label) > slide.headroom:
+            return Infeasible(f"{_named(held)} is too tall to shut {_named(target)} over it", 0, False, _named(target))
+        best = Infeasible("nothing was tried", -1)
+        for side in sorted(SIDES, key=lambda s: (target.xy[1] >= 0) != (s == "left")):
+            if self.spent():
+                return best
+            result = self._drawer_with(side, task, held, target, holding, slide.opens)
+            if isinstance(result, Plan):
+                return result
+            best = result if result.progress > best.progress else best
+        return best
+
+    def _drawer_with(
+        self, side: str, task: Task, held: SceneObject, target: SceneObject, holding: bool, opens: float
+    ) -> Plan | Infeasible:
+        arm, other = self.arms[side], self.arms[SIDES[1 - SIDES.index(side)]]
+        other.set_config(other.parked)
+        opening = self._slide(arm, other, target, True, arm.home)
+        if isinstance(opening, Infeasible):
+            return opening
+        saved = _save(held)
+        p.resetJointState(target.body, target.joint, -opens)
+        try:
+            rest = self.plan(task, held, target, holding, arms=(side,), start="home")
+            if isinstance(rest, Infeasible):
+                return replace(rest, progress=rest.progress + len(opening.segments))
+            bottom = slide_point(target, "middle") + [0, 0, 0.002]  # as it will lie in the drawer, upright
+            p.resetBasePositionAndOrientation(
+                held.body, [*bottom[:2], bottom[2] + height(held.label) / 2], (0, 0, 0, 1)
+            )
+            end = next(s.path[-1] for s in reversed(rest.segments) if s.path is not None)
+            shutting = self._slide(arm, other, target, False, end, moving=held)
+        finally:
+            p.resetJointState(target.body, target.joint, 0.0)
+            _restore(held, saved)
+            arm.set_config(arm.home)
+        if isinstance(shutting, Infeasible):
+            return replace(shutting, progress=shutting.progress + len(opening.segments) + len(rest.segments))
+        return replace(rest, opens=opening, shuts=shutting)
+
+    def _slide(
+        self,
+        arm: Arm,
+        other: Arm,
+        target: SceneObject,
+        opening: bool,
+        start: np.ndarray,
+        moving: SceneObject | None = None,
+    ) -> Plan | Infeasible:
+        """The drawer pulled open (then the arm back at its start) or pushed shut, from joints `start`;
+        `moving`: what lies in it (it slides with the drawer, no obstacle)."""
+        steps = slide_steps(target, opening) + ([Step("home", "to its start")] if opening else [])
+        arm.set_config(start)
+        obstacles = {
+            body: name for body, name in self._obstacles(target).items() if moving is None or body != moving.body
+        }
+        found = self._plan_variant(arm, Clearance(arm, obstacles), steps, target, target, None, start)
+        if isinstance(found, Infeasible):
+            return found
+        return Plan(arm, other, Variant(), found, None, Geometry.measure(target, target), SLIDE)
+
     def replan_in_hand(self, plan: Plan, in_hand: tuple) -> Plan | None:
         """The rest of `plan` (after the pick-up) planned afresh from where its arm is, for the held object
         at pose `in_hand` relative to the gripper (as found): a grasp can push the object before the
@@ -336,15 +417,17 @@ class Planner:
                 # a motion that may touch what it reaches for goes there straight: a detour found with the
                 # object ignored could sweep through it
                 into = step.into and carried is not None
+                straight = into or step.straight
                 path = (
                     _straight_line(arm, q, goal, position, step.orientation)
-                    if into
+                    if straight
                     else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
                 )
-                if into and path is None:
-                    why, reach = f"the {arm.side} arm cannot go straight down to '{step.name}'", False
+                if straight and path is None:
+                    way = "straight down" if into else "straight"  # into a container, or along a slide or a row
+                    why, reach = f"the {arm.side} arm cannot go {way} to '{step.name}'", False
                     continue
-                blocker = _path_clash(clash, path) if into else None
+                blocker = _path_clash(clash, path) if straight else None
                 if path is None or blocker:
                     blocker = blocker or segment_clash(clash, q, goal)
                     why, reach = (

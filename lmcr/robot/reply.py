@@ -7,7 +7,8 @@ the water into the cup, but only 40% of it went in." on a failure, "I can't reac
 the water into the glass instead?" when the plan is infeasible and another object would do, the
 completion's question while it waits for an answer, and a sentence for each error kind
 (`error_outcome`). Past tenses come from English's regular rule, or from a predicate's `past` in the
-lexicon for an irregular verb.
+lexicon for an irregular verb; what a learned verb did is said with its motion ("I threw the peel into the
+compost bin", `motion_done`): the corpus gives a verb's roles, not its past tense.
 """
 
 from __future__ import annotations
@@ -17,11 +18,13 @@ from collections.abc import Mapping
 
 from lmcr.frame import Frame
 from lmcr.lexicon import Lexicon, load_lexicon
+from lmcr.robot.household import MOTIONS, household
 
 _SLOT = re.compile(r"(the )?\{(\w+)\}")
 _AUTO_ID = re.compile(r"(.+)#(\d+)")
 ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth")
 LEAVE_IT = "I'll leave it."
+MOTIONS_SAID = "and put things away, throw them out or hand them over"  # household.MOTIONS, as a person hears them
 
 
 def past_tense(verb: str, irregular: str | None = None) -> str:
@@ -40,6 +43,26 @@ def past_tense(verb: str, irregular: str | None = None) -> str:
     if len(re.findall(r"[aeiou]+", verb)) == 1 and re.search(r"(?:^|[^aeiou])[aeiou][^aeiouwxy]$", verb):
         return verb + verb[-1] + "ed"
     return verb + "ed"
+
+
+TOOL_MOTIONS_SAID = {"stir": "stirred", "wipe": "wiped"}  # tasks.TOOL_MOTIONS, in the past tense
+
+
+def motion_done(motion: str | None, roles: Mapping[str, str]) -> str | None:
+    """What the robot did, in the past tense of its own motion ("threw the peel into the compost bin",
+    "handed the knife to the person", "put the apple on the shelf", "stirred the batter with the spoon");
+    None for the paper's predicates, whose own verbs say it."""
+    if motion in TOOL_MOTIONS_SAID and {"Theme", "Instrument"} <= set(roles):
+        return f"{TOOL_MOTIONS_SAID[motion]} the {roles['Theme']} with the {roles['Instrument']}"
+    if motion not in MOTIONS or not {"Theme", "Destination"} <= set(roles):
+        return None
+    theme, place = roles["Theme"], roles["Destination"]
+    if motion == "hand over":
+        return f"handed the {theme} to the {place}"
+    if motion == "dispose":
+        return f"threw the {theme} into the {place}"
+    found = household().get(place)
+    return f"put the {theme} {'on' if found and found.surface == 'top' else 'into'} the {place}"
 
 
 def phrase(frame: Mapping | Frame, lexicon: Lexicon | None = None, tense: str = "base") -> str:
@@ -90,7 +113,8 @@ def say(outcome: Mapping, lexicon: Lexicon | None = None) -> str:
     if not outcome["feasible"]:
         return _refusal(outcome, frame, lexicon)
     if outcome.get("success"):
-        return f"I {phrase(frame, lexicon, 'past')}."
+        done = motion_done(outcome.get("motion"), _parts(frame)[1])
+        return f"I {done or phrase(frame, lexicon, 'past')}."
     return f"I tried to {phrase(frame, lexicon)}, but {_what_failed(outcome.get('checks') or {})}."
 
 
@@ -128,10 +152,11 @@ def _error(outcome: Mapping, lexicon: Lexicon) -> str:
 
 
 def _cannot_do(predicate: str | None, lexicon: Lexicon) -> str:
-    """'Sorry, I don't know how to do that. I can blend, brush, ... or sprinkle things.'"""
+    """'Sorry, I don't know how to do that. I can blend, brush, ... or sprinkle things, and put things
+    away, throw them out or hand them over.' (the paper's predicates' motions, and the learned verbs')"""
     verbs = lexicon.hand_written  # what the robot has motions for
     can = ", ".join(verbs[:-1]) + f" or {verbs[-1]}" if len(verbs) > 1 else "".join(verbs)
-    return f"Sorry, I don't know how to {predicate or 'do that'}. I can {can} things."
+    return f"Sorry, I don't know how to {predicate or 'do that'}. I can {can} things, {MOTIONS_SAID}."
 
 
 def _refusal(outcome: Mapping, frame, lexicon: Lexicon) -> str:

@@ -24,6 +24,7 @@ from pathlib import Path
 from lmcr.instances import DuplicateIdError, assign_ids, id_problem
 from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
 from lmcr.lexicon import load_lexicon
+from lmcr.robot.household import household
 
 TABLE_CENTRE = (0.60, 0.0)  # in the robot's base frame (x forward), metres: as near as the pedestal allows
 TABLE_TOP = 0.75  # height above the floor
@@ -59,8 +60,10 @@ CONTAINERS = {
     "soup": (0.16, 0.16, 0.07),
     "salad": (0.18, 0.18, 0.08),
     "chocolate": (0.14, 0.14, 0.06),
-    "batter": (0.14, 0.14, 0.06),
-}  # food served in a bowl
+    "batter": (0.14, 0.14, 0.06),  # food served in a bowl
+    # the household's receptacles and the person's hand (household.json), by the box around them
+    **{label: r.size for label, r in household().items()},
+}
 FOOD = {
     "onion": ("sphere", 0.035),
     "garlic": ("sphere", 0.025),
@@ -88,6 +91,7 @@ FOOD = {
     "towel": ("box", 0.20, 0.14, 0.015),
     "pastry brush": ("box", 0.18, 0.03, 0.02),
 }
+WALL = 0.006  # a kitchen container's walls and floor, this thick
 BOTTLE = (0.03, 0.16)  # radius, height of bottles and jugs
 SHAKER = (0.025, 0.09)
 
@@ -98,6 +102,8 @@ class SceneObject:
     xy: tuple[float, float]
     body: int = -1
     id: str = ""  # this object among those sharing its label (lmcr.instances); assigned by its Scene when empty
+    link: int = -1  # the body's link things are put in (a drawer's), -1 the body itself
+    joint: int = -1  # the joint that link slides on (a drawer's), -1 none
 
     @property
     def name(self) -> str:
@@ -155,6 +161,25 @@ def solid_shape(label: str) -> tuple:
     if label in POWDERS:
         return ("cyl", *SHAKER)
     return FOOD[label]
+
+
+def depth(label: str) -> float:
+    """How far below a container's top its floor's top is (0: things rest on its top, as on a shelf, or on
+    a solid object)."""
+    found = household().get(label)
+    if found is not None:
+        return found.depth
+    return CONTAINERS[label][2] - WALL if label in CONTAINERS else 0.0
+
+
+def has_shape(label: str) -> bool:
+    """Whether the simulated world has a shape for `label` (a kitchen object or a household receptacle)."""
+    return label in CONTAINERS or label in FOOD or label in LIQUIDS or label in POWDERS
+
+
+def robot_objects() -> set[str]:
+    """The labels a scene may use: the lexicon's objects and the household's receptacles."""
+    return set(load_lexicon().objects) | set(household())
 
 
 def footprint(label: str) -> float:
@@ -280,7 +305,7 @@ def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding:
     """Validated objects (known labels, finite on-table positions that do not overlap, different ids),
     the ones without a position placed at random with `seed`; `holding` is the label of what the robot
     holds. An item is (label, xy or None) or (label, xy or None, id or None)."""
-    vocabulary = set(load_lexicon().objects)
+    vocabulary = robot_objects()
     labels, given = [item[0] for item in items], [item[2] if len(item) > 2 else None for item in items]
     for k, label in enumerate(labels):
         if not isinstance(label, str) or label not in vocabulary:

@@ -20,8 +20,21 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pybullet as p
 
+from lmcr.frame import Frame
 from lmcr.robot.arm import DOWN, relative_pose
-from lmcr.robot.scene import CONTAINERS, TABLE_TOP, SceneObject, footprint, height, outline, world_xy
+from lmcr.robot.household import household
+from lmcr.robot.scene import (
+    CONTAINERS,
+    TABLE_TOP,
+    WALL,
+    SceneObject,
+    depth,
+    footprint,
+    has_shape,
+    height,
+    outline,
+    world_xy,
+)
 
 CARRY_HEIGHTS = (0.40, 0.33, 0.26)  # above the table, tried in turn: the far corners are reached lower
 TILT = math.radians(100)  # how far a bottle turns to pour: its opening then points a little down
@@ -34,6 +47,15 @@ PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
 GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
+HAND_OFFER = 0.008  # an object handed over is held out with its underside this far above the person's palm
+HAND_GAP = 0.03  # ... and lies in the hand while its underside is at most this far above the palm
+WIPE_HEIGHT, WIPE_CLEAR = 0.005, 0.008  # a wiping tool's underside this far above the surface, its edge from a wall
+WIPE_APPROACH = 0.05  # it comes down onto the surface, and leaves it, straight from this far above
+WIPE_OVERLAP, WIPED = 0.9, 0.95  # rows overlap by a tenth of the tool's width; this share of the surface is wiped
+STIR_RADIUS, STIR_TURNS = 0.025, 2  # the tool's tip circles this far round the middle, this many times
+STIR_DEPTH, STIR_CLEAR = 0.03, 0.015  # its tip this far below the rim, this far clear of the walls
+HANDLE_BAR = 0.015  # a drawer handle's bar, this thick
+SHUT = 0.01  # metres: a drawer this near its closed end is shut
 PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
 
 
@@ -41,7 +63,8 @@ PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this 
 class Step:
     """A gripper pose to reach (`kind` "move", first reachable of `positions`), or an action."""
 
-    kind: str  # move | home, park (to the arm's start, out of the way) | grasp | release | spill
+    # move | home, park (to the arm's start, out of the way) | grasp | release | spill | give (a person takes it)
+    kind: str
     name: str = ""
     positions: tuple = ()
     orientation: tuple = DOWN
@@ -53,6 +76,7 @@ class Step:
     # the held object goes into the target through its opening: though the motion may touch the target
     # (what is in it), the object must pass the walls clear
     into: bool = False
+    straight: bool = False  # the gripper moves along the straight line (pulling a drawer on its slide)
 
     @property
     def moves(self) -> bool:
@@ -119,8 +143,8 @@ class Geometry:
     @classmethod
     def measure(cls, held: SceneObject, target: SceneObject) -> Geometry:
         pos, orn = p.getBasePositionAndOrientation(held.body)
-        lo, hi = p.getAABB(target.body)
-        tpos, _ = p.getBasePositionAndOrientation(target.body)
+        lo, hi = p.getAABB(target.body, target.link)  # a drawer's: what things are put in
+        tpos = slide_point(target, "middle") if target.joint >= 0 else p.getBasePositionAndOrientation(target.body)[0]
         return cls(
             held,
             target,
@@ -171,6 +195,31 @@ class Geometry:
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
 
 
+def slide_point(target: SceneObject, which: str) -> np.ndarray:
+    """A drawer's `handle` or the `middle` of its floor (household.json) in the world, where the drawer
+    now stands (open or shut)."""
+    frame = np.asarray(p.getLinkState(target.body, target.link)[4])  # moves with the drawer
+    return frame + getattr(household()[target.label].slide, which)
+
+
+def slide_steps(target: SceneObject, opening: bool) -> list[Step]:
+    """Pull a drawer open (or push it shut) by its handle: the gripper comes down over the bar, holds it,
+    moves straight along the slide for its whole travel, lets go and rises."""
+    slide = household()[target.label].slide
+    orn = Variant().upright()  # the fingers along the bar, over it: across it, one would meet the drawer's front
+    grip = slide_point(target, "handle") + [0, 0, HANDLE_BAR / 2 + GRIP_GAP]
+    to = grip + [-slide.opens if opening else slide.opens, 0, 0]
+    name, way = target.name, ("pull", "open") if opening else ("push", "shut")
+    return [
+        move(f"above the {name}'s handle", grip + [0, 0, 0.1], orn),
+        move(f"on the {name}'s handle", grip, orn, touches="target"),
+        Step("hook", f"hold the {name}'s handle"),
+        Step("move", f"{way[0]} the {name} {way[1]}", (to,), orn, "target", straight=True),
+        Step("unhook", "let go of the handle"),
+        move("up from the handle", to + [0, 0, 0.1], orn, touches="target"),
+    ]
+
+
 def side_grip_height(label: str) -> float:
     """How far above the table a side grasp holds the object: SIDE_GRIP of its height, at least SIDE_GRIP_MIN."""
     return max(SIDE_GRIP * height(label), SIDE_GRIP_MIN)
@@ -181,13 +230,14 @@ def _turned(orientation, yaw: float) -> tuple:
     return p.multiplyTransforms([0, 0, 0], p.getQuaternionFromEuler((0, 0, yaw)), [0, 0, 0], orientation)[1]
 
 
-def tilted(variant: Variant) -> tuple:
-    """The gripper orientation with the grasped object turned TILT: a side grasp rolls the wrist about
+def tilted(variant: Variant, angle: float = TILT) -> tuple:
+    """The gripper orientation with the grasped object turned `angle`: a side grasp rolls the wrist about
     the gripper's axis; a top grasp turns about the line between the fingers (about any other axis a
-    finger would end up under the opening, in the way of what pours)."""
+    finger would end up under the opening, in the way of what pours; a tool lying flat, turned a quarter,
+    stands on its end)."""
     upright = variant.at_target()
     axis = np.asarray(p.getMatrixFromQuaternion(upright)).reshape(3, 3)[:, 2 if variant.side else 1]
-    turn = p.getQuaternionFromAxisAngle(axis.tolist(), variant.tilt_sign * TILT)
+    turn = p.getQuaternionFromAxisAngle(axis.tolist(), variant.tilt_sign * angle)
     return p.multiplyTransforms([0, 0, 0], turn, [0, 0, 0], upright)[1]
 
 
@@ -307,21 +357,35 @@ def program_sprinkle(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 
 def program_place(g: Geometry, v: Variant, holding: bool, press: bool = False) -> list[Step]:
     """Lower the held object into or onto the target and let go (heat, fry; blend also presses)."""
-    depth = CONTAINERS.get(g.target.label, (0, 0, 0))[2]
     orn, t = v.at_target(), g.target_top
-    drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
-    # the bottom 1.5 cm above the target's floor, but the hand stays above a deep container's rim
-    bottom = max(t[2] - depth + 0.015, t[2] + 0.01 - drop)
-    lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
-    steps = [
-        *pick(g, v, holding),
-        over_target(g, v),
-        move(f"lower into {g.target.name}", lower, orn, touches="target"),
-        Step("release", "let go"),
-    ]
+    steps = [*pick(g, v, holding), over_target(g, v), _lower_into(g, v), Step("release", "let go")]
     if press:
         steps += [move("above lid", t + [0, 0, 0.06], orn), move("press", t + [0, 0, 0.02], orn, touches="target")]
     return [*steps, above(t, "retreat", orn)]
+
+
+def _lower_into(g: Geometry, v: Variant) -> Step:
+    """Lower the held object into the target (onto it, when things rest on its top): its bottom 1.5 cm
+    above the target's floor, but the hand stays above a deep container's rim (it drops the rest)."""
+    orn, t = v.at_target(), g.target_top
+    drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
+    bottom = max(t[2] - depth(g.target.label) + 0.015, t[2] + 0.01 - drop)
+    lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
+    return move(f"lower into {g.target.name}", lower, orn, touches="target")
+
+
+def program_hand_over(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the object out just above the person's palm, let the person take it, then let go and draw back."""
+    orn, t = v.at_target(), g.target_top
+    offer = gripper_for(g.bottom(v), orn, t + [0, 0, HAND_OFFER])
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move(f"hold out to {g.target.name}", offer, orn, touches="target"),
+        Step("give", f"{g.target.name} takes it"),
+        Step("release", "let go"),
+        above(g.target_top, "retreat", orn),
+    ]
 
 
 def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -374,6 +438,86 @@ def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
 
 
+def surface(target: SceneObject, box: tuple) -> tuple[float, float, float, float, float]:
+    """The surface a tool wipes: a container's floor within its walls, else the object's top, as x and y
+    bounds and height (`box` the target's AABB)."""
+    (lo, hi), inset = box, (WALL if target.label in CONTAINERS and depth(target.label) > 0 else 0.0)
+    return lo[0] + inset, hi[0] - inset, lo[1] + inset, hi[1] - inset, hi[2] - depth(target.label)
+
+
+def fits_on(tool: str, label: str) -> bool:
+    """Whether a wiping tool lies flat on the surface with room to move (within a container's walls, which
+    must be lower than the tool: the hand holding it stays above the rim)."""
+    if not has_shape(tool) or not has_shape(label) or depth(label) >= height(tool):
+        return False
+    (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
+    inset = WALL + WIPE_CLEAR if label in CONTAINERS and depth(label) > 0 else WIPE_CLEAR
+    return min(tx, ty) <= min(sx, sy) - inset and max(tx, ty) <= max(sx, sy) - inset
+
+
+def program_wipe(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the tool flat on the surface and wipe it in rows, each the tool's width from the last, back
+    and forth from edge to edge until it has gone over the whole surface; then lift it."""
+    orn = v.upright()  # not turned while carried: the tool lies square to the surface, as it lay on the table
+    x0, x1, y0, y1, z = surface(g.target, g.target_box)
+    hx, hy, _ = outline(g.held.label)
+    xs = (x0 + hx + WIPE_CLEAR, x1 - hx - WIPE_CLEAR)
+    rows = max(1, math.ceil((y1 - y0 - 2 * WIPE_CLEAR) / (2 * hy * WIPE_OVERLAP)))
+    ys = np.linspace(y0 + hy + WIPE_CLEAR, y1 - hy - WIPE_CLEAR, rows) if rows > 1 else [(y0 + y1) / 2]
+    strokes = []
+    for k, y in enumerate(ys):
+        for end, x in enumerate(xs[:: -1 if k % 2 else 1]):
+            at = gripper_for(g.bottom(v), orn, [x, y, z + WIPE_HEIGHT])
+            name, probe = f"wipe row {k + 1} {'to' if end else 'from'}", f"row {k + 1} {end}"
+            strokes.append(Step("move", name, (at,), orn, "target", probe, straight=True))  # level: no dip in the floor
+    # down onto the surface and back up straight: a joint-space move there could sweep the tool through a rim
+    first, last = strokes[0].positions[0], strokes[-1].positions[0]
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move("above the first row", first + [0, 0, WIPE_APPROACH], orn),
+        *strokes,
+        Step("move", "lift it", (last + [0, 0, WIPE_APPROACH],), orn, "target", straight=True),
+    ]
+
+
+def lower_end(g: Geometry, v: Variant, orientation) -> np.ndarray:
+    """The end of the held object's long side that points down with the gripper at `orientation` (a tool
+    stood on its end), in the gripper's frame."""
+    half_x, half_y, _ = outline(g.held.label)
+    middle = g.held_top[2] - height(g.held.label) / 2 - g.held_pos[2]
+    ends = [[s * half_x, 0, middle] if half_x >= half_y else [0, s * half_y, middle] for s in (1, -1)]
+    in_hand = [g.point_in_hand(v, end) for end in ends]
+    # the lower the point, the higher the gripper that puts it at a given height
+    return max(in_hand, key=lambda e: gripper_for(e, orientation, [0, 0, 0])[2])
+
+
+def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Stand the tool on its end over the container, lower its tip STIR_DEPTH below the rim (between the
+    walls), circle it STIR_TURNS times round the middle, and lift it out."""
+    orn, t = tilted(v, math.pi / 2), g.target_top
+    tip = lower_end(g, v, orn)
+    lo, hi = g.target_box
+    room = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - STIR_CLEAR - footprint(g.held.label)
+    radius, below = max(0.0, min(STIR_RADIUS, room)), min(STIR_DEPTH, depth(g.target.label) - 0.015)
+    at = [
+        [t[0] + radius * math.cos(a), t[1] + radius * math.sin(a), t[2] - below]
+        for a in np.linspace(0, 2 * math.pi * STIR_TURNS, 6 * STIR_TURNS + 1)[1:]
+    ]
+    name = g.target.name
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move(f"stand it up over {name}", gripper_for(tip, orn, t + [0, 0, 0.04]), orn),
+        move(f"into {name}", gripper_for(tip, orn, [*at[-1][:2], at[-1][2]]), orn, "target", into=True),
+        *[
+            move(f"stir {k + 1}", gripper_for(tip, orn, point), orn, "target", f"stir {k + 1}")
+            for k, point in enumerate(at)
+        ],
+        move(f"out of {name}", gripper_for(tip, orn, t + [0, 0, 0.04]), orn, "target", "lifted"),
+    ]
+
+
 def put_down(xy: tuple[float, float]) -> Task:
     """Pick the object up (unless it is in the hand), set it down upright at the free table spot `xy`
     and park the arm: the object is in the way of a task in the hand or out of one arm's reach, and the
@@ -402,12 +546,14 @@ class Outcome:
     particles: list[int] = field(default_factory=list)
     probes: dict[str, tuple] = field(default_factory=dict)  # name -> (position, AABB)
     replanned: bool = False
+    taken: bool = False  # the person took the object handed over
 
 
 def inside(target: SceneObject, point, above: float = 0.05) -> bool:
-    """Whether a point lies within the target's outline, above the table and at most `above` over its
-    rim (0.01: held in it, as a liquid must be; more: resting on top of it)."""
-    lo, hi = p.getAABB(target.body)
+    """Whether a point lies within the target's outline (a drawer's: the drawer's own, wherever it is),
+    above the table and at most `above` over its rim (0.01: held in it, as a liquid must be; more:
+    resting on top of it)."""
+    lo, hi = p.getAABB(target.body, target.link)
     return lo[0] <= point[0] <= hi[0] and lo[1] <= point[1] <= hi[1] and TABLE_TOP - 0.01 <= point[2] <= hi[2] + above
 
 
@@ -427,8 +573,63 @@ def check_sprinkle(held: SceneObject, target: SceneObject, out: Outcome) -> dict
 
 
 def check_in_target(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """In (or on) the target; a drawer must also be shut again."""
     ok = inside(target, p.getBasePositionAndOrientation(held.body)[0])
-    return {"in_target": ok, "ok": ok}
+    if target.joint < 0:
+        return {"in_target": ok, "ok": ok}
+    shut = bool(p.getJointState(target.body, target.joint)[0] > -SHUT)
+    return {"in_target": ok, "shut": shut, "ok": ok and shut}
+
+
+def check_in_bin(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Thrown away: the object lies inside the bin, below its rim (not caught on it)."""
+    ok = inside(target, p.getBasePositionAndOrientation(held.body)[0], above=0.0)
+    return {"in_bin": ok, "ok": ok}
+
+
+def check_handed_over(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Handed over: the person took the object (it lay in the hand when given) and it is still there once
+    the robot has let go and drawn back."""
+    there = in_palm(held, target)
+    return {"taken": out.taken, "in_persons_hand": there, "ok": bool(out.taken and there)}
+
+
+def in_palm(held: SceneObject, person: SceneObject) -> bool:
+    """Whether the object lies in the person's hand: its middle over the palm, its underside at most
+    HAND_GAP above the palm's top (and not sunk through it)."""
+    pos, _ = p.getBasePositionAndOrientation(held.body)
+    lo, hi = p.getAABB(person.body)
+    underside = p.getAABB(held.body)[0][2]
+    return bool(lo[0] <= pos[0] <= hi[0] and lo[1] <= pos[1] <= hi[1] and hi[2] - 0.01 <= underside <= hi[2] + HAND_GAP)
+
+
+def check_wiped(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Wiped: the share of the surface (a 5 mm grid, WIPE_CLEAR in from its edges: the tool keeps that far
+    from a wall) the tool's footprint went over, row by row as it was seen at each row's two ends, is at
+    least WIPED."""
+    x0, x1, y0, y1, _ = surface(target, p.getAABB(target.body, target.link))
+    x0, x1, y0, y1 = x0 + WIPE_CLEAR, x1 - WIPE_CLEAR, y0 + WIPE_CLEAR, y1 - WIPE_CLEAR
+    rows = {}
+    for name, (_, (lo, hi)) in out.probes.items():
+        if name.startswith("row "):
+            rows.setdefault(name.split()[1], []).append((lo, hi))
+    swept = [
+        (min(b[0][0] for b in ends), max(b[1][0] for b in ends), min(b[0][1] for b in ends), max(b[1][1] for b in ends))
+        for ends in rows.values()
+    ]
+    grid = [(x, y) for x in np.arange(x0, x1, 0.005) for y in np.arange(y0, y1, 0.005)]
+    covered = sum(any(a <= x <= b and c <= y <= d for a, b, c, d in swept) for x, y in grid) / max(len(grid), 1)
+    return {"wiped_share": round(covered, 3), "ok": covered >= WIPED}
+
+
+def check_stir(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Stirred: at every point of the circles the tool reached below the rim within the container's
+    outline, and it came back out."""
+    rim = p.getAABB(target.body, target.link)[1][2]
+    circle = [v for k, v in out.probes.items() if k.startswith("stir")]
+    stirred = bool(circle) and all(box[0][2] < rim and inside(target, pos, above=1.0) for pos, box in circle)
+    lifted = "lifted" in out.probes and out.probes["lifted"][1][0][2] > rim
+    return {"stirred": stirred, "lifted_out": bool(lifted), "ok": stirred and bool(lifted)}
 
 
 def check_dip(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
@@ -457,6 +658,7 @@ class Task:
     check: Callable[[SceneObject, SceneObject, Outcome], dict]
     pours: bool = False  # the held object's contents run out of its opening
     turns: bool = False  # the held object is turned over (pouring or dumping): either way will do
+    motion: str = ""  # the class of motion it is (a learned verb's), else the predicate's own program
 
 
 TASKS = {
@@ -472,3 +674,41 @@ TASKS = {
     "brush": Task("Theme", "Destination", program_stroke, check_stroke),
     "rub": Task("Theme", "Destination", program_stroke, check_stroke),
 }
+
+# How a Theme is put at a Destination, by the Destination's motion (household.json; a kitchen container
+# takes things placed into it): the motions of every learned verb whose frame has both roles
+MOTIONS = {
+    "place": Task("Theme", "Destination", program_place, check_in_target, motion="place"),
+    "dispose": Task("Theme", "Destination", program_place, check_in_bin, motion="dispose"),
+    "hand over": Task("Theme", "Destination", program_hand_over, check_handed_over, motion="hand over"),
+}
+# the motions of a learned verb's class that work with a tool (the Instrument) on the Theme
+TOOL_MOTIONS = {
+    "stir": Task("Instrument", "Theme", program_stir, check_stir, turns=True, motion="stir"),
+    "wipe": Task("Instrument", "Theme", program_wipe, check_wiped, motion="wipe"),
+}
+
+# pulling a drawer open or pushing it shut (`slide_steps`, planned beside the task): a part of putting
+# something into it, checked with the task
+SLIDE = Task("", "", lambda g, v, holding: [], lambda held, target, out: {"ok": True}, motion="slide")
+
+
+def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
+    """The motion program of a completed frame: the paper's predicate's own; for a learned verb's frame
+    that puts a Theme at a Destination, the motion a household receptacle there asks for ("throw out the
+    peel" into a bin: dispose; "bring me the soap": hand over; "put the milk away" in a drawer: place),
+    or, at a kitchen container, placing when the verb's learned class (`verb_motion`) is `place` ("put the
+    apple in the bowl"; not "cut the bread into the bowl"); for a frame with a tool, the tool motion of the
+    verb's class ("whisk the batter with the spoon": stir). None when the robot has no motion for it."""
+    if frame.predicate in TASKS:
+        return TASKS[frame.predicate]
+    roles = frame.role_map
+    if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
+        fits = verb_motion != "wipe" or fits_on(roles["Instrument"], roles["Theme"])
+        return TOOL_MOTIONS[verb_motion] if fits else None
+    if not {"Theme", "Destination"} <= set(roles):
+        return None
+    found = household().get(roles["Destination"])
+    if found is not None:
+        return MOTIONS[found.motion]
+    return MOTIONS["place"] if verb_motion == "place" else None

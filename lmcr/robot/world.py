@@ -11,8 +11,10 @@ import pybullet as p
 
 from lmcr.robot.baxter import PEDESTAL_HEIGHT
 from lmcr.robot.description import baxter_urdf
-from lmcr.robot.scene import CONTAINERS, TABLE_CENTRE, TABLE_SIZE, TABLE_TOP, Scene, height, solid_shape, world_xy
+from lmcr.robot.household import HouseholdError, Receptacle, household, open_box
+from lmcr.robot.scene import CONTAINERS, TABLE_CENTRE, TABLE_SIZE, TABLE_TOP, WALL, Scene, height, solid_shape, world_xy
 
+SLIDE_FRICTION = 3.0  # newtons that hold a drawer where it was left (the hand pulls with up to 500)
 ROLLING_RESISTANCE = 0.01  # of round food (spheres) on the table, metres: the lever of its contact patch
 
 
@@ -22,25 +24,21 @@ def _color(label: str) -> list[float]:
 
 
 def _container(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
-    w, d, h = CONTAINERS[label]
-    t = 0.006  # wall thickness
-    parts = [
-        ([w / 2, d / 2, t / 2], [0, 0, t / 2]),
-        ([t / 2, d / 2, h / 2], [w / 2 - t / 2, 0, h / 2]),
-        ([t / 2, d / 2, h / 2], [-w / 2 + t / 2, 0, h / 2]),
-        ([w / 2, t / 2, h / 2], [0, d / 2 - t / 2, h / 2]),
-        ([w / 2, t / 2, h / 2], [0, -d / 2 + t / 2, h / 2]),
-    ]
+    """An open box of a floor and four walls (a cup, a pot), or a household receptacle built from its
+    parts (household.json) with its mass (0: fixed in place) and colour."""
+    found = household().get(label)
+    parts = found.parts if found else open_box(*CONTAINERS[label], wall=WALL)
+    mass, colour = (found.mass, list(found.colour)) if found else (0.3, _color(label))
     col = p.createCollisionShapeArray(
-        [p.GEOM_BOX] * 5, halfExtents=[e for e, _ in parts], collisionFramePositions=[o for _, o in parts]
+        [p.GEOM_BOX] * len(parts), halfExtents=[h for h, _ in parts], collisionFramePositions=[c for _, c in parts]
     )
     vis = p.createVisualShapeArray(
-        [p.GEOM_BOX] * 5,
-        halfExtents=[e for e, _ in parts],
-        visualFramePositions=[o for _, o in parts],
-        rgbaColors=[_color(label)] * 5,
+        [p.GEOM_BOX] * len(parts),
+        halfExtents=[h for h, _ in parts],
+        visualFramePositions=[c for _, c in parts],
+        rgbaColors=[colour] * len(parts),
     )
-    return p.createMultiBody(0.3, col, vis, [x, y, z])
+    return p.createMultiBody(mass, col, vis, [x, y, z])
 
 
 def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
@@ -65,6 +63,22 @@ def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     return body
 
 
+def _articulated(found: Receptacle, x: float, y: float) -> tuple[int, int, int]:
+    """A receptacle described by a URDF (a drawer unit), fixed when its mass is 0: its body, and the link
+    things go in and the joint it slides on (-1 when it has no slide). The slide's motor is a little
+    friction, so that a drawer stays where the hand leaves it."""
+    body = p.loadURDF(str(found.urdf), [x, y, TABLE_TOP], useFixedBase=found.mass == 0)
+    if found.slide is None:
+        return body, -1, -1
+    joints = {p.getJointInfo(body, j)[1].decode(): j for j in range(p.getNumJoints(body))}
+    links = {p.getJointInfo(body, j)[12].decode(): j for j in range(p.getNumJoints(body))}
+    if found.slide.joint not in joints or found.slide.link not in links:
+        raise HouseholdError(f"{found.urdf}: has no joint {found.slide.joint!r} or link {found.slide.link!r}")
+    joint = joints[found.slide.joint]
+    p.setJointMotorControl2(body, joint, p.VELOCITY_CONTROL, targetVelocity=0, force=SLIDE_FRICTION)
+    return body, links[found.slide.link], joint
+
+
 def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     """Reset a DIRECT pybullet world with floor, table, robot (the official Baxter description at `urdf`,
     else ours) and the scene's objects; returns the robot."""
@@ -84,7 +98,11 @@ def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     scene.bodies = {}
     for obj in scene.objects:
         x, y = world_xy(obj.xy)
-        obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
+        found = household().get(obj.label)
+        if found is not None and found.urdf is not None:
+            obj.body, obj.link, obj.joint = _articulated(found, x, y)
+        else:
+            obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
         scene.bodies[obj.body] = obj
     if scene.holding is not None:
         x, y = world_xy(scene.holding.xy)

@@ -1,0 +1,182 @@
+"""The household's receptacles and the person, described in data (`household.json`), not code: bins, boxes,
+a shelf and a hand held out over the table. Each is its shape (an open box, or boxes put together), its
+mass (0: fixed in place), the surface things are put on (inside it below the rim, or on its top) and the
+motion that puts a Theme there (place, dispose, hand over). The scene takes them as objects like the
+kitchen's containers; the world builds them from their parts; a learned verb's frame with a Theme and a
+Destination is carried out with the Destination's motion (`tasks.task_for`).
+
+A light module (json only): the scene's validation reads the vocabulary without loading the simulator."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from lmcr.errors import LMCRError
+
+HOUSEHOLD_FILE = Path(__file__).with_name("household.json")
+MOTIONS = ("place", "dispose", "hand over")  # the motions that put a Theme at a Destination
+SURFACES = ("inside", "top")
+
+Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # half extents, centre
+
+
+class HouseholdError(LMCRError, ValueError):
+    """The household file is not a valid description of receptacles."""
+
+
+@dataclass(frozen=True)
+class Slide:
+    """A drawer: the `link` things are put in slides on the prismatic `joint`, pulled `opens` metres
+    towards the robot by its `handle` (the bar's middle, in the body's frame, closed) and pushed back;
+    things go to the `middle` of its floor (body frame, closed) and are at most `headroom` tall (the
+    cabinet's top passes over them)."""
+
+    link: str
+    joint: str
+    opens: float
+    handle: tuple[float, float, float]
+    middle: tuple[float, float, float]
+    headroom: float
+
+
+@dataclass(frozen=True)
+class Receptacle:
+    """One receptacle: its shape (boxes in a frame whose origin is the middle of its footprint on the
+    table top, or a URDF body), the box it needs (`size`: width along x, depth along y, height), how far
+    below its top things put inside go (`depth`, 0 when they rest on top), mass, where things go, the
+    motion that puts them there, and its `slide` when it is a drawer."""
+
+    label: str
+    parts: tuple[Box, ...]
+    size: tuple[float, float, float]
+    depth: float
+    mass: float
+    surface: str
+    motion: str
+    colour: tuple[float, float, float, float]
+    urdf: Path | None = None
+    slide: Slide | None = None
+
+
+def _around(parts: tuple[Box, ...]) -> tuple[float, float, float]:
+    """Width (x), depth (y) and height of the box around the parts, from the table top up (the
+    footprint is centred on the origin by construction)."""
+    lo = [min(c[k] - h[k] for h, c in parts) for k in range(3)]
+    hi = [max(c[k] + h[k] for h, c in parts) for k in range(3)]
+    return 2 * max(-lo[0], hi[0]), 2 * max(-lo[1], hi[1]), hi[2]
+
+
+def _inner_depth(parts: tuple[Box, ...], surface: str) -> float:
+    """How far below the top the lowest part's top is (an open box's floor); 0 for things set on top."""
+    if surface == "top":
+        return 0.0
+    floor = min(parts, key=lambda part: part[1][2])
+    return _around(parts)[2] - (floor[1][2] + floor[0][2])
+
+
+def open_box(width: float, depth: float, height: float, wall: float, raised: float = 0.0) -> tuple[Box, ...]:
+    """A floor and four walls `wall` thick: a cup, a bin, a cupped hand (`raised` above the table)."""
+    t, z = wall, raised
+    return (
+        ((width / 2, depth / 2, t / 2), (0.0, 0.0, z + t / 2)),
+        ((t / 2, depth / 2, height / 2), (width / 2 - t / 2, 0.0, z + height / 2)),
+        ((t / 2, depth / 2, height / 2), (-width / 2 + t / 2, 0.0, z + height / 2)),
+        ((width / 2, t / 2, height / 2), (0.0, depth / 2 - t / 2, z + height / 2)),
+        ((width / 2, t / 2, height / 2), (0.0, -depth / 2 + t / 2, z + height / 2)),
+    )
+
+
+def _numbers(value: object, n: int, where: str, positive: bool = False) -> tuple[float, ...]:
+    ok = (
+        isinstance(value, list)
+        and len(value) == n
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+    )
+    if not ok or (positive and min(value) <= 0):
+        kind = "positive numbers" if positive else "numbers"
+        raise HouseholdError(f"{where}: must be {n} finite {kind}, not {value!r:.60}")
+    return tuple(float(v) for v in value)
+
+
+def _number(entry: dict, key: str, where: str, default: float | None = None) -> float:
+    value = entry.get(key, default)
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
+        raise HouseholdError(f"{where}: '{key}' must be a number >= 0, not {value!r:.40}")
+    return float(value)
+
+
+def _parts(entry: dict, where: str) -> tuple[Box, ...]:
+    if "open_box" in entry:
+        w, d, h = _numbers(entry["open_box"], 3, f"{where}: open_box", positive=True)
+        wall = _number(entry, "wall", where)
+        if not 0 < wall < min(w, d) / 2:
+            raise HouseholdError(f"{where}: 'wall' must be thinner than half the box, not {wall}")
+        return open_box(w, d, h, wall, _number(entry, "raised", where, 0.0))
+    parts = entry.get("parts")
+    if not isinstance(parts, list) or not parts or not all(isinstance(x, dict) for x in parts):
+        raise HouseholdError(f"{where}: needs an 'open_box' or a non-empty 'parts' list of {{half, at}}")
+    boxes = tuple(
+        (_numbers(x.get("half"), 3, f"{where}: part {k} half", True), _numbers(x.get("at"), 3, f"{where}: part {k} at"))
+        for k, x in enumerate(parts)
+    )
+    if min(c[2] - h[2] for h, c in boxes) < -1e-9:
+        raise HouseholdError(f"{where}: a part reaches below the table top")
+    return boxes
+
+
+def _choice(entry: dict, key: str, allowed: tuple[str, ...], where: str) -> str:
+    value = entry.get(key)
+    if value not in allowed:
+        raise HouseholdError(f"{where}: '{key}' must be one of {', '.join(allowed)}, not {value!r:.40}")
+    return value
+
+
+def read_household(path: Path) -> dict[str, Receptacle]:
+    """The receptacles of a household file, by label, validated (a bad entry: one line naming it)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise HouseholdError(f"{path}: not a readable JSON file ({exc})") from None
+    entries = data.get("receptacles") if isinstance(data, dict) else None
+    if not isinstance(entries, dict):
+        raise HouseholdError(f"{path}: needs a 'receptacles' object (label -> description)")
+    return {label: _receptacle(label, entry, Path(path), f"{path}: {label!r}") for label, entry in entries.items()}
+
+
+def _receptacle(label: str, entry: object, path: Path, where: str) -> Receptacle:
+    if not isinstance(entry, dict):
+        raise HouseholdError(f"{where}: is not a JSON object")
+    colour = _numbers(entry.get("colour", [0.6, 0.6, 0.6, 1]), 4, f"{where}: colour")
+    mass, surface = _number(entry, "mass", where), _choice(entry, "surface", SURFACES, where)
+    motion = _choice(entry, "motion", MOTIONS, where)
+    if "urdf" not in entry:
+        parts = _parts(entry, where)
+        return Receptacle(label, parts, _around(parts), _inner_depth(parts, surface), mass, surface, motion, colour)
+    urdf = entry["urdf"]
+    if not isinstance(urdf, str) or not (path.parent / urdf).is_file():
+        raise HouseholdError(f"{where}: 'urdf' must name a URDF file beside the household file, not {urdf!r:.60}")
+    size = _numbers(entry.get("size"), 3, f"{where}: size", positive=True)
+    depth = _number(entry, "depth", where)
+    if depth > size[2]:
+        raise HouseholdError(f"{where}: 'depth' {depth} is deeper than the body is tall ({size[2]})")
+    slide = _slide(entry["slide"], f"{where}: slide") if "slide" in entry else None
+    return Receptacle(label, (), size, depth, mass, surface, motion, colour, path.parent / urdf, slide)
+
+
+def _slide(entry: object, where: str) -> Slide:
+    if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("link", "joint")):
+        raise HouseholdError(f"{where}: needs the 'link' and the 'joint' (names in the URDF)")
+    handle = _numbers(entry.get("handle"), 3, f"{where}: handle")
+    middle = _numbers(entry.get("middle"), 3, f"{where}: middle")
+    opens, headroom = _number(entry, "opens", where), _number(entry, "headroom", where)
+    return Slide(entry["link"], entry["joint"], opens, handle, middle, headroom)
+
+
+@cache
+def household() -> dict[str, Receptacle]:
+    """The shipped household's receptacles by label."""
+    return read_household(HOUSEHOLD_FILE)

