@@ -43,13 +43,13 @@ class NoMotionError(NoPredicateError):
     def __init__(self, predicate: str):
         can = ", ".join(sorted(TASKS))
         super().__init__(
-            f"the simulated Baxter has no motion for {predicate!r} yet (it can {can}, and put a Theme "
-            "at a Destination: place, dispose, hand over)"
+            f"the simulated Baxter has no motion for {predicate!r} yet (it can {can}; and place, dispose, "
+            "hand over, stir or wipe for a verb learned as one of those)"
         )
         self.predicate = predicate
 
 
-def _with_motion(completion: Completion, options: list[tuple[Frame, Candidate | None]], lex: Lexicon) -> list:
+def _with_tasks(completion: Completion, options: list[tuple[Frame, Candidate | None]], lex: Lexicon) -> list:
     """The options with the task that carries each out (None when the robot has no motion for it: a
     learned verb whose class has none, "cut the bread into the bowl"; that one is refused as the robot
     cannot do it, and the others are offered); NoMotionError when none has one."""
@@ -109,7 +109,7 @@ def execute(
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
-    options = _with_motion(completion, _options(completion, answer), parser.lex)[:MAX_TRIED]
+    options = _with_tasks(completion, _options(completion, answer), parser.lex)[:MAX_TRIED]
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget)
     tried = _search(planner, scene, options, {d.id for d in seen})
