@@ -369,3 +369,14 @@ def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_
     assert out["frame"]["roles"]["Instrument"] == tool and out["success"] and out["checks"][check], out
     verb = {"stirred": "stirred", "wiped_share": "wiped"}[check]
     assert out["reply"] == f"I {verb} the {layout[0][0]} with the {tool}."
+
+
+def test_the_motion_names_agree_wherever_they_are_used():
+    """The household's motions are the tasks' placing motions; the tool motions are learned classes and
+    each has its past tense in what the robot says."""
+    from lmcr.frame_corpus.predicates import MOTION_CLASSES
+    from lmcr.robot.reply import TOOL_MOTIONS_SAID
+
+    assert set(tasks.MOTIONS) == set(MOTIONS)
+    assert set(tasks.TOOL_MOTIONS) <= set(MOTION_CLASSES) and set(TOOL_MOTIONS_SAID) == set(tasks.TOOL_MOTIONS)
+    assert "place" in MOTION_CLASSES  # the class a kitchen container's placing asks for (task_for)

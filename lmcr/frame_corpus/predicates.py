@@ -258,17 +258,13 @@ def motion_classes(predicates: dict[str, LearnedPredicate], fillers: dict[tuple[
         totals[role].update(counts)
     vectors = {key: _ppmi(counts, totals[key[1]]) for key, counts in blocks.items()}
     prototypes = {cls: verb for cls, verb in MOTION_CLASSES.items() if verb in predicates}
-    classes = {}
-    for name in predicates:
 
-        def likeness(cls: str, name: str = name) -> float:
-            return sum(_cosine(vectors[(name, r)], vectors[(prototypes[cls], r)]) for r in CLASS_ROLES) / len(
-                CLASS_ROLES
-            )
+    def likeness(name: str, verb: str) -> float:
+        return sum(_cosine(vectors[(name, r)], vectors[(verb, r)]) for r in CLASS_ROLES) / len(CLASS_ROLES)
 
-        if prototypes:
-            classes[name] = max(prototypes, key=lambda cls: (likeness(cls), cls))
-    return classes
+    if not prototypes:
+        return {}
+    return {name: max(prototypes, key=lambda c: (likeness(name, prototypes[c]), c)) for name in predicates}
 
 
 def _role_fillers(p: LearnedPredicate, role: str, fillers: dict[tuple[str, str], Counter]) -> Counter:

@@ -127,8 +127,7 @@ class Planner:
         """The first feasible plan over the `arms` (the nearer one first) and the task's variants, or the
         reason of the attempt that got furthest. The arm starts at its `start` configuration ("home",
         or "parked": then it first moves home), the other one parked. A spent budget ends the search."""
-        near = held if not holding else target
-        sides = sorted(arms, key=lambda s: (near.xy[1] >= 0) != (s == "left"))
+        sides = _nearer_first(held if not holding else target, arms)
         best = Infeasible("nothing was tried", -1)
         for side in sides:
             arm, other = self.arms[side], self.arms[SIDES[1 - SIDES.index(side)]]
@@ -227,7 +226,7 @@ class Planner:
         if height(held.label) > slide.headroom:
             return Infeasible(f"{_named(held)} is too tall to shut {_named(target)} over it", 0, False, _named(target))
         best = Infeasible("nothing was tried", -1)
-        for side in sorted(SIDES, key=lambda s: (target.xy[1] >= 0) != (s == "left")):
+        for side in _nearer_first(target, SIDES):
             if self.spent():
                 return best
             result = self._drawer_with(side, task, held, target, holding, slide.opens)
@@ -562,6 +561,11 @@ def _grasped(arm: Arm, q, held: SceneObject) -> tuple:
     """The held object's pose in the hand when grasped at joints `q`, as it stands now."""
     arm.set_config(q)
     return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
+
+
+def _nearer_first(obj: SceneObject, arms: tuple[str, ...]) -> list[str]:
+    """The `arms` with the one on the object's side of the table first."""
+    return sorted(arms, key=lambda s: (obj.xy[1] >= 0) != (s == "left"))
 
 
 def _named(obj: SceneObject) -> str:

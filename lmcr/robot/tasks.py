@@ -438,10 +438,15 @@ def program_stroke(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     return [*pick(g, v, holding), over_target(g, v), *strokes, over_target(g, v)]
 
 
+def _walled(label: str) -> bool:
+    """Whether things put on the object lie on a floor within walls (an open container)."""
+    return label in CONTAINERS and depth(label) > 0
+
+
 def surface(target: SceneObject, box: tuple) -> tuple[float, float, float, float, float]:
     """The surface a tool wipes: a container's floor within its walls, else the object's top, as x and y
     bounds and height (`box` the target's AABB)."""
-    (lo, hi), inset = box, (WALL if target.label in CONTAINERS and depth(target.label) > 0 else 0.0)
+    (lo, hi), inset = box, (WALL if _walled(target.label) else 0.0)
     return lo[0] + inset, hi[0] - inset, lo[1] + inset, hi[1] - inset, hi[2] - depth(target.label)
 
 
@@ -451,7 +456,7 @@ def fits_on(tool: str, label: str) -> bool:
     if not has_shape(tool) or not has_shape(label) or depth(label) >= height(tool):
         return False
     (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
-    inset = WALL + WIPE_CLEAR if label in CONTAINERS and depth(label) > 0 else WIPE_CLEAR
+    inset = WALL + WIPE_CLEAR if _walled(label) else WIPE_CLEAR
     return min(tx, ty) <= min(sx, sy) - inset and max(tx, ty) <= max(sx, sy) - inset
 
 
