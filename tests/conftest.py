@@ -1,4 +1,4 @@
-"""Shared fixtures: the embedded sample corpus, throwaway stores, and the optional ../shared data."""
+"""Shared fixtures: the embedded sample corpus, throwaway stores, the optional ../shared data and a simulator."""
 
 from __future__ import annotations
 
@@ -57,3 +57,13 @@ def prefect_api(tmp_path_factory):
             os.environ.pop("PREFECT_HOME")
         else:
             os.environ["PREFECT_HOME"] = home
+
+
+@pytest.fixture(scope="module")
+def sim():
+    """A DIRECT pybullet simulator for a test module's robot tests."""
+    import pybullet as p
+
+    client = p.connect(p.DIRECT)
+    yield client
+    p.disconnect(client)

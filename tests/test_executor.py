@@ -61,13 +61,6 @@ LAYOUTS = {
 DEFAULT_LAYOUT = ([-0.1, 0.25], [0.1, -0.2])
 
 
-@pytest.fixture(scope="module")
-def sim():
-    client = p.connect(p.DIRECT)
-    yield client
-    p.disconnect(client)
-
-
 def test_urdf_has_the_published_arm_kinematics(tmp_path, monkeypatch):
     monkeypatch.delenv("LMCR_BAXTER_URDF", raising=False)
     robot = ET.fromstring(urdf_text())
@@ -945,7 +938,10 @@ def test_a_held_object_goes_into_a_container_only_where_it_fits_the_opening(sim,
     plan = planner.plan(PROGRAMS["dip"], chicken, batter, holding=False)
     assert isinstance(plan, Plan) and (plan.arm.side == "right") is checked
     out = run_plan(plan, chicken, batter, [o for o in scene.objects if o not in (chicken, batter)], planner)
-    assert out["success"] is checked and (out["target_moved_m"] < 0.02) is checked, out
+    if checked:
+        assert out["success"] and out["target_moved_m"] < 0.02, out
+    else:  # the turned chicken met the wall and pushed the bowl
+        assert not out["success"] and out["target_moved_m"] > 0.01, out
 
 
 def test_food_that_is_not_in_a_container_is_dipped_into_without_an_opening_to_fit(sim, tmp_path):

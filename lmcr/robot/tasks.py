@@ -1,4 +1,5 @@
-"""One motion program per predicate: the steps (gripper poses, grasp, release, pouring) that act out a
+"""One motion program per predicate, and per class of motion of the learned verbs (place, dispose, hand
+over, stir, wipe, cut, cover, serve): the steps (gripper poses, grasp, release, pouring) that act out a
 completed frame, computed from the objects' geometry, and the checks that say whether it worked.
 
 A program is built for one way of doing the task (`Variant`: the gripper's turn about the vertical when
@@ -6,9 +7,9 @@ it grasps, the direction it tilts to pour); the planner tries variants until one
 exact, not corrected while moving: the held object's pose in the hand is known from the grasp, so the
 gripper pose that puts a bottle's mouth over the cup's centre is computed, not searched for.
 
-Over 400 lines on purpose: the eleven predicates' programs and their checks share the same geometry
-helpers (rims, mouths, grasp heights) and read as one table of motions; a module per predicate would
-repeat the helpers' imports eleven times for a dozen lines each.
+Over 400 lines on purpose: the programs and their checks share the same geometry helpers (rims, mouths,
+grasp heights, a tool's grip) and read as one table of motions; a module per predicate would repeat the
+helpers' imports for a dozen lines each.
 """
 
 from __future__ import annotations
@@ -25,7 +26,9 @@ from lmcr.robot.arm import DOWN, relative_pose
 from lmcr.robot.household import household
 from lmcr.robot.scene import (
     CONTAINERS,
+    FOOD,
     TABLE_TOP,
+    TOOLS,
     WALL,
     SceneObject,
     depth,
@@ -57,6 +60,18 @@ STIR_DEPTH, STIR_CLEAR = 0.03, 0.015  # its tip this far below the rim, this far
 HANDLE_BAR = 0.015  # a drawer handle's bar, this thick
 SHUT = 0.01  # metres: a drawer this near its closed end is shut
 PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
+CUT_STROKES, SAW = 3, 0.015  # a cut saws down through the food in this many strokes, the blade this far back and forth
+CUT_ABOVE, CUT_CLEAR = 0.03, 0.004  # the edge starts this far above the food; it ends this far above the board
+CUT_THROUGH = 0.006  # the food is cut through when the edge came this near its underside
+HANDLE_OFF = 0.005  # while sawing, the blade's end next to the handle stays this far off the food
+COVER_GAP = 0.005  # a lid is let go with its underside this far above the rim
+LEVEL = math.radians(5)  # a lid tilted more than this does not sit on the rim
+# a ladle's bowl dips with its floor this far below the rim of what it scoops from, at least this far above
+# its floor; it carries this many grains (the content) and is tipped out this far above the target's rim
+SCOOP_DEPTH, SCOOP_FLOOR, SCOOP_GRAINS, TIP_HEIGHTS = 0.045, 0.015, 12, (0.06, 0.03, 0.1)
+TIPS = tuple(math.radians(a) for a in (15, 30, 45))  # it is tipped out in steps, its spout kept in place
+LEVEL_CARRY, LEVEL_LEG = 0.08, 0.08  # ... carried level this far above the higher rim, in legs this long
+SERVED = 0.6  # this share of what the ladle carried must end in the target
 
 
 @dataclass(frozen=True)
@@ -64,6 +79,8 @@ class Step:
     """A gripper pose to reach (`kind` "move", first reachable of `positions`), or an action."""
 
     # move | home, park (to the arm's start, out of the way) | grasp | release | spill | give (a person takes it)
+    # | blade in (a knife goes into food) | cut (the food is cut through when the blade went down through it)
+    # | scoop (a ladle fills where it is) | run out (what it carries is let go of) | empty (wait while it runs out)
     kind: str
     name: str = ""
     positions: tuple = ()
@@ -100,6 +117,8 @@ class Variant:
     def half_across(self, label: str) -> float:
         """Half the object's width between the fingers: a round one's radius, or a box's extent along
         the line a top grasp's fingers close on (across a long object's narrow side)."""
+        if label in TOOLS and not self.side:  # held by its grip: a knife's handle, a lid's knob
+            return TOOLS[label].grip_width / 2
         half_x, half_y, round_ = outline(label)
         if self.side or round_:
             return footprint(label)
@@ -139,9 +158,10 @@ class Geometry:
     target_top: np.ndarray = field(default_factory=lambda: np.zeros(3))
     target_box: tuple = ()
     grasped: tuple | None = None  # the held object's pose in the hand as found after the grasp, if not as planned
+    source: SceneObject | None = None  # what a ladle scoops from (Task.source)
 
     @classmethod
-    def measure(cls, held: SceneObject, target: SceneObject) -> Geometry:
+    def measure(cls, held: SceneObject, target: SceneObject, source: SceneObject | None = None) -> Geometry:
         pos, orn = p.getBasePositionAndOrientation(held.body)
         lo, hi = p.getAABB(target.body, target.link)  # a drawer's: what things are put in
         tpos = slide_point(target, "middle") if target.joint >= 0 else p.getBasePositionAndOrientation(target.body)[0]
@@ -153,11 +173,15 @@ class Geometry:
             np.array([pos[0], pos[1], p.getAABB(held.body)[1][2]]),
             np.array([tpos[0], tpos[1], hi[2]]),
             (lo, hi),
+            source=source,
         )
 
     def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
-        """The gripper pose that grasps the held object by its top, or from the side around its body
-        (high enough for the hand to clear the table)."""
+        """The gripper pose that grasps the held object by its top (a tool by its grip's), or from the side
+        around its body (high enough for the hand to clear the table)."""
+        if self.held.label in TOOLS and not variant.side:
+            grip = p.multiplyTransforms(self.held_pos, self.held_orn, TOOLS[self.held.label].grip, [0, 0, 0, 1])[0]
+            return np.asarray(grip) + [0, 0, GRIP_GAP], variant.upright()
         if variant.side:
             return self.held_top - [
                 0,
@@ -260,9 +284,10 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
     if not round_ and abs(2 * half_x - 2 * half_y) > 0.02:
         long_x = half_x > half_y
         yaws = [0.0, math.pi] if long_x else [math.pi / 2, -math.pi / 2]
-        # a long object may also be held nearer either end, the hand then further from a neighbour
+        # a long object may also be held nearer either end, the hand then further from a neighbour (a
+        # tool only by its grip)
         reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
-        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 else []
+        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 and held.label not in TOOLS else []
     signs = (1, -1) if turns else (1,)
     top = [
         Variant(yaw, pitch, sign, turn=turn, shift=shift)
@@ -523,6 +548,147 @@ def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     ]
 
 
+def cuts(tool: str, label: str) -> bool:
+    """Whether the `tool` cuts the `label` through: a blade, and food whose short side it spans while it saws
+    (drawn SAW back and forth across the food's middle, the handle kept off the food)."""
+    found = TOOLS.get(tool)
+    if label not in FOOD or found is None or found.blade is None:
+        return False
+    half_x, half_y, _ = outline(label)
+    return min(half_x, half_y) + SAW <= found.blade_reach - HANDLE_OFF + 1e-9
+
+
+def program_cut(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Hold the knife's blade upright over the food's middle, along its short side, and saw down through
+    it to the board in CUT_STROKES strokes (the blade drawn back and forth), then lift it out. Whether the
+    food was cut through is seen when the strokes end (`act` then swaps it for its pieces)."""
+    tool, (half_x, half_y, _) = TOOLS[g.held.label], outline(g.target.label)
+    # the handle to one side or the other (the two ways of doing it), the blade across a long food
+    heading = (math.pi / 2 if half_x > half_y else 0.0) + (0.0 if v.tilt_sign > 0 else math.pi)
+    orn = _turned(v.upright(), heading)
+    edge = g.point_in_hand(v, tool.blade)
+    ahead = g.point_in_hand(v, np.add(tool.blade, np.multiply(tool.blade_axis, SAW)))
+    along = gripper_for(edge, orn, [0, 0, 0]) - gripper_for(ahead, orn, [0, 0, 0])  # SAW along the edge, in the world
+    (x, y, top), bottom = g.target_top, g.target_box[0][2]
+
+    def edge_at(sawed: float, z: float) -> np.ndarray:
+        return gripper_for(edge, orn, [x, y, z]) + sawed * along
+
+    depths = np.linspace(top, bottom + CUT_CLEAR, CUT_STROKES + 1)[1:]
+    name, start = g.target.name, edge_at(0.0, top + CUT_ABOVE)
+    return [
+        *pick(g, v, holding),
+        above(start, f"over {name}", orn),
+        move(f"the blade over {name}", start, orn),
+        Step("blade in", f"into {name}"),
+        *[
+            Step("move", f"cut {k + 1}", (edge_at((-1.0) ** k, z),), orn, "target", f"cut {k + 1}", straight=True)
+            for k, z in enumerate(depths)
+        ],
+        Step("cut", f"through {name}"),
+        Step("move", f"lift the {g.held.name} out", (start,), orn, "target", "lifted", straight=True),
+    ]
+
+
+def covers(tool: str, label: str) -> bool:
+    """Whether the `tool` covers the `label`: a container with an opening, and a tool that lies over all of
+    it (a lid, foil; a plate on a bowl)."""
+    if tool == label or not has_shape(tool) or not has_shape(label) or not _walled(label):
+        return False
+    (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
+    return tx >= sx and ty >= sy
+
+
+def program_cover(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Carry the lid (or foil) square over the container, lower it until its underside is COVER_GAP above
+    the rim, let go (it settles on the rim) and draw back."""
+    orn, t = v.upright(), g.target_top
+    lower = gripper_for(g.bottom(v), orn, t + [0, 0, COVER_GAP])
+    return [
+        *pick(g, v, holding),
+        over_target(g, v),
+        move(f"lower it onto {g.target.name}", lower, orn, touches="target"),
+        Step("release", "let go"),
+        above(t, "retreat", orn),
+    ]
+
+
+def scoops(tool: str) -> bool:
+    """Whether the `tool` has a bowl to carry content in (a ladle)."""
+    return tool in TOOLS and TOOLS[tool].scoop is not None
+
+
+def serves(source: str, target: str, tool: str | None) -> bool:
+    """Whether content can be served from `source` into `target` (both hold things within walls) with the
+    `tool` (a ladle; None: the one the robot finds on the table)."""
+    return _walled(source) and _walled(target) and source != target and (tool is None or scoops(tool))
+
+
+def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Dip the ladle's bowl into the container it serves from (its floor SCOOP_DEPTH below the rim, at
+    least SCOOP_FLOOR above the container's floor), fill it there, lift it out level, carry it over the
+    target, and tip it out spout first in TIPS, the spout held TIP_HEIGHTS above the target's middle; then
+    level again the same way and lift it."""
+    # the ladle headed as the variant turns it, or the other way round (`tilt_sign`: the tip's own way is
+    # the one that lowers the spout): its handle and foot may be in another object's way in one of them
+    v = replace(v, turn=v.turn + (0.0 if v.tilt_sign > 0 else math.pi))
+    tool, orn = TOOLS[g.held.label], v.at_target()
+    bowl, lip = g.point_in_hand(v, tool.scoop), g.point_in_hand(v, tool.lip)
+    lo, hi = p.getAABB(g.source.body, g.source.link)
+    x, y = (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2
+    bottom = max(hi[2] - SCOOP_DEPTH, hi[2] - depth(g.source.label) + SCOOP_FLOOR)
+    dip, lifted = gripper_for(bowl, orn, [x, y, bottom]), gripper_for(bowl, orn, [x, y, hi[2] + 0.03])
+    # the way of turning the hand that tips the bowl down (the other would run the content down the handle)
+    sign = min((1, -1), key=lambda s: -gripper_for(bowl, tilted(replace(v, tilt_sign=s), TIPS[-1]), [0, 0, 0])[2])
+    tips = [tilted(replace(v, tilt_sign=sign), angle) for angle in TIPS]
+    spouts = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
+    pours = tuple(gripper_for(lip, orn, spout) for spout in spouts)  # level, the spout over the target
+    name, into = g.source.name, g.target.name
+    return [
+        *pick(g, v, holding),
+        above(lifted, f"over {name}", orn),
+        move(f"above {name}", lifted, orn),
+        Step("move", f"dip into {name}", (dip,), orn, straight=True),
+        Step("scoop", f"fill it from {name}"),
+        Step("move", f"lift it out of {name}", (lifted,), orn, straight=True),
+        # carried level on straight lines (a joint-space motion turns the hand between its ends, and the
+        # open spout would spill): up, across, and down to the spout over the target
+        *_level_carry(lifted, pours[0], orn, into),
+        Step("move", f"its spout over {into}", pours, orn, straight=True),
+        Step("run out", "let the content go"),
+        # (the spout a little higher or lower where the arm cannot tip it further where it is)
+        *[
+            Step("move", f"tip it out {k + 1}", tuple(gripper_for(lip, t, at) for at in spouts), t, straight=True)
+            for k, t in enumerate(tips)
+        ],
+        Step("empty", "let it run out"),
+        # level again the way it tipped (clear of the target's rim as it was), then up and away
+        *[
+            Step("move", f"level it {k + 1}", tuple(gripper_for(lip, t, at) for at in spouts), t, straight=True)
+            for k, t in enumerate([*tips[-2::-1], orn])
+        ],
+        Step("move", "lift it", tuple(x + [0, 0, LEVEL_CARRY] for x in pours), orn, straight=True),
+    ]
+
+
+def _level_carry(start: np.ndarray, end: np.ndarray, orn, into: str) -> list[Step]:
+    """Straight up from `start`, across and down to LEVEL_CARRY above `end` without turning the hand, in
+    legs at most LEVEL_LEG long (each solved from the last: one long line's end may be solved in another
+    arm configuration, and the hand would turn on the way to it); a leg across goes higher where the
+    lower way is blocked (past a tall bin)."""
+    top = max(start[2], end[2]) + LEVEL_CARRY
+    corners = [start, np.array([*start[:2], top]), np.array([*end[:2], top]), end + [0, 0, LEVEL_CARRY]]
+    legs = []
+    for a, b in zip(corners, corners[1:]):
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / LEVEL_LEG))
+        across = a[2] == b[2] == top
+        legs += [(a + (b - a) * k / n, across and k < n) for k in range(1, n + 1)]
+    return [
+        Step("move", f"carry it to {into} {k + 1}", (x, x + [0, 0, LEVEL_CARRY]) if up else (x,), orn, straight=True)
+        for k, (x, up) in enumerate(legs)
+    ]
+
+
 def put_down(xy: tuple[float, float]) -> Task:
     """Pick the object up (unless it is in the hand), set it down upright at the free table spot `xy`
     and park the arm: the object is in the way of a task in the hand or out of one arm's reach, and the
@@ -552,6 +718,9 @@ class Outcome:
     probes: dict[str, tuple] = field(default_factory=dict)  # name -> (position, AABB)
     replanned: bool = False
     taken: bool = False  # the person took the object handed over
+    pieces: list[int] = field(default_factory=list)  # the bodies a cut food became
+    clinging: list[int] = field(default_factory=list)  # what holds a ladle's content in it while carried
+    cut: tuple = ()  # the cut's plane: a point on it and its normal (world)
 
 
 def inside(target: SceneObject, point, above: float = 0.05) -> bool:
@@ -637,6 +806,40 @@ def check_stir(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
     return {"stirred": stirred, "lifted_out": bool(lifted), "ok": stirred and bool(lifted)}
 
 
+def check_cut(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Cut: the food is in pieces, one each side of the blade's plane, still about where the food lay (on
+    the board, not flung away), and the knife came back out above them."""
+    if not out.pieces:
+        return {"in_pieces": False, "pieces_in_place": False, "lifted_out": False, "ok": False}
+    point, normal = out.cut
+    at = [np.asarray(p.getBasePositionAndOrientation(b)[0]) for b in out.pieces]
+    sides = {bool(np.dot(x - point, normal) > 0) for x in at}
+    # a piece may roll over onto its flat side (half an apple rolls about 1.6 of its radius), not further
+    near = all(np.linalg.norm((x - point)[:2]) <= 2 * footprint(target.label) + 0.03 and x[2] >= TABLE_TOP for x in at)
+    top = max(p.getAABB(b)[1][2] for b in out.pieces)
+    lifted = "lifted" in out.probes and out.probes["lifted"][1][0][2] > top
+    pieces = len(out.pieces) >= 2 and sides == {True, False}
+    return {"in_pieces": pieces, "pieces_in_place": near, "lifted_out": lifted, "ok": pieces and near and lifted}
+
+
+def check_served(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Served: the ladle was filled in the container it served from, and at least SERVED of what it
+    carried lies in the target (below its rim)."""
+    filled = len(out.particles) >= SCOOP_GRAINS
+    share = share_inside(target, out.particles, above=0.01) if filled else 0.0
+    return {"filled": filled, "served_share": share, "ok": bool(filled and share >= SERVED)}
+
+
+def check_covered(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
+    """Covered: the lid (foil) rests on the container's rim, level, over the whole opening."""
+    (lo, hi), (tlo, thi) = p.getAABB(held.body), p.getAABB(target.body, target.link)
+    over = all(lo[k] <= tlo[k] + WALL and hi[k] >= thi[k] - WALL for k in (0, 1))
+    on_rim = thi[2] - 0.005 <= lo[2] <= thi[2] + 0.01
+    up = np.asarray(p.getMatrixFromQuaternion(p.getBasePositionAndOrientation(held.body)[1])).reshape(3, 3)[:, 2]
+    level = bool(math.acos(min(1.0, abs(up[2]))) <= LEVEL)
+    return {"over_opening": over, "on_rim": on_rim, "level": level, "ok": bool(over and on_rim and level)}
+
+
 def check_dip(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
     rim = p.getAABB(target.body)[1][2]
     pos, box = out.probes["dip"]
@@ -664,6 +867,14 @@ class Task:
     pours: bool = False  # the held object's contents run out of its opening
     turns: bool = False  # the held object is turned over (pouring or dumping): either way will do
     motion: str = ""  # the class of motion it is (a learned verb's), else the predicate's own program
+    square: bool = False  # the held object stays square to the table (the program turns it, if at all)
+    source_role: str = ""  # the role of a third object the motion works with (serve: what it scoops from)
+    # ... that object, once the instruction's objects are known (`with_source`)
+    source: SceneObject | None = field(default=None, compare=False)
+
+    def with_source(self, objects: dict[str, SceneObject]) -> Task:
+        """The task for the instruction's `objects` (role -> object): with its source when it has one."""
+        return replace(self, source=objects[self.source_role]) if self.source_role else self
 
 
 TASKS = {
@@ -691,7 +902,14 @@ MOTIONS = {
 TOOL_MOTIONS = {
     "stir": Task("Instrument", "Theme", program_stir, check_stir, turns=True, motion="stir"),
     "wipe": Task("Instrument", "Theme", program_wipe, check_wiped, motion="wipe"),
+    "cut": Task("Instrument", "Theme", program_cut, check_cut, turns=True, motion="cut", square=True),
+    "cover": Task("Instrument", "Theme", program_cover, check_covered, motion="cover", square=True),
 }
+# a verb of the serve class: a ladle (the Instrument, stated or found on the table) carries the Theme's
+# content into the Destination
+SERVE = Task("Instrument", "Destination", program_serve, check_served, turns=True, motion="serve", source_role="Theme")
+# whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
+TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers}
 
 # pulling a drawer open or pushing it shut (`slide_steps`, planned beside the task): a part of putting
 # something into it, checked with the task
@@ -704,12 +922,17 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
     peel" into a bin: dispose; "bring me the soap": hand over; "put the milk away" in a drawer: place),
     or, at a kitchen container, placing when the verb's learned class (`verb_motion`) is `place` ("put the
     apple in the bowl"; not "cut the bread into the bowl"); for a frame with a tool, the tool motion of the
-    verb's class ("whisk the batter with the spoon": stir). None when the robot has no motion for it."""
+    verb's class ("whisk the batter with the spoon": stir; "slice the bread with the knife": cut; "cover the pot
+    with the lid": cover) when the tool's shape can do it; a verb of the serve class ladles the Theme's
+    content into the Destination ("ladle the soup into the bowl"). None when the robot has no motion for it."""
     if frame.predicate in TASKS:
         return TASKS[frame.predicate]
     roles = frame.role_map
+    if verb_motion == "serve" and {"Theme", "Destination"} <= set(roles) and roles["Destination"] not in household():
+        served = serves(roles["Theme"], roles["Destination"], roles.get("Instrument"))
+        return SERVE if served else None
     if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
-        fits = verb_motion != "wipe" or fits_on(roles["Instrument"], roles["Theme"])
+        fits = TOOL_FITS.get(verb_motion, lambda tool, label: True)(roles["Instrument"], roles["Theme"])
         return TOOL_MOTIONS[verb_motion] if fits else None
     if not {"Theme", "Destination"} <= set(roles):
         return None

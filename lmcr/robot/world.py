@@ -12,7 +12,18 @@ import pybullet as p
 from lmcr.robot.baxter import PEDESTAL_HEIGHT
 from lmcr.robot.description import baxter_urdf
 from lmcr.robot.household import HouseholdError, Receptacle, household, open_box
-from lmcr.robot.scene import CONTAINERS, TABLE_CENTRE, TABLE_SIZE, TABLE_TOP, WALL, Scene, height, solid_shape, world_xy
+from lmcr.robot.scene import (
+    CONTAINERS,
+    TABLE_CENTRE,
+    TABLE_SIZE,
+    TABLE_TOP,
+    TOOLS,
+    WALL,
+    Scene,
+    height,
+    solid_shape,
+    world_xy,
+)
 
 SLIDE_FRICTION = 3.0  # newtons that hold a drawer where it was left (the hand pulls with up to 500)
 ROLLING_RESISTANCE = 0.01  # of round food (spheres) on the table, metres: the lever of its contact patch
@@ -29,6 +40,17 @@ def _container(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
     found = household().get(label)
     parts = found.parts if found else open_box(*CONTAINERS[label], wall=WALL)
     mass, colour = (found.mass, list(found.colour)) if found else (0.3, _color(label))
+    return _boxes(parts, mass, colour, x, y, z)
+
+
+def _tool(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
+    """A tool built from its parts (household.json: a knife's handle and blade, a lid and its knob)."""
+    tool = TOOLS[label]
+    return _boxes(tool.parts, tool.mass, list(tool.colour), x, y, z)
+
+
+def _boxes(parts: tuple, mass: float, colour: list[float], x: float, y: float, z: float) -> int:
+    """One body of boxes (half extents, centre) in a frame at (x, y, z), the middle of its footprint."""
     col = p.createCollisionShapeArray(
         [p.GEOM_BOX] * len(parts), halfExtents=[h for h, _ in parts], collisionFramePositions=[c for _, c in parts]
     )
@@ -79,6 +101,10 @@ def _articulated(found: Receptacle, x: float, y: float) -> tuple[int, int, int]:
     return body, links[found.slide.link], joint
 
 
+# how each kind of object is built (SceneObject.kind)
+_MAKERS = {"container": _container, "tool": _tool, "bottle": _solid, "shaker": _solid, "food": _solid}
+
+
 def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     """Reset a DIRECT pybullet world with floor, table, robot (the official Baxter description at `urdf`,
     else ours) and the scene's objects; returns the robot."""
@@ -102,12 +128,11 @@ def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
         if found is not None and found.urdf is not None:
             obj.body, obj.link, obj.joint = _articulated(found, x, y)
         else:
-            obj.body = _container(obj.label, x, y) if obj.kind == "container" else _solid(obj.label, x, y)
+            obj.body = _MAKERS[obj.kind](obj.label, x, y)
         scene.bodies[obj.body] = obj
     if scene.holding is not None:
         x, y = world_xy(scene.holding.xy)
-        make = _container if scene.holding.kind == "container" else _solid
-        scene.holding.body = make(scene.holding.label, x, y, 0.0)  # on the floor
+        scene.holding.body = _MAKERS[scene.holding.kind](scene.holding.label, x, y, 0.0)  # on the floor
     for _ in range(120):  # let everything settle
         p.stepSimulation()
     return robot
