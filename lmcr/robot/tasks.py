@@ -629,9 +629,6 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     least SCOOP_FLOOR above the container's floor), fill it there, lift it out level, carry it over the
     target, and tip it out spout first in TIPS, the spout held TIP_HEIGHTS above the target's middle; then
     level again the same way and lift it."""
-    # the ladle headed as the variant turns it, or the other way round (`tilt_sign`: the tip's own way is
-    # the one that lowers the spout): its handle and foot may be in another object's way in one of them
-    v = replace(v, turn=v.turn + (0.0 if v.tilt_sign > 0 else math.pi))
     tool, orn = TOOLS[g.held.label], v.at_target()
     bowl, lip = g.point_in_hand(v, tool.scoop), g.point_in_hand(v, tool.lip)
     lo, hi = p.getAABB(g.source.body, g.source.link)
@@ -907,7 +904,7 @@ TOOL_MOTIONS = {
 }
 # a verb of the serve class: a ladle (the Instrument, stated or found on the table) carries the Theme's
 # content into the Destination
-SERVE = Task("Instrument", "Destination", program_serve, check_served, turns=True, motion="serve", source_role="Theme")
+SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme")
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
 TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers}
 
