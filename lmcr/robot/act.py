@@ -165,7 +165,7 @@ def _scoop(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
     """Fill the ladle; what it took clings to it (as a grasp holds) until it is tipped out: loose grains on
     a floor open at the spout ratchet out of it as the arm starts and stops, which a thick soup does not."""
     out.particles += fill(held, plan.geometry.source)
-    out.clinging = [_cling(held.body, grain) for grain in out.particles]
+    out.clinging = [fix_to(held.body, grain) for grain in out.particles]
 
 
 def _run_out(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
@@ -173,12 +173,6 @@ def _run_out(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
     for constraint in out.clinging:
         p.removeConstraint(constraint)
     out.clinging = []
-
-
-def _cling(body: int, grain: int) -> int:
-    pose = p.getBasePositionAndOrientation
-    rel_pos, rel_orn = relative_pose(*pose(body), *pose(grain))
-    return p.createConstraint(body, -1, grain, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn)
 
 
 def _empty(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
@@ -204,10 +198,16 @@ def take(held: SceneObject, person: SceneObject) -> bool:
     where it is. False when it does not (the person cannot take what is not in their hand)."""
     if not in_palm(held, person):
         return False
-    pose = p.getBasePositionAndOrientation
-    rel_pos, rel_orn = relative_pose(*pose(person.body), *pose(held.body))
-    p.createConstraint(person.body, -1, held.body, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn)
+    fix_to(person.body, held.body)
     return True
+
+
+def fix_to(body: int, other: int) -> int:
+    """Hold `other` rigidly where it now is relative to `body` (a hand that took it, a ladle it clings to);
+    returns the constraint."""
+    pose = p.getBasePositionAndOrientation
+    rel_pos, rel_orn = relative_pose(*pose(body), *pose(other))
+    return p.createConstraint(body, -1, other, -1, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn)
 
 
 def _replan_if_shifted(arm, plan: Plan, held: SceneObject, planner: Planner) -> Plan | None:
