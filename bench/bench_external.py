@@ -9,6 +9,10 @@ how often the prediction set holds a right object and its mean size (KnowNo's su
 share with no completion and why, and the latency of one completion (p50, p90). The measures are
 defined in lmcr/evaluate/external.py. --out-jsonl writes one line per item: its set, the completion
 line (`prediction_set` included, or its error) and its outcome.
+
+--peer [GGUF] adds the peer's rows (lmcr/evaluate/peer.py): the same items put zero-shot to a small
+offline LM (Gemma 3 270M from the `peer` extra, or the GGUF file given), under each of its scorings;
+--peer-only leaves the product's rows out.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from pathlib import Path
 
 from record import add_json_option, run_or_exit, write_results
 
+from lmcr.evaluate import peer
 from lmcr.evaluate.external import read_sets, run_set, summarize
 from lmcr.files import check_output_file
 from lmcr.jsonl import InputError, write_jsonl_atomic
@@ -83,6 +88,8 @@ def main() -> None:
     parser_.add_argument("--data-dir", type=Path, default=None, help="data folder (default $LMCR_DATA_DIR)")
     parser_.add_argument("--method", default=COMPLETION_METHOD, help=f"completion method (default {COMPLETION_METHOD})")
     parser_.add_argument("--out-jsonl", type=Path, default=None, help="one line per item: completion and outcome")
+    parser_.add_argument("--peer", nargs="?", const="", default=None, metavar="GGUF", help="add the offline LM peer")
+    parser_.add_argument("--peer-only", action="store_true", help="only the peer's rows")
     add_json_option(parser_, "bench_external")
     args = parser_.parse_args()
     run_or_exit(run, args)
@@ -93,10 +100,23 @@ def run(args: argparse.Namespace) -> None:
     if args.out_jsonl is not None:
         check_output_file(args.out_jsonl)
     ws = Workspace.from_env(data_dir=args.data_dir)
-    scorer, config = ws.completion_scorer(args.method)
+    figures, lines = {"sets": ", ".join(sets)}, []
+    if not args.peer_only:
+        figures |= product_rows(ws, args.method, sets, lines)
+    if args.peer is not None or args.peer_only:
+        figures |= peer_table(ws, args.peer or None, sets, lines)
+    if args.out_jsonl is not None:
+        write_jsonl_atomic(args.out_jsonl, lines)
+        print(f"{len(lines)} items written to {args.out_jsonl}")
+    write_results(args.json, "bench_external", __doc__.splitlines()[0], figures)
+
+
+def product_rows(ws: Workspace, method: str, sets: dict, lines: list) -> dict:
+    """The product's figures per set (printed as a table), its lines appended to `lines`."""
+    scorer, config = ws.completion_scorer(method)
     parser = ws.parser()
-    print(f"{args.method}; {config.source}")
-    summaries, lines = {}, []
+    print(f"{method}; {config.source}")
+    summaries = {}
     for name, items in sets.items():
         done = run_set(parser, scorer, config, items)
         summaries[name] = summarize(items, [outcome for _, outcome in done])
@@ -105,13 +125,30 @@ def run(args: argparse.Namespace) -> None:
     for name, summary in summaries.items():
         reasons = ", ".join(f"{reason} {count}" for reason, count in summary["error reasons"].items())
         print(f"{name}: errors: {reasons or 'none'}")
-    if args.out_jsonl is not None:
-        write_jsonl_atomic(args.out_jsonl, lines)
-        print(f"{len(lines)} items written to {args.out_jsonl}")
-    figures = {"method": args.method, "calibration": config.source, "sets": ", ".join(sets)}
+    figures = {"method": method, "calibration": config.source}
     for name, summary in summaries.items():
         figures |= flat(name, summary)
-    write_results(args.json, "bench_external", __doc__.splitlines()[0], figures)
+    return figures
+
+
+def peer_table(ws: Workspace, gguf: str | None, sets: dict, lines: list) -> dict:
+    """The peer's figures per set and scoring (printed as a table), its answers appended to `lines`."""
+    model_file = Path(gguf) if gguf else peer.gguf_model_file(ws.data_dir / "baselines")
+    print(f"peer: {model_file.name}, loading (a minute or two)", flush=True)
+    lm = peer.load_peer(model_file)
+    answers = {}
+    for name, items in sets.items():
+        answers[name] = [peer.answer(lm.logprob, item) for item in items]
+        lines += [{"set": name, "peer": a.to_json()} for a in answers[name]]
+        print(f"peer: {name} answered", flush=True)
+    figures = {"peer": f"{model_file.name}, zero-shot, told the missing role"}
+    for scoring in peer.SCORINGS:
+        rows = peer.peer_rows(sets, answers, scoring)
+        print(f"peer ({scoring} log-probability of the answer)")
+        print(table({name: {**dict.fromkeys(key for _, key, _ in COLUMNS), **row} for name, row in rows.items()}))
+        for name, row in rows.items():
+            figures |= {f"peer {scoring}: {name}: {k}": v for k, v in row.items()}
+    return figures
 
 
 if __name__ == "__main__":

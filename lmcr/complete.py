@@ -208,7 +208,7 @@ def complete(
     spec = parser.lex.predicates[frame.predicate]
     pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing))
-    scores = scorer([Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], context)
+    scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
         scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
     probs = softmax(scores, config.temperature)
@@ -229,6 +229,22 @@ def complete(
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )
+
+
+def _scores(scorer: Scorer, frames: list[Frame], fillings: list[dict[str, str]], context: str) -> list[float]:
+    """The frames' scores. Where the fillings span several open roles and the scorer has terms that only
+    rank fillers within a role (`SummedScorer.with_roles`), each role's best scores as it does without
+    them and its fillers keep their order with them: the roles compete as without the terms."""
+    by_role = [next(iter(f)) for f in fillings]
+    if not getattr(scorer, "has_within_role", False) or len(set(by_role)) < 2:
+        return scorer(frames, context)
+    full, without = scorer.with_roles(frames, context)
+    best: dict[str, float] = {}
+    best_without: dict[str, float] = {}
+    for role, score, rest in zip(by_role, full, without):
+        best[role] = max(best.get(role, -math.inf), score)
+        best_without[role] = max(best_without.get(role, -math.inf), rest)
+    return [score - best[role] + best_without[role] for role, score in zip(by_role, full)]
 
 
 def _open_roles(spec, roles: dict[str, str | None], missing: list[str]) -> tuple[str, ...]:

@@ -25,15 +25,27 @@ def test_smoothed_estimates_by_hand():
     assert m.n == 10 and m.types == 3
     p_bowl = (1 + 1) / (10 + 3 + 1)  # add-one over the fillers, one slot for unseen
     assert m.p_value("bowl") == pytest.approx(p_bowl)
-    p_bowl_dest = (1 + 2 * p_bowl) / (4 + 2)  # pour's Destination seen 4 times, bowl once
+    bowl_a_dest = (1 + 2 * p_bowl) / (4 + 2)  # every predicate's Destinations: 4, bowl once
+    assert m.p_in_role("Destination", "bowl") == pytest.approx(bowl_a_dest)
+    p_bowl_dest = (1 + 2 * bowl_a_dest) / (4 + 2)  # pour's Destination seen 4 times, bowl once
     assert m.p_filler("pour", "Destination", "bowl") == pytest.approx(p_bowl_dest)
     given = (0 + 2 * p_bowl_dest) / (3 + 2)  # water was the theme of 3 frames with a destination, none bowl
     assert m.p_given("pour", "Theme", "water", "Destination", "bowl") == pytest.approx(given)
-    p_water_theme = (4 + 2 * m.p_value("water")) / (4 + 2)
+    water_a_theme = (6 + 2 * m.p_value("water")) / (6 + 2)  # pour's 4 and cut's 2 Themes
+    p_water_theme = (4 + 2 * water_a_theme) / (4 + 2)
     back = (0 + 2 * p_water_theme) / (0 + 2)  # bowl never given: the backoff alone
     assert m.score_frame(("pour", {"Theme": "water", "Destination": "bowl"})) == pytest.approx(
         math.log(given) + math.log(back)
     )
+
+
+def test_a_verb_never_seen_with_a_filler_backs_off_to_what_fills_the_role():
+    m = FrameCountScorer(FILLERS, PAIRS)
+    # cut never had a Destination: a cup (a Destination of pour, 3 times) outscores water (only ever a Theme)
+    assert m.p_filler("cut", "Destination", "cup") > m.p_filler("cut", "Destination", "water")
+    # as a Theme it is the other way round (cut's own Themes are all water, so compare a verb with none)
+    assert m.p_filler("fry", "Theme", "water") > m.p_filler("fry", "Theme", "cup")
+    assert m.p_filler("fry", "Destination", "cup") > m.p_filler("fry", "Destination", "water")
 
 
 def test_seen_together_beats_seen_apart_and_unseen():

@@ -263,6 +263,35 @@ def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parse
 
 
 @pytest.mark.model
+def test_a_within_role_term_ranks_fillers_but_leaves_the_open_role_to_the_rest(learned_parser):
+    from lmcr.complete import complete
+    from lmcr.scorers.registry import SummedScorer
+
+    rest = {("Destination", "glass"): 2.0, ("Instrument", "microwave"): 1.0, ("Instrument", "oven"): 0.5}
+    term = {("Instrument", "oven"): 5.0, ("Destination", "glass"): -1.0}  # would turn the role to Instrument
+
+    def reading(likes):
+        return lambda frames, context="": [sum(likes.get(pair, 0.0) for pair in f.roles) for f in frames]
+
+    objects = ["soup", "microwave", "oven", "glass"]
+    summed = complete(
+        learned_parser, SummedScorer([(reading(rest), False), (reading(term), False)]), "warm the soup", objects
+    )
+    assert summed.frame.role_map == {"Theme": "soup", "Instrument": "oven"}  # a plain sum: the term chose the role
+    split = complete(
+        learned_parser, SummedScorer([(reading(rest), False), (reading(term), True)]), "warm the soup", objects
+    )
+    assert split.frame.role_map == {"Theme": "soup", "Destination": "glass"}  # the role as the rest chose it
+    ranked = [(c.objects, c.score) for c in split.candidates]
+    instruments = [objects for objects, _ in ranked if "Instrument" in objects]
+    assert instruments[0] == {"Instrument": "oven"}  # within the role the term still ranks: oven over microwave
+    # each role's best scores as without the term (and its open-role prior): the roles compete as before
+    alone = complete(learned_parser, reading(rest), "warm the soup", objects)
+    best = {next(iter(c.objects)): c.score for c in reversed(alone.candidates)}
+    assert {next(iter(o)): s for o, s in reversed(ranked)} == pytest.approx(best, abs=1e-3)
+
+
+@pytest.mark.model
 def test_a_verb_with_too_little_evidence_is_refused_by_name(learned_parser):
     from lmcr.srl.instruction import NoPredicateError, parse_instruction
 

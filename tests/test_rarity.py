@@ -1,14 +1,18 @@
-"""The rarity term: phrase counts from a tiny store's sentences, by hand, and what it does to a ranking."""
+"""The rarity term: phrase counts from a tiny store's sentences, by hand, and what it does to a ranking; the
+word n-gram index that counts the phrases met while scoring."""
 
 from __future__ import annotations
 
 import json
 import math
 
+import numpy as np
 import pytest
 
 from lmcr.frame import Frame
+from lmcr.scorers import ngram_index
 from lmcr.scorers.mixture import Mixture
+from lmcr.scorers.ngram_index import NgramIndex
 from lmcr.scorers.rarity import WEIGHT, PhraseCounts, phrase_pattern
 from lmcr.scorers.registry import make_scorer, scorer_fingerprint
 from lmcr.scorers.resources import MethodResources, corpus_words
@@ -106,3 +110,68 @@ def test_counts_are_cached_by_the_caller_named_file_and_a_bad_cache_is_recounted
         fresh.count_cached(["pan", "cheese"], cache)
         assert fresh.counts == {"pan": 5, "cheese": 1}
         assert json.loads(cache.read_text())["counts"] == {"pan": 5, "cheese": 1}
+
+
+def test_the_ngram_index_counts_phrases_as_the_scan_counts_one_alone(store):
+    db, sql_dir, _ = store
+    index = NgramIndex.build(db, sql_dir, progress=lambda line: None)
+    assert index.corpora == ["household", "recipes"]
+    for phrase in ("pan", "cutting board", "cheese", "board", "bowl", "scissors", "Cutting Boards"):
+        alone = PhraseCounts(*store)
+        alone.count([phrase])
+        assert index.count(phrase, {"all": 1.0}) == alone.counts[phrase.lower()], phrase
+    assert index.count("pan", {"household": 3.0}) == 3 * 2
+    assert index.count("pan", {"recipes": 1.0, "household": 0.5}) == 3 + 0.5 * 2
+
+
+def test_a_phrase_the_index_cannot_hold_is_not_looked_up():
+    assert ngram_index.words("Cutting  Board") == ["cutting", "board"]
+    for phrase in ("crème fraîche", "m&m", "salt and black pepper", "  "):
+        assert ngram_index.words(phrase) is None, phrase
+    assert NgramIndex(np.zeros(0, dtype=np.uint64), np.zeros((0, 0)), []).count("pan", {"all": 1.0}) == 0.0
+
+
+def test_the_key_is_duckdbs_md5_number():
+    duckdb = pytest.importorskip("duckdb")
+    for ngram in ("pan", "cutting board", "a b c"):
+        assert (
+            ngram_index.key(ngram) == duckdb.connect().execute("select md5_number_upper(?)", [ngram]).fetchall()[0][0]
+        )
+
+
+def test_phrases_met_while_scoring_are_looked_up_in_the_index_and_the_rest_scanned(store):
+    keys = np.array(sorted(ngram_index.key(k) for k in ("pan", "pans")), dtype=np.uint64)
+    made_up = NgramIndex(keys, np.array([[40], [2]], dtype=np.uint32), ["recipes"])  # counts no scan gives
+    calls = []
+    counts = PhraseCounts(*store, index=lambda: calls.append(1) or made_up)
+    counts.look_up(["Pan", "dump the pan into", "crème"])
+    assert counts.counts == {"pan": 42, "dump the pan into": 1, "crème": 0} and calls == [1]
+    counts.count(["cheese"])  # the up-front count is a scan, the index untouched
+    assert counts.counts["cheese"] == 1 and calls == [1]
+
+
+def test_the_index_is_cached_and_an_unreadable_one_is_rebuilt(store, tmp_path, monkeypatch):
+    db, sql_dir, _ = store
+    path = tmp_path / "cache" / "ngrams.npz"
+    first = NgramIndex.cached(db, sql_dir, path)
+    assert path.is_file() and first.count("pan", {"all": 1.0}) == 5
+
+    def no_build(*args, **kwargs):
+        raise AssertionError("built again")
+
+    monkeypatch.setattr(NgramIndex, "build", no_build)
+    assert NgramIndex.cached(db, sql_dir, path).count("cutting board", {"all": 1.0}) == 2
+    monkeypatch.undo()
+    path.write_bytes(b"not an index")
+    assert NgramIndex.cached(db, sql_dir, path).count("pan", {"all": 1.0}) == 5
+    assert NgramIndex.load(path).count("pan", {"all": 1.0}) == 5
+
+
+def test_the_rarity_scorer_indexes_the_store_at_its_first_new_label(store, tmp_path):
+    db, sql_dir, _ = store
+    res = MethodResources(checkpoints=db.parent, db=db, sql_dir=sql_dir, cache_dir=tmp_path / "caches")
+    frames = [Frame.of("dump", {"Theme": "cheese", "Destination": "panini pan"})]
+    scanned = PhraseCounts(*store)
+    expected = -WEIGHT * (scanned.log_p("cheese") + scanned.log_p("panini pan"))
+    assert make_scorer("rarity", res)(frames) == pytest.approx([expected])
+    assert [p.name.split("-")[0] for p in (tmp_path / "caches").glob("ngrams-*.npz")] == ["ngrams"]

@@ -58,6 +58,31 @@ class ScorerSpec:
     build: Callable[[MethodResources], Callable[..., list[float]]]
     fingerprint: Callable[[MethodResources], str | None] = lambda res: None
     reads_context: bool = False
+    # a term that ranks the fillers of one role and leaves the choice among open roles to the rest
+    # (its scores are centred per role set, but their spread would still move which role wins)
+    within_role: bool = False
+
+
+class SummedScorer:
+    """'a+b+...': the parts' scores summed (for log-probability methods, a product of experts).
+    `with_roles` also gives the sum of the parts that choose among open roles (all but the within-role
+    terms), each part scored once."""
+
+    def __init__(self, parts: list[tuple[Scorer, bool]]):
+        self.parts = parts
+        self.has_within_role = any(within_role for _, within_role in parts)
+
+    def __call__(self, frames: list[Frame], context: str = "") -> list[float]:
+        return self.with_roles(frames, context)[0]
+
+    def with_roles(self, frames: list[Frame], context: str = "") -> tuple[list[float], list[float]]:
+        """(the full sums, the sums without the within-role terms)."""
+        full, roles = [0.0] * len(frames), [0.0] * len(frames)
+        for part, within_role in self.parts:
+            for k, score in enumerate(part(frames, context)):
+                full[k] += score
+                roles[k] += 0.0 if within_role else score
+        return full, roles
 
 
 def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
@@ -111,10 +136,13 @@ def _frame_corpus_hash(res: MethodResources) -> str:
 
 
 def _rarity(res: MethodResources) -> Scorer:
+    from lmcr.scorers.ngram_index import NgramIndex
     from lmcr.scorers.rarity import PhraseCounts
 
     db = store_path(res, "rarity", "sentences")
-    counts = PhraseCounts(db, res.sql_dir, corpus_words(res), res.corpus, res.mixture)
+    index_file = cache_dir(res) / f"ngrams-{store_corpus_hash(res.db, 'sentence')[:12]}.npz"
+    index = functools.cache(lambda: NgramIndex.cached(db, res.sql_dir, index_file))  # built at the first new label
+    counts = PhraseCounts(db, res.sql_dir, corpus_words(res), res.corpus, res.mixture, index)
     # the detector's objects up front (completion then never scans), cached by the corpus content
     counts.count_cached(load_lexicon().objects, count_cache(res, "phrases", "sentence"))
     return counts.rarity
@@ -217,7 +245,7 @@ SCORERS: dict[str, ScorerSpec] = {
     "conceptnet": ScorerSpec(_conceptnet),
     "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
-    "commonsense": ScorerSpec(_commonsense, _commonsense_fingerprint),  # a term, as rarity
+    "commonsense": ScorerSpec(_commonsense, _commonsense_fingerprint, within_role=True),  # a term, as rarity
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
     "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
@@ -240,8 +268,8 @@ def make_scorer(method: str, res: MethodResources) -> Scorer:
     """The scorer of `method`; 'a+b' sums the scores of methods a and b (for log-probability methods,
     a product of experts)."""
     if "+" in method:
-        parts = [make_scorer(m, res) for m in method.split("+")]
-        return lambda frames, context="": [sum(s) for s in zip(*(part(frames, context) for part in parts))]
+        names = method.split("+")
+        return SummedScorer([(make_scorer(m, res), m in SCORERS and SCORERS[m].within_role) for m in names])
     if method not in SCORERS:
         raise MethodUnavailable(f"unknown method {method!r}; available: {', '.join(METHODS)}")
     spec = SCORERS[method]
