@@ -54,7 +54,7 @@ def store(tmp_path) -> Path:
 
 
 def test_every_named_query_runs_on_the_locked_down_connection(store):
-    values = {"corpus": "all", "phrases": "cup|glass", "min_sentences": "1"}
+    values = {"corpus": "all", "phrases": "cup|glass", "min_sentences": "1", "max_words": "3"}
     for path in sorted((SQL_DIR / "queries").glob("*.sql")):
         wanted = query_params(path.read_text(encoding="utf-8"))
         result = runner.invoke(

@@ -31,6 +31,7 @@ from lmcr.scorers.resources import MethodUnavailable
 from lmcr.store import named_query, read_connection
 
 ALPHA = 5.0  # the smoothing mass (module docstring)
+BACKOFF = "role"  # what P(o | v, m) backs off to, in the calibration's fingerprint: P(o | m) (module docstring)
 
 
 def add_one(count: float, total: float, types: int) -> float:

@@ -114,6 +114,12 @@ def _frame_counts(res: MethodResources) -> Scorer:
     return counts.score_frames
 
 
+def _frame_counts_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.frame_counts import ALPHA, BACKOFF
+
+    return f"{_frame_corpus_hash(res)}*{ALPHA:g}/{BACKOFF}"
+
+
 def _similar_verbs(res: MethodResources) -> Scorer:
     from lmcr.scorers.similar_verbs import MIN_PAIRS, NEIGHBOURS, SimilarVerbs
 
@@ -238,7 +244,7 @@ SCORERS: dict[str, ScorerSpec] = {
         method: ScorerSpec(_lm_scorer(lin), _lm_fingerprint(lin), reads_context=lin == "sentence")
         for method, lin in LM_METHODS.items()
     },
-    "frame_counts": ScorerSpec(_frame_counts, _frame_corpus_hash),
+    "frame_counts": ScorerSpec(_frame_counts, _frame_counts_fingerprint),
     "similar_verbs": ScorerSpec(_similar_verbs, _similar_verbs_fingerprint),
     "cooccur": ScorerSpec(_cooccur),
     "word2vec": ScorerSpec(_word2vec),

@@ -9,6 +9,6 @@ positions as (
     from words
 )
 select corpus, array_to_string(w[i:i + k - 1], ' ') as ngram, count(*) as n
-from positions, range(1, $max_words + 1) as sizes(k)
+from positions, range(1, cast($max_words as integer) + 1) as sizes(k)
 where i + k - 1 <= len(w)
 group by all
