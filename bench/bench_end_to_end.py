@@ -9,7 +9,12 @@ the robot's hand (`"holding"`). One
 `lmcr execute --input IN.jsonl --output OUT.jsonl` process (the published checkpoint and store of
 $LMCR_DATA_DIR) runs them all. Prints: completed right (the frame is the expected one), executed
 successfully, both, executed plans that failed, refused before moving, errors; per predicate; then
-every instruction that is not both right and successful, with why.
+every instruction that is not both right and successful, with why. `--repeat N` gives each instruction
+N scenes (ids `<id>#<k>`): a larger batch of the same requests.
+
+Time: the batch's wall clock, and each instruction's time, read as the interval between its result line
+and the one before (the batch writes each line to its sidecar when its instruction is done; polled every
+0.2 s, so each is within about 0.2 s), the first one including the process's start and loading.
 """
 
 from __future__ import annotations
@@ -18,16 +23,20 @@ import argparse
 import collections
 import json
 import random
+import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from record import add_json_option, write_results
 
 from lmcr.jsonl import read_jsonl
 from lmcr.lexicon import load_lexicon
+from lmcr.partial import SIDECAR
 
+SLOW = 30.0  # seconds: the bar no instruction may pass (issue 50)
 FIELDS = {"id": str, "instruction": str, "objects": list, "expected": dict}
 
 
@@ -42,6 +51,26 @@ def batch_line(record: dict, seed: int, distractors: int = 0) -> dict:
     if held:
         scene["holding"] = held[0]
     return {"id": record["id"], "instruction": record["instruction"], "scene": scene}
+
+
+def timed_batch(command: list[str], output: Path) -> tuple[float, list[float]]:
+    """Run the batch; its wall seconds and each result line's interval since the one before."""
+    started = time.perf_counter()
+    process = subprocess.Popen(command)
+    sidecar = output.with_name(output.name + SIDECAR)  # where the lines go as they are done (lmcr.partial)
+    stamps: list[float] = []
+    while True:
+        done = process.poll() is not None
+        written = output if done else sidecar
+        lines = written.read_bytes().count(b"\n") if written.exists() else 0
+        stamps += [time.perf_counter()] * (lines - len(stamps))
+        if done:
+            break
+        time.sleep(0.2)
+    if process.returncode:
+        raise subprocess.CalledProcessError(process.returncode, command)
+    ends = [started, *stamps]
+    return time.perf_counter() - started, [b - a for a, b in zip(ends, ends[1:])]
 
 
 def verdict(record: dict, out: dict) -> str:
@@ -66,9 +95,11 @@ def main() -> None:
     args_.add_argument("--method", help="completion method (default: lmcr execute's)")
     args_.add_argument("--urdf", help="the official Baxter URDF instead of the built-in one")
     args_.add_argument("--distractors", type=int, default=0, help="random other objects in each scene")
+    args_.add_argument("--repeat", type=int, default=1, help="scenes per instruction (a larger batch)")
     add_json_option(args_, "bench_end_to_end")
     args = args_.parse_args()
-    records = [r for _, r in read_jsonl(args.instructions, FIELDS)]
+    read = [r for _, r in read_jsonl(args.instructions, FIELDS)]
+    records = read if args.repeat <= 1 else [{**r, "id": f"{r['id']}#{k}"} for k in range(args.repeat) for r in read]
     work = args.work or Path(tempfile.mkdtemp(prefix="lmcr-e2e-"))
     work.mkdir(parents=True, exist_ok=True)
     inp, outp = work / "in.jsonl", work / "out.jsonl"
@@ -79,7 +110,7 @@ def main() -> None:
     command = [sys.executable, "-m", "lmcr.cli", "execute", "--input", str(inp), "--output", str(outp)]
     command += ["--method", args.method] if args.method else []
     command += ["--urdf", args.urdf] if args.urdf else []
-    subprocess.run(command, check=True)
+    wall, times = timed_batch(command, outp)
     outs = {o["id"]: o for o in map(json.loads, outp.read_text().splitlines())}
     rows, per = collections.Counter(), collections.defaultdict(collections.Counter)
     misses = []
@@ -115,6 +146,11 @@ def main() -> None:
         )
     print("not both right and successful:" if misses else "every instruction right and successful")
     print("\n".join(misses))
+    slow = sum(t > SLOW for t in times)
+    print(
+        f"batch of {n}: {wall:.0f} s ({60 * n / wall:.1f} instructions a minute); per instruction median "
+        f"{statistics.median(times):.1f} s, max {max(times):.1f} s, over {SLOW:.0f} s: {slow}"
+    )
     figures = {
         "instructions": n,
         "seed": args.seed,
@@ -126,6 +162,11 @@ def main() -> None:
         "executed plans that failed": rows["failed"],
         "refused before moving": rows["refused"],
         "errors": rows["error"],
+        "batch wall seconds": round(wall, 1),
+        "instructions a minute": round(60 * n / wall, 2),
+        "per instruction median s": round(statistics.median(times), 2),
+        "per instruction max s": round(max(times), 2),
+        f"instructions over {SLOW:.0f} s": slow,
     }
     figures |= {f"{pred}: both": f"{c['both']}/{c['n']}" for pred, c in sorted(per.items())}
     write_results(args.json, "bench_end_to_end", __doc__.splitlines()[0], figures)
