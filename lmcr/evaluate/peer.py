@@ -122,7 +122,9 @@ def load_peer(gguf: Path) -> CausalLM:
     try:
         tokenizer = AutoTokenizer.from_pretrained(folder, gguf_file=name)
         model = AutoModelForCausalLM.from_pretrained(folder, gguf_file=name, dtype=torch.float32)
-    except (ValueError, OSError, KeyError, ImportError) as exc:
+    except ImportError as exc:  # `gguf` or `accelerate` missing: transformers needs them for a GGUF file
+        raise InputError(EXTRA.format(str(exc).splitlines()[0])) from None
+    except (ValueError, OSError, KeyError) as exc:
         raise InputError(f"{gguf}: not a model the peer can read ({str(exc).splitlines()[0]})") from None
     return CausalLM(model, tokenizer)
 
