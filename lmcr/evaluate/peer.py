@@ -30,6 +30,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from lmcr.complete import softmax
 from lmcr.evaluate.external import ExternalItem, percentile
 from lmcr.jsonl import InputError
 from lmcr.lexicon import normalize_name as normalize
@@ -150,16 +151,9 @@ def answer(logprob: LogProb, item: ExternalItem) -> PeerAnswer:
     return PeerAnswer(item.id, item.objects, scores, 1000 * (time.perf_counter() - started))
 
 
-def probabilities(scores: Sequence[float]) -> list[float]:
-    """The softmax of the objects' scores."""
-    top = max(scores)
-    weights = [math.exp(s - top) for s in scores]
-    return [w / sum(weights) for w in weights]
-
-
 def right_probability(item: ExternalItem, answer_: PeerAnswer, scoring: str) -> float:
     """The probability the peer gives a right object (the best of them, where several are right)."""
-    probs = probabilities(answer_.scores[scoring])
+    probs = softmax(answer_.scores[scoring], 1.0)
     right = [p for o, p in zip(answer_.objects, probs) if normalize(o) in item.expected_any]
     return max(right, default=0.0)
 
@@ -182,7 +176,7 @@ def summarize_peer(
     n = len(items)
     top = asked = covered = size = 0
     for item, ans in zip(items, answers):
-        probs = probabilities(ans.scores[scoring])
+        probs = softmax(ans.scores[scoring], 1.0)
         best = max(range(len(probs)), key=probs.__getitem__)
         in_set = [o for o, p in zip(ans.objects, probs) if p >= threshold]
         top += normalize(ans.objects[best]) in item.expected_any

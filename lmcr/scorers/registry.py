@@ -146,8 +146,13 @@ def _rarity(res: MethodResources) -> Scorer:
     from lmcr.scorers.rarity import PhraseCounts
 
     db = store_path(res, "rarity", "sentences")
-    index_file = cache_dir(res) / f"ngrams-{store_corpus_hash(res.db, 'sentence')[:12]}.npz"
-    index = functools.cache(lambda: NgramIndex.cached(db, res.sql_dir, index_file))  # built at the first new label
+
+    @functools.cache
+    def index() -> NgramIndex:  # named by the corpus content, read (or built) at the first new label only
+        return NgramIndex.cached(
+            db, res.sql_dir, cache_dir(res) / f"ngrams-{store_corpus_hash(db, 'sentence')[:12]}.npz"
+        )
+
     counts = PhraseCounts(db, res.sql_dir, corpus_words(res), res.corpus, res.mixture, index)
     # the detector's objects up front (completion then never scans), cached by the corpus content
     counts.count_cached(load_lexicon().objects, count_cache(res, "phrases", "sentence"))
