@@ -59,14 +59,19 @@ def timed_batch(command: list[str], output: Path) -> tuple[float, list[float]]:
     process = subprocess.Popen(command)
     sidecar = output.with_name(output.name + SIDECAR)  # where the lines go as they are done (lmcr.partial)
     stamps: list[float] = []
-    while True:
-        done = process.poll() is not None
-        written = output if done else sidecar
-        lines = written.read_bytes().count(b"\n") if written.exists() else 0
-        stamps += [time.perf_counter()] * (lines - len(stamps))
-        if done:
-            break
-        time.sleep(0.2)
+    try:
+        while True:
+            done = process.poll() is not None
+            written = output if done else sidecar
+            lines = written.read_bytes().count(b"\n") if written.exists() else 0
+            stamps += [time.perf_counter()] * (lines - len(stamps))
+            if done:
+                break
+            time.sleep(0.2)
+    finally:  # interrupted or failed while polling: the batch ends with the benchmark
+        if process.poll() is None:
+            process.terminate()
+            process.wait()
     if process.returncode:
         raise subprocess.CalledProcessError(process.returncode, command)
     ends = [started, *stamps]

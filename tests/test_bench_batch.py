@@ -1,8 +1,10 @@
 """The end-to-end benchmark's batch timing (bench/bench_end_to_end.py): each instruction's time read from
-the batch's sidecar as its lines appear, and a failed batch reported."""
+the batch's sidecar as its lines appear, a failed batch reported, and the batch ended with a benchmark
+that fails."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -41,3 +43,16 @@ def test_each_instruction_is_timed_as_its_line_appears(bench, tmp_path):
 def test_a_failed_batch_is_an_error(bench, tmp_path):
     with pytest.raises(subprocess.CalledProcessError):
         bench.timed_batch([sys.executable, "-c", "raise SystemExit(3)"], tmp_path / "out.jsonl")
+
+
+def test_a_benchmark_that_fails_while_polling_ends_its_batch(bench, tmp_path):
+    out, pid_file = tmp_path / "out.jsonl", tmp_path / "pid"
+    # the batch notes its pid, then makes its sidecar unreadable (a folder): the next poll fails
+    batch = (
+        f"import os, time; open({str(pid_file)!r}, 'w').write(str(os.getpid())); "
+        f"os.mkdir({str(out) + '.partial'!r}); time.sleep(60)"
+    )
+    with pytest.raises(IsADirectoryError):
+        bench.timed_batch([sys.executable, "-c", batch], out)
+    with pytest.raises(ProcessLookupError):  # ended and reaped with the benchmark, not left running
+        os.kill(int(pid_file.read_text()), 0)
