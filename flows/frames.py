@@ -10,6 +10,7 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner, TaskRunner
 
+from flows.futures import results
 from lmcr.frame_corpus.build import build_frame_corpus
 from lmcr.frame_corpus.config import FrameCorpusConfig
 from lmcr.frame_corpus.shards import Shard, ShardJob, ShardResult, parse_shard
@@ -26,7 +27,7 @@ def parse_shard_task(shard: Shard, job: ShardJob) -> ShardResult:
 def on_task_runner(shards: list[Shard], job: ShardJob) -> list[ShardResult]:
     """The build's `parse_all`: a task per shard on the flow's task runner."""
     futures = [parse_shard_task.submit(shard, job) for shard in shards]
-    return [future.result() for future in futures]
+    return results(futures)
 
 
 @flow(name="frames", task_runner=ProcessPoolTaskRunner(max_workers=2))

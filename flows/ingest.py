@@ -8,6 +8,7 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_table_artifact
 from prefect.task_runners import ProcessPoolTaskRunner
 
+from flows.futures import results
 from lmcr.ingest import Source, StagedFile, expand_corpora
 from lmcr.ingest.run import corpus_summary, parse_and_stage, plan
 from lmcr.ingest.stage import load_staged, remove_sources
@@ -67,6 +68,6 @@ def ingest_flow(
         todo, skipped = plan(con, sources)
     get_run_logger().info("%d sources to ingest, %d unchanged", len(todo), len(skipped))
     futures = [parse_and_stage_task.submit(s, sha, ws.staging) for s, sha in todo]
-    summary = load_task(ws, [f.result() for f in futures])
+    summary = load_task(ws, results(futures))
     create_table_artifact(key="ingest-summary", table=summary, description="Corpus counts after ingest")
     return summary

@@ -26,6 +26,8 @@ import httpx
 
 STARTUP_TIMEOUT_S = 600.0  # a server takes ~5 s on a quiet machine and minutes beside heavy work
 PR_SET_PDEATHSIG = 1
+DRAIN_S = 30.0  # per Prefect worker (logs, events) at the end of a run
+DRAIN_INTERRUPTED_S = 3.0
 
 
 class ServerStartError(RuntimeError):
@@ -86,7 +88,7 @@ def _wait_healthy(process: subprocess.Popen, url: str, timeout_s: float) -> None
     )
 
 
-def _drain_prefect_workers(timeout_s: float = 30.0) -> None:
+def _drain_prefect_workers(timeout_s: float) -> None:
     """Send the logs and events Prefect still buffers while the server is up: drained later (at exit),
     they would wait for a stopped server, retry for a minute and print connection errors."""
     from prefect.events.worker import EventsWorker
@@ -136,6 +138,7 @@ def local_server(timeout_s: float | None = None) -> Iterator[str]:
     port = _free_port()
     url = f"http://127.0.0.1:{port}/api"
     process = _start(port)
+    drain_s = DRAIN_S
     try:
         _wait_healthy(process, url, timeout_s or startup_timeout())
         print(f"Prefect server for this run: {url} (stopped when the run ends)", flush=True)
@@ -145,9 +148,12 @@ def local_server(timeout_s: float | None = None) -> Iterator[str]:
         refresh_global_settings_context()
         with temporary_settings(updates={PREFECT_API_URL: url}):
             yield url
+    except KeyboardInterrupt:
+        drain_s = DRAIN_INTERRUPTED_S  # who pressed Ctrl-C waits for the prompt, not for the last log lines
+        raise
     finally:
         if process.poll() is None:
-            _drain_prefect_workers()
+            _drain_prefect_workers(drain_s)
         if os.environ.pop("PREFECT_API_URL", None):
             refresh_global_settings_context()
         stop_process(process)
