@@ -1056,3 +1056,54 @@ def test_no_joint_angles_take_the_gripper_past_the_arms_reach(sim, tmp_path):
         arm.set_config(arm.home)
         q, err_pos, _ = arm.solve(far, DOWN, [arm.home])
         assert err_pos == pytest.approx(0.25) and np.allclose(q, arm.home)
+
+
+def test_the_self_collision_box_test_never_drops_a_pair_that_touches(sim, tmp_path):
+    """Only pairs whose boxes overlap get the exact query: over random joint angles every pair of links
+    that touches is among them, and they are a small share of all pairs."""
+    from lmcr.robot.collision import Clearance
+    from lmcr.robot.plan import Planner
+    from lmcr.robot.scene import Scene
+
+    scene = Scene([SceneObject("cup", (0.0, 0.2))])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    rng = np.random.default_rng(1)
+    for arm in planner.arms.values():
+        clearance = Clearance(arm, {})
+        touching, candidates = 0, 0
+        for _ in range(200):
+            arm.set_config(rng.uniform(*arm.limits.T))
+            near = set(clearance._pair_boxes.overlapping())
+            exact = {
+                (a, b)
+                for a, b in clearance.self_pairs
+                if p.getClosestPoints(arm.robot, arm.robot, 0.0, linkIndexA=a, linkIndexB=b)
+            }
+            assert exact <= near
+            touching += bool(exact)
+            candidates += len(near)
+        assert touching > 0  # the random angles do bring the arm against the body
+        assert candidates < 0.1 * 200 * len(clearance.self_pairs)
+
+
+def test_an_ik_solve_that_stalls_ends_early_and_one_that_converges_is_unchanged(sim, tmp_path, monkeypatch):
+    """A pose the arm cannot take (inside its reach, turned the wrong way) ends once the error stops
+    falling, long before the step limit; a reachable pose is still solved to the millimetre."""
+    from lmcr.robot.arm import DOWN, IK_STALL_STEPS
+    from lmcr.robot.plan import Planner
+    from lmcr.robot.scene import Scene
+
+    scene = Scene([SceneObject("cup", (0.0, 0.2))])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    arm = planner.arms["left"]
+    steps = []
+    real_set = arm.set_config
+    monkeypatch.setattr(arm, "set_config", lambda q: steps.append(1) or real_set(q))
+    behind = arm.shoulder + np.array([-0.3, 0.0, -0.5])  # behind the robot, pointing down: no joint angles
+    _, err_pos, err_rot = arm._dls(arm.home.copy(), behind, DOWN)
+    assert err_pos + err_rot > 0.01 and IK_STALL_STEPS < len(steps) < 150
+    steps.clear()
+    arm.set_config(arm.home)
+    target = arm.ee_pose()[0] + np.array([0.05, -0.05, -0.05])
+    q, err_pos, err_rot = arm._dls(arm.home.copy(), target, arm.ee_pose()[1])
+    assert err_pos < 2e-4 and err_rot < 2e-3 and len(steps) < 150
