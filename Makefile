@@ -22,12 +22,13 @@ demo: setup
 	$(BIN)/lmcr srl "could you pour me some water?"
 
 # The browser step may fail (no node, no npm registry): the headless preview test then skips.
+# Two pytest workers (pytest-xdist): most tests are one busy process, and CI has two cores.
 test: setup
 	-$(MAKE) browser
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
 	$(BIN)/ruff check lmcr flows tests bench docs
 	$(BIN)/ruff format --check lmcr flows tests bench docs
-	$(BIN)/python -m pytest -q --durations=10
+	$(BIN)/python -m pytest -q -n 2 --dist worksteal --durations=10
 
 # Headless Chromium from the npm registry (@sparticuz/chromium bundles the binary) for the HIT preview check.
 browser: annotation/browser/node_modules/.installed
