@@ -36,9 +36,10 @@ class TrainConfig:
     # batches reach val ppl 35.0 / 29.1 / 26.7 / 25.9 after epochs 1-4 (2 cores: 1,382 s), where
     # 6,000-token batches reached 44.1 / 31.9 / 28.3 / 26.8 / 26.6 / 25.0 after epochs 1-6, in 580-681 s
     # each. On a CPU the smaller batches cost nothing in tokens/s (35-38k in bf16, about 22k in fp32, on
-    # 2 cores). 2,000-token batches gained at first but not by epoch 3 (32.6 / 28.6 / 26.7); a cosine
-    # decay to 2% over 3 epochs was worse (33.7 after 3), larger batches worse still (12k tokens, lr 4e-3:
-    # 43.6 after 3). Four epochs keep a from-scratch store under 40 minutes on 2 cores in bf16.
+    # 2 cores). 2,000-token batches gained at first but not by epoch 3 (32.6 / 28.6 / 26.7), lr 5e-3
+    # did not gain (34.9 / 29.9 after epochs 1-2), a cosine decay to 2% over 3 epochs was worse (33.7
+    # after 3), larger batches worse still (12k tokens, lr 4e-3: 43.6 after 3). Four epochs keep a
+    # from-scratch store under 40 minutes on 2 cores in bf16.
     max_epochs: int = 4
     lr: float = 3e-3
     batch_tokens: int = 3000
