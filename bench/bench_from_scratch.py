@@ -19,7 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-from record import add_json_option, write_results
+from record import add_json_option, add_shared_option, write_results
 
 from lmcr.checkout import REPO_ROOT
 from lmcr.workspace import Workspace
@@ -84,9 +84,7 @@ def store_figures(data_dir: Path) -> dict:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data-dir", type=Path, required=True, help="a new, empty data folder (kept)")
-    parser.add_argument(
-        "--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
-    )
+    add_shared_option(parser)
     parser.add_argument("--youcook2", type=Path, action="append", help="YouCook2 annotations (repeatable)")
     parser.add_argument("--recipes", type=Path, action="append", help="a recipe file or folder (repeatable)")
     parser.add_argument("--household", type=Path, action="append", help="a household file or folder (repeatable)")
@@ -98,7 +96,7 @@ def main() -> int:
     seconds = {
         "ingest": stage("ingest", ["ingest", *corpus_options(args)], args.data_dir),
         "frames": stage("frames", ["frames"], args.data_dir),
-        "train sentence-all": stage("train sentence-all", [*TRAIN], args.data_dir),
+        "train sentence-all": stage("train sentence-all", list(TRAIN), args.data_dir),
     }
     total = sum(seconds.values())
     figures = {

@@ -7,14 +7,11 @@ Prints wall time, sentences/s and words/s for the cold run, and the wall time of
 from __future__ import annotations
 
 import argparse
-import os
 import tempfile
 import time
-from pathlib import Path
 
-from record import add_json_option, write_results
+from record import add_json_option, add_shared_option, write_results
 
-from lmcr.checkout import REPO_ROOT
 from lmcr.ingest import expand_inputs
 from lmcr.ingest.run import corpus_summary, ingest_sources
 from lmcr.store import connect
@@ -23,9 +20,7 @@ from lmcr.workspace import Workspace
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
-    )
+    add_shared_option(parser)
     parser.add_argument("--workers", type=int, default=2)
     add_json_option(parser, "bench_ingest")
     args = parser.parse_args()

@@ -11,15 +11,13 @@ time, words/s).
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import duckdb
-from record import add_json_option, write_results
+from record import add_json_option, add_shared_option, write_results
 
-from lmcr.checkout import REPO_ROOT
 from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.instruction import NoPredicateError, parse_instruction
@@ -83,9 +81,7 @@ def _throughput(texts: list[str], resources: str) -> tuple[int, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--shared", type=Path, default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared")
-    )
+    add_shared_option(parser)
     parser.add_argument("--db", type=Path, default=None)
     parser.add_argument("--resources", type=Path, default=None)
     parser.add_argument("--sample", type=int, default=40_000)

@@ -35,6 +35,16 @@ def add_json_option(parser: argparse.ArgumentParser, name: str) -> None:
     )
 
 
+def add_shared_option(parser: argparse.ArgumentParser) -> None:
+    """`--shared DIR`: the read-only shared data (default $LMCR_SHARED_DIR, else ../shared beside the checkout)."""
+    parser.add_argument(
+        "--shared",
+        type=Path,
+        default=Path(os.environ.get("LMCR_SHARED_DIR") or REPO_ROOT.parent / "shared"),
+        help="the shared data folder (default $LMCR_SHARED_DIR, else ../shared)",
+    )
+
+
 def run_or_exit(run: Callable[[argparse.Namespace], None], args: argparse.Namespace) -> None:
     """`run(args)`; a project error (bad input, a missing store) ends the benchmark with its one line."""
     try:
