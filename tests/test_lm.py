@@ -17,7 +17,16 @@ from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer
-from lmcr.lm.train import PrecisionError, TrainConfig, bf16_unsupported, pick_precision, train_lm
+from lmcr.lm.train import (
+    FINAL_LR_FRACTION,
+    PrecisionError,
+    TrainConfig,
+    bf16_unsupported,
+    learning_rate,
+    perplexity,
+    pick_precision,
+    train_lm,
+)
 from lmcr.lm.vocab import Vocab
 from lmcr.setting import Setting
 
@@ -96,6 +105,23 @@ def test_tiny_corpus_overfits(overfit):
     assert history[-1]["val_ppl"] < 1.6 < history[0]["val_ppl"]
 
 
+def test_learning_rate_decays_linearly_over_the_last_epochs():
+    config = TrainConfig(max_epochs=5, decay_epochs=2, lr=0.004)
+    assert [learning_rate(config, e, 0.5) for e in (1, 2, 3)] == [0.004] * 3
+    assert learning_rate(config, 4, 0.0) == 0.004
+    assert learning_rate(config, 5, 0.0) == pytest.approx(0.004 * (1 - (1 - FINAL_LR_FRACTION) / 2))
+    assert learning_rate(config, 5, 1.0) == pytest.approx(0.004 * FINAL_LR_FRACTION)
+    assert learning_rate(TrainConfig(max_epochs=5, decay_epochs=0), 5, 0.99) == TrainConfig.lr
+    whole = TrainConfig(max_epochs=2, decay_epochs=9)  # more decay epochs than epochs: decays from the start
+    assert learning_rate(whole, 1, 0.0) == whole.lr > learning_rate(whole, 1, 0.5) > learning_rate(whole, 2, 0.5)
+
+
+def test_the_last_epoch_trains_at_a_decaying_rate(overfit):
+    _, _, history = overfit
+    assert [h["lr_end"] for h in history[:-1]] == [0.02] * (len(history) - 1)
+    assert history[-1]["lr_end"] == pytest.approx(0.02 * FINAL_LR_FRACTION)  # the run's last step ends the decay
+
+
 NO_BF16 = bf16_unsupported(torch.device("cpu"))
 needs_bf16 = pytest.mark.skipif(NO_BF16 is not None, reason=f"bf16 path: {NO_BF16}")
 
@@ -113,6 +139,8 @@ def test_bf16_autocast_trains_as_well_and_is_recorded(overfit):
     assert history[-1]["val_ppl"] < 1.6 and {h["precision"] for h in history} == {"bf16"}
     assert all(p.dtype == torch.float32 for p in model.parameters())  # master weights stay fp32
     assert float(torch.tensor([1e-40]) * 1.0) > 0  # denormal flushing ended with the training steps
+    exact = perplexity(model, ids, 200, torch.device("cpu"))
+    assert perplexity(model, ids, 200, torch.device("cpu"), "bf16") == pytest.approx(exact, rel=0.02)
 
 
 def test_precision_choices(overfit):
@@ -153,6 +181,19 @@ def test_time_budget_stops_between_epochs(overfit):
     model = RecurrentLM(LMConfig(len(vocab), embedding=16, layers=1))
     history = train_lm(model, ids, ids, TrainConfig(max_epochs=50, patience=50, max_minutes=1e-9))
     assert len(history) == 1  # the first epoch always runs; the budget stops the next
+
+
+def test_a_time_budget_moves_the_decay_to_the_last_epoch_that_fits(overfit, monkeypatch):
+    """A clock that moves 10 s per reading: an epoch (training and validation) takes 20 s, and a budget
+    of 104 s fits three of the ten epochs asked for; the third is the one that decays."""
+    _, vocab, _ = overfit
+    ids = [vocab.encode(tokens(t)) for t in CORPUS]
+    clock = iter(range(0, 10_000, 10))
+    monkeypatch.setattr("lmcr.lm.train.time.perf_counter", lambda: next(clock))
+    model = RecurrentLM(LMConfig(len(vocab), embedding=16, layers=1))
+    config = TrainConfig(max_epochs=10, patience=10, lr=0.02, batch_tokens=200, max_minutes=104 / 60)
+    history = train_lm(model, ids, ids, config)
+    assert [h["lr_end"] for h in history] == pytest.approx([0.02, 0.02, 0.02 * FINAL_LR_FRACTION])
 
 
 def test_target_perplexity_stops_training(overfit):

@@ -49,6 +49,9 @@ def train(
     ),
     batch_tokens: int = typer.Option(TrainConfig.batch_tokens, min=64, max=10_000_000, help="Padded tokens per batch."),
     lr: float = typer.Option(TrainConfig.lr, min=1e-7, max=1.0, help="Adam learning rate."),
+    decay_epochs: int = typer.Option(
+        TrainConfig.decay_epochs, min=0, max=1000, help="Last epochs over which the rate decays linearly (0: none)."
+    ),
     min_freq: int = typer.Option(MIN_FREQ, min=1, help="Vocabulary frequency cut-off."),
     seed: int = typer.Option(TrainConfig.seed, **SEED, help="Seed of the initial weights and the batch order."),
     device: str | None = typer.Option(None, help="cpu | cuda (default: cuda when present)"),
@@ -72,6 +75,7 @@ def train(
             max_minutes=max_minutes,
             precision=precision,
             lr=lr,
+            decay_epochs=decay_epochs,
             batch_tokens=batch_tokens,
             seed=seed,
         ),

@@ -123,7 +123,13 @@ def continue_setting(
     old = [seq for seq, doc in zip(text.train, text.train_docs) if doc not in new_docs]
     replayed = random.Random(config.seed).sample(old, min(len(old), round(config.replay * len(new))))
     steps = replace(
-        train_config, max_epochs=config.epochs, lr=config.lr, seed=config.seed, max_minutes=None, patience=config.epochs
+        train_config,
+        max_epochs=config.epochs,
+        lr=config.lr,
+        decay_epochs=config.decay_epochs,
+        seed=config.seed,
+        max_minutes=None,
+        patience=config.epochs,
     )
     model = base.model
     history = train_lm(
