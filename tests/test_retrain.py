@@ -11,6 +11,7 @@ import pytest
 
 from lmcr.checkout import REPO_ROOT
 from lmcr.retrain import Inputs, classify
+from lmcr.scorers.registry import COMPLETION_METHOD
 
 SAMPLE = REPO_ROOT / "data" / "sample"
 RECIPE = {
@@ -132,7 +133,12 @@ def test_retrain_acts_on_each_kind_of_change(prefect_api, tmp_path, monkeypatch)
 
     # A new recipe file: the current LM continues on its sentences and as many old ones, same vocabulary.
     extra = write_recipes(tmp_path / "garden.jsonl", range(3))
+    asked, real = [], lmcr.retrain.make_scorer
+    monkeypatch.setattr(lmcr.retrain, "make_scorer", lambda method, res: asked.append(method) or real(method, res))
     warm = run(tmp_path, [str(more)], recipes=[extra])
+    # The gate asks for the default completion (what users get) for candidate and current; this store's
+    # recipes hold no robot-predicate frame, so frame counts cannot score and both are judged by the LM.
+    assert asked[:4] == [COMPLETION_METHOD, "sentence_lm"] * 2
     assert (warm["decision"], warm["change"], warm["action"]) == ("promoted", "corpus_added", "warm_start")
     new = tmp_path / "checkpoints" / "sentence-all" / latest(tmp_path)
     provenance = json.loads((new / "provenance.json").read_text())
@@ -147,7 +153,9 @@ def test_retrain_acts_on_each_kind_of_change(prefect_api, tmp_path, monkeypatch)
     current = str(new)
     write_recipes(tmp_path / "garden.jsonl", range(5))
     monkeypatch.setattr(
-        lmcr.retrain, "checkpoint_accuracy", lambda version, rated, config: 0.9 if str(version) == current else 0.5
+        lmcr.retrain,
+        "checkpoint_accuracy",
+        lambda version, rated, config, db=None: 0.9 if str(version) == current else 0.5,
     )
     kept = run(tmp_path, [str(more)], recipes=[extra])
     assert (kept["decision"], kept["change"], kept["action"]) == ("kept", "corpus_changed", "warm_start")
