@@ -20,7 +20,7 @@ from pathlib import Path
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
-from lmcr.grounding import ground_roles, referents, served_vessel
+from lmcr.grounding import ground_roles, objects_named, referents, served_vessel
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
@@ -131,12 +131,19 @@ def softmax(scores: list[float], temperature: float) -> list[float]:
     return [w / total for w in weights]
 
 
-def _candidate_frames(missing: list[str], objects: list[str], open_roles: tuple[str, ...]) -> list[dict[str, str]]:
+def _candidate_frames(
+    missing: list[str], objects: list[str], open_roles: tuple[str, ...], named: dict[str, list[str]]
+) -> list[dict[str, str]]:
     """One filling per object (or ordered object pair) for the missing roles; one missing role that may be
-    any of `open_roles` (`_open_roles`) gets a filling per role and object."""
+    any of `open_roles` (`_open_roles`) gets a filling per role and object. A role whose stated word names
+    several objects (`named`: "the chips" with two bags) is filled with one of those."""
+
+    def choices(role: str) -> list[str]:
+        return [o for o in objects if o in named[role]] if named.get(role) else objects
+
     if len(missing) == 1:
-        return [{role: o} for role in open_roles for o in objects]
-    return [{missing[0]: a, missing[1]: b} for a in objects for b in objects if a != b]
+        return [{role: o} for role in open_roles for o in choices(role)]
+    return [{missing[0]: a, missing[1]: b} for a in choices(missing[0]) for b in choices(missing[1]) if a != b]
 
 
 def _question(spec, roles: dict[str, str | None], missing: list[str], choices: list[Candidate]) -> str:
@@ -202,12 +209,15 @@ def complete(
         ignored_objects=tuple(ignored),
         context=context,
     )
-    missing = [r for r, v in roles.items() if v is None]
+    # The roles nothing was said for come first: a stated word the robot could not ground ("dispose of the
+    # empty bottle") still says the role, so the robot picks what it names but the role was not missing.
+    missing = sorted((r for r, v in roles.items() if v is None), key=lambda r: r in unresolved)
     if not missing:
         return replace(read, frame=Frame.of(frame.predicate, roles), instances=_instances(roles, ids_of))
     spec = parser.lex.predicates[frame.predicate]
     pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
-    fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing))
+    named = {r: objects_named(word, pool) for r, word in unresolved.items()}
+    fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
         scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
@@ -219,13 +229,14 @@ def complete(
     )
     chosen = _filled(roles, candidates[0].objects)
     in_set = [c for c in candidates if c.probability >= config.set_threshold]
-    missing = [r for r in chosen if r not in roles or roles[r] is None]  # the role the objects chose
+    # the roles the objects chose, nothing said for them first (`missing`'s order), unless words were said for all
+    missing = [r for r in candidates[0].objects if r not in unresolved] or list(candidates[0].objects)
     return replace(
         read,
         frame=Frame.of(frame.predicate, chosen),
         missing_roles=tuple(missing),
         candidates=candidates,
-        question=_ask(spec, roles, missing, read, candidates, in_set, config.max_choices),
+        question=_ask(spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices),
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )

@@ -81,6 +81,13 @@ def named_by_head(value: str, detected: list[str]) -> str | None:
     """The one detected object a stated filler names by its head word or its letters: "the chips" with
     kettle chips on the table, "the soda" with an orange soda, "RedBull" for red bull, the lemma "carrot"
     for the carrots; None when no object or several match (which of them is then the robot's question)."""
+    found = objects_named(value, detected)
+    return found[0] if len(found) == 1 else None
+
+
+def objects_named(value: str, detected: list[str]) -> list[str]:
+    """Every detected object a stated filler names by its head word or its letters (see `named_by_head`),
+    in the order detected: "the chips" with kettle chips and jalapeno chips names both."""
     words = value.split()
     squeezed = value.replace(" ", "")
 
@@ -92,8 +99,7 @@ def named_by_head(value: str, detected: list[str]) -> str | None:
             return True
         return len(label) > 1 and same_noun(label[-1], words[-1])
 
-    found = {o for o in detected if names(o)}
-    return found.pop() if len(found) == 1 else None
+    return [o for o in detected if names(o)]
 
 
 def said_in_full(value: str, detected: list[str], said: str) -> str | None:

@@ -264,6 +264,22 @@ def test_a_stated_thing_grounds_in_the_one_object_its_head_word_names(parser):
     assert chips.unresolved == {"Theme": "chip"} and chips.question.startswith("I see no chip.")
 
 
+def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_objects_it_names(parser):
+    """ "pour the chips" with two kinds of chips: the Destination is what the request left missing; the
+    Theme was said, so the robot picks one of the chips for it (never the cup), and offers the pairs."""
+    out = complete(parser, scorer, "pour the chips", ["kettle chips", "multigrain chips", "cup", "bowl"])
+    assert out.missing_roles == ("Destination",) and out.unresolved == {"Theme": "chip"}
+    assert {c.objects["Theme"] for c in out.candidates} == {"kettle chips", "multigrain chips"}
+    assert all(c.object == c.objects["Destination"] for c in out.candidates)  # a candidate names the missing role
+    assert out.frame.role_map["Destination"] == "cup" and out.question.startswith("I see no chip. Should I pour ")
+    unnamed = complete(parser, scorer, "pour the crisps", ["kettle chips", "cup", "bowl"])  # names no object
+    assert unnamed.missing_roles == ("Destination",) and {c.objects["Theme"] for c in unnamed.candidates} == {
+        "kettle chips",
+        "cup",
+        "bowl",
+    }
+
+
 def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(parser):
     """The parser's lemma "carrot" is the carrots on the table, "dish" the dishes, "patty" the mint
     patties; an object whose whole label the instruction says is what a filler cut short stands for

@@ -207,6 +207,29 @@ def test_a_particle_after_an_object_the_parser_misread_still_names_the_phrasal_v
 
 
 @pytest.mark.model
+@pytest.mark.parametrize(
+    "instruction, theme",
+    [
+        ("put the bay leaves away", "bay leaves"),
+        ("put the vanilla extract away", "vanilla extract"),
+        ("put the ranch dressing away", "ranch dressing"),
+    ],
+)
+def test_a_word_misread_as_a_verb_that_ends_a_name_the_corpus_knows_starts_no_frame(learned_parser, instruction, theme):
+    """The tagger reads "leaves", "extract", "dressing" as verbs; the corpus says "bay leaves" is a name,
+    so the word ends the Theme and evokes nothing (never "leave", "extract" or "dress" the robot is asked
+    to do). Without the learned compounds the name stays cut short."""
+    from lmcr.srl.compounds import Compounds
+    from lmcr.srl.parser import FrameParser
+
+    names = frozenset({"bay leaves", "vanilla extract", "ranch dressing"})
+    parser = FrameParser(learned_parser.nlp, learned_parser.lex, compounds=Compounds(strong_bigrams=names))
+    frames = parser.parse(instruction)
+    assert [(f.predicate, f.roles) for f in frames] == [("put away", {"Theme": theme, "Destination": None})]
+    assert len(learned_parser.parse(instruction)) == 2  # the misread verb's frame, with nothing learned
+
+
+@pytest.mark.model
 def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_parser):
     from lmcr.complete import CompletionConfig, complete
 

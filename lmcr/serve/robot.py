@@ -143,7 +143,7 @@ class ServedRobot:
             parser, scorer, config = self.models()
             completion = complete(parser, scorer, text, labels, config)
         missing = completion.missing_roles
-        said = {r: (None if r in missing else v) for r, v in completion.frame.roles}
+        said = {r: (None if r in missing else completion.unresolved.get(r, v)) for r, v in completion.frame.roles}
         pending = None
         if completion.question and missing:
             stated = {v for r, v in completion.frame.roles if r != missing[0]}

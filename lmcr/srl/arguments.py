@@ -92,6 +92,16 @@ def noun_gerund(token: Token) -> bool:
     )
 
 
+def misread_name_end(token: Token, compounds: Compounds | None) -> bool:
+    """A word tagged as a verb right after a noun with which the corpus makes a fixed name ("put the bay
+    leaves/VBZ away", "the vanilla extract/VB", "the ranch dressing/VBG"): the name's last word, not a verb
+    of the request. Without the learned compounds no word is."""
+    if compounds is None or token.i == 0 or not token.tag_.startswith("VB"):
+        return False
+    before = token.doc[token.i - 1]
+    return before.tag_.startswith("NN") and f"{before.lower_} {token.lower_}" in compounds.strong_bigrams
+
+
 def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = None) -> tuple[str, int, int] | None:
     """(value, start_char, end_char) of the argument headed by `token`, or None if it names nothing."""
     head = resolve_head(token, lex)
@@ -113,8 +123,11 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
             break
         parts.insert(0, child)
     start = parts[0].idx if parts else head.idx
-    # "the steak seasoning": a gerund that ends the name is its head word
+    # "the steak seasoning": a gerund that ends the name is its head word; so is a word misread as a verb
+    # that the corpus says ends the name ("the bay leaves/VBZ")
+    after = head.doc[head.i + 1] if head.i + 1 < len(head.doc) else None
     gerund = next((c for c in head.children if noun_gerund(c)), None)
+    gerund = after if after is not None and misread_name_end(after, compounds) else gerund
     if gerund is not None:
         value = " ".join([p.lower_ for p in parts] + [head.lower_, gerund.lower_])
         return value, start, gerund.idx + len(gerund)

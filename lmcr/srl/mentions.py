@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from spacy.tokens import Doc, Span, Token
 
 from lmcr.lexicon import Lexicon, PredicateSpec
-from lmcr.srl.arguments import argument_value, noun_gerund, resolve_head
+from lmcr.srl.arguments import argument_value, misread_name_end, noun_gerund, resolve_head
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
 
@@ -313,7 +313,7 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
     frames = []
     for token in doc:
         lemma = predicate_lemma(token, lex)
-        if lemma is None:
+        if lemma is None or misread_name_end(token, compounds):
             continue
         name, spec = predicate_name(token, lemma, lex)
         args = _collect(token, lex, spec)
