@@ -19,6 +19,11 @@ def results(futures: Iterable[Any]) -> list[Any]:
     try:
         return [future.result() for future in futures]
     except KeyboardInterrupt:
-        for worker in multiprocessing.active_children():
-            worker.terminate()
+        stop_workers()
         raise
+
+
+def stop_workers() -> None:
+    """Terminate this process's worker processes (a process pool's), whatever they are doing."""
+    for worker in multiprocessing.active_children():
+        worker.terminate()

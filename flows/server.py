@@ -24,6 +24,8 @@ from contextlib import contextmanager
 
 import httpx
 
+from flows.futures import stop_workers
+
 STARTUP_TIMEOUT_S = 600.0  # a server takes ~5 s on a quiet machine and minutes beside heavy work
 PR_SET_PDEATHSIG = 1
 DRAIN_S = 30.0  # per Prefect worker (logs, events) at the end of a run
@@ -160,11 +162,28 @@ def local_server(timeout_s: float | None = None) -> Iterator[str]:
 
 
 def run_with_server(main, *args, **kwargs):
-    """`main(*args, **kwargs)` against one local server (see `local_server`); SIGTERM ends it like Ctrl-C,
-    so the server is stopped on a polite kill too. Returns what `main` returns."""
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    """`main(*args, **kwargs)` against one local server (see `local_server`). Ctrl-C and SIGTERM (a polite
+    kill) stop the run's worker processes at once and end it with KeyboardInterrupt, the server stopped,
+    wherever the signal lands: one that lands inside a library that wraps it in an error of its own
+    (Prefect serialising a task's context as it submits it) still ends the run as an interrupt, not with
+    that error's traceback. Returns what `main` returns."""
+    interrupted: list[int] = []
+
+    def interrupt(signum, frame):
+        interrupted.append(signum)
+        stop_workers()
+        raise KeyboardInterrupt
+
+    handled = [s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) is not signal.SIG_IGN]
+    previous = {s: signal.signal(s, interrupt) for s in handled}  # an ignored Ctrl-C (a background job) stays so
     try:
         with local_server():
-            return main(*args, **kwargs)
+            try:
+                return main(*args, **kwargs)
+            except Exception as exc:
+                if interrupted:
+                    raise KeyboardInterrupt from exc
+                raise
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)

@@ -1,13 +1,17 @@
-"""Waiting for task futures: an interrupt stops the worker processes instead of waiting for them."""
+"""Waiting for task futures, and a run's Ctrl-C or SIGTERM: an interrupt stops the worker processes instead
+of waiting for them."""
 
 from __future__ import annotations
 
 import multiprocessing
+import os
+import signal
 import time
 
 import pytest
 
 from flows.futures import results
+from flows.server import run_with_server
 
 
 class Done:
@@ -38,3 +42,44 @@ def test_an_interrupt_terminates_the_workers_and_is_re_raised():
     finally:
         if worker.is_alive():
             worker.kill()
+
+
+def _wrapped_interrupt(how: signal.Signals, worker) -> None:
+    """A run's body: a signal lands inside a library call that turns the KeyboardInterrupt into an error of
+    its own (as pydantic does while Prefect serialises a task's context on submit)."""
+    try:
+        os.kill(os.getpid(), how)
+        time.sleep(5)  # the handler runs before this ends
+    except KeyboardInterrupt as exc:
+        raise RuntimeError("Error calling function `ser_model`: KeyboardInterrupt") from exc
+    raise AssertionError("the signal was not delivered")
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_that_a_library_wraps_still_ends_the_run_as_an_interrupt(monkeypatch, how):
+    """Ctrl-C or SIGTERM anywhere in the run: the workers are stopped at once and the run ends with
+    KeyboardInterrupt (the pipeline's one line and exit status 130), not the wrapping error's traceback;
+    the process's own handlers are restored after."""
+    monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")  # no server of its own
+    worker = multiprocessing.get_context("spawn").Process(target=time.sleep, args=(60,))
+    worker.start()
+    before = signal.getsignal(how)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_with_server(_wrapped_interrupt, how, worker)
+        worker.join(timeout=10)
+        assert not worker.is_alive() and worker.exitcode is not None and worker.exitcode < 0
+        assert signal.getsignal(how) is before
+    finally:
+        if worker.is_alive():
+            worker.kill()
+
+
+def test_an_error_without_a_signal_is_left_as_it_is(monkeypatch):
+    monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")
+
+    def fails():
+        raise RuntimeError("a real failure")
+
+    with pytest.raises(RuntimeError, match="a real failure"):
+        run_with_server(fails)
