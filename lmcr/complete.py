@@ -236,7 +236,7 @@ def complete(
         frame=Frame.of(frame.predicate, chosen),
         missing_roles=tuple(missing),
         candidates=candidates,
-        question=_ask(spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices),
+        question=_ask(spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices, named),
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )
@@ -321,6 +321,7 @@ def _ask(
     candidates: tuple[Candidate, ...],
     in_set: list[Candidate],
     max_choices: int,
+    named: dict[str, list[str]],
 ) -> str | None:
     """The clarifying question, or None when the choice is clear: asked when the prediction set `in_set`
     holds more or fewer than one candidate (and there was a choice), and always when the best candidate
@@ -334,8 +335,17 @@ def _ask(
     choices = (in_set if len(in_set) > 1 or one else list(candidates))[: max(max_choices, 2)]
     question = _question(spec, roles, missing, choices)
     if read.unresolved:
-        return f"I see no {' or '.join(read.unresolved.values())}. {question}"
+        return f"{_unseen(read.unresolved, named)} {question}"
     return question
+
+
+def _unseen(unresolved: dict[str, str], named: dict[str, list[str]]) -> str:
+    """What the robot says of the words it could not ground: "I see no side.", or, for a word whose head
+    names several of the objects (`named`: "the chips" with two bags), "I see more than one chip." """
+    several = [w for r, w in unresolved.items() if named.get(r)]
+    unseen = [w for r, w in unresolved.items() if not named.get(r)]
+    said = [f"I see no {' or '.join(unseen)}."] if unseen else []
+    return " ".join(said + ([f"I see more than one {' or '.join(several)}."] if several else []))
 
 
 def _instances(roles: dict[str, str | None], ids_of: dict[str, list[str]]) -> dict[str, list[str]]:

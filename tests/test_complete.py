@@ -255,13 +255,13 @@ def test_instruction_accuracy_counts_a_question_by_its_best_guess(parser, tmp_pa
 
 def test_a_stated_thing_grounds_in_the_one_object_its_head_word_names(parser):
     """ "the soda" is the orange soda on the table, "redbull" the red bull; with two kinds of chips "the
-    chips" names neither, and the robot asks."""
+    chips" names neither, and the robot asks which (it sees more than one, not none)."""
     soda = complete(parser, scorer, "pour the soda", ["orange soda", "cup", "bowl"])
     assert soda.frame.role_map["Theme"] == "orange soda" and not soda.unresolved
     bull = complete(parser, scorer, "pour the redbull", ["red bull", "cup"])
     assert bull.frame.role_map["Theme"] == "red bull"
     chips = complete(parser, scorer, "pour the chips into the bowl", ["kettle chips", "multigrain chips", "bowl"])
-    assert chips.unresolved == {"Theme": "chip"} and chips.question.startswith("I see no chip.")
+    assert chips.unresolved == {"Theme": "chip"} and chips.question.startswith("I see more than one chip.")
 
 
 def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_objects_it_names(parser):
@@ -271,7 +271,7 @@ def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_obje
     assert out.missing_roles == ("Destination",) and out.unresolved == {"Theme": "chip"}
     assert {c.objects["Theme"] for c in out.candidates} == {"kettle chips", "multigrain chips"}
     assert all(c.object == c.objects["Destination"] for c in out.candidates)  # a candidate names the missing role
-    assert out.frame.role_map["Destination"] == "cup" and out.question.startswith("I see no chip. Should I pour ")
+    assert out.frame.role_map["Destination"] == "cup" and out.question.startswith("I see more than one chip. Should I pour ")
     unnamed = complete(parser, scorer, "pour the crisps", ["kettle chips", "cup", "bowl"])  # names no object
     assert unnamed.missing_roles == ("Destination",) and {c.objects["Theme"] for c in unnamed.candidates} == {
         "kettle chips",
