@@ -16,7 +16,7 @@ from lmcr.frame import Frame
 from lmcr.jsonl import InputError
 from lmcr.robot import tasks
 from lmcr.robot.household import MOTIONS, HouseholdError, household, read_household
-from lmcr.robot.scene import CONTAINERS, depth, height, make_scene, outline, scene_from_json, world_xy
+from lmcr.robot.scene import CONTAINERS, SceneObject, depth, height, make_scene, outline, scene_from_json, world_xy
 from lmcr.robot.world import build_world
 
 
@@ -397,6 +397,60 @@ def test_a_serving_verb_takes_the_ladle_it_finds_on_the_table(sim, tmp_path, lea
     without = make_scene([o for o in layout if o[0] != "ladle"])
     with pytest.raises(ExecutionError, match="cannot scoop here: nothing to scoop with on the table"):
         execute("scoop the soup", without, learned_parser, prefers_bowl, CompletionConfig(), tmp_path)
+
+
+def _prefers(label: str):
+    return lambda frames, context="": [1.0 if label in f.role_map.values() else 0.0 for f in frames]
+
+
+def test_a_ladle_is_headed_over_a_far_bowl_where_its_bowl_can_be_tipped(sim, tmp_path, learned_parser):
+    """The bowl at the far left, the ladle on the right: turned no further than other held objects turn
+    (TURNS), no heading of the ladle let an arm tip it out over the bowl ('tip it out 3' 11 cm short);
+    turned further (WIDE_TURNS) it serves."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    layout = [
+        ("soup", [0.17, 0.08]),
+        ("bowl", [0.11, 0.28]),
+        ("ladle", [-0.05, -0.28]),
+        ("oil", [-0.04, -0.38]),
+        ("trash can", [-0.15, 0.33]),
+        ("towel", [0.02, -0.12]),
+        ("black pepper", [-0.06, 0.03]),
+    ]
+    out = execute("scoop the soup", make_scene(layout), learned_parser, _prefers("bowl"), CompletionConfig(), tmp_path)
+    assert out["feasible"] and out["success"] and out["checks"]["served_share"] >= 0.9, out.get("reason", out)
+
+
+def test_only_a_wide_task_turns_the_hand_further():
+    ladle = SceneObject("ladle", (0.1, 0.1))
+    usual, wide = tasks.variants(ladle), tasks.variants(ladle, wide=True)
+    assert {v.turn for v in usual} == set(tasks.TURNS) and {v.turn for v in wide} == {*tasks.TURNS, *tasks.WIDE_TURNS}
+    assert set(usual) < set(wide) and tasks.SERVE.wide and not any(t.wide for t in tasks.TASKS.values())
+
+
+def test_a_sponge_set_down_and_picked_up_turned_wipes_clear_of_the_walls(sim, tmp_path, learned_parser):
+    """Out of the wiping arm's reach, the sponge is set down first and picked up again, now turned in the
+    hand: its strokes keep its turned corners clear of the cutting board's walls (planned for its square
+    outline, they dragged the board 7 cm and wiped 0.66 of it)."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    layout = [
+        ("cutting board", [0.119, 0.037]),
+        ("sponge", [0.157, -0.168]),
+        ("recycling bin", [-0.124, 0.358]),
+        ("soy sauce", [0.057, -0.183]),
+        ("towel", [-0.188, 0.012]),
+        ("pan", [-0.168, -0.294]),
+    ]
+    scene = make_scene(layout, seed=842060)  # the seed decides where it is set down (`free_spots`)
+    out = execute("wipe the cutting board", scene, learned_parser, _prefers("sponge"), CompletionConfig(), tmp_path)
+    assert out["frame"]["roles"]["Instrument"] == "sponge" and "put the sponge down" in [
+        w["name"] for w in out["waypoints"]
+    ]
+    assert out["success"] and out["target_moved_m"] < 0.01 and out["checks"]["wiped_share"] >= 0.95, out["checks"]
 
 
 def test_the_motion_names_agree_wherever_they_are_used():

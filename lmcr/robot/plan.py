@@ -553,9 +553,10 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
     over in, by its middle (tilting either way); carried unturned when the task keeps it `square`."""
     if holding:
-        found = [v for v in variants(held, turns=task.turns) if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
+        found = variants(held, turns=task.turns, wide=task.wide)
+        found = [v for v in found if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
     else:
-        found = variants(held, task.pours, opening, task.turns)
+        found = variants(held, task.pours, opening, task.turns, task.wide)
     return [v for v in found if v.turn == 0.0] if task.square else found
 
 

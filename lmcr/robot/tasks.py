@@ -48,6 +48,9 @@ SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at
 SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
 PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far side of the table
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying
+# ... and further for a tool held by a long handle (a ladle): where the handle points decides whether the
+# arm can tip its bowl over the target
+WIDE_TURNS = (1.6, -1.6)
 GRIP_GAP = 0.005  # fingertips this far above the held object's top when it is grasped
 GRIP_END = 0.04  # a long object held off its middle is held at least this far from its end
 HAND_OFFER = 0.008  # an object handed over is held out with its underside this far above the person's palm
@@ -214,6 +217,23 @@ class Geometry:
         """The middle of the held object's underside in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) - self.held_pos[2]])
 
+    def underside(self, variant: Variant, orientation) -> tuple[float, float, float]:
+        """The held object's underside as the gripper holds it at `orientation`: its half-extents along the
+        world's x and y about its middle (one the grasp left turned in the hand spans more than its outline)
+        and how far its lowest corner hangs below its middle (one left tilted)."""
+        half_x, half_y, _ = outline(self.held.label)
+        z = self.held_top[2] - height(self.held.label) - self.held_pos[2]
+        middle = self.point_in_hand(variant, [0, 0, z])
+        corners = [self.point_in_hand(variant, [x * half_x, y * half_y, z]) - middle for x in (1, -1) for y in (1, -1)]
+        # each corner's offset from the middle in the world, the gripper at `orientation`
+        offsets = [p.multiplyTransforms([0, 0, 0], orientation, list(c), [0, 0, 0, 1])[0] for c in corners]
+        # rounded to a tenth of a millimetre: an object held square spans its outline, not a float's noise off it
+        return (
+            round(max(abs(o[0]) for o in offsets), 4),
+            round(max(abs(o[1]) for o in offsets), 4),
+            round(max(0.0, -min(o[2] for o in offsets)), 4),
+        )
+
     def centre(self, variant: Variant) -> np.ndarray:
         """The held object's middle in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
@@ -271,12 +291,14 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
     return np.asarray(goal) - offset
 
 
-def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False) -> list[Variant]:
+def variants(
+    held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False, wide: bool = False
+) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
     forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
     object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it
-    pours), headed from the robot towards the object."""
+    pours), headed from the robot towards the object. A `wide` task's hand also turns by WIDE_TURNS."""
     half_x, half_y, round_ = outline(held.label)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if round_:  # a square box held across its corners would not fit between fingers set for its sides
@@ -294,7 +316,7 @@ def variants(held: SceneObject, pours: bool = False, opening: float = 0.0, turns
         for shift in shifts
         for pitch in PITCHES
         for yaw in yaws
-        for turn in TURNS
+        for turn in (TURNS + WIDE_TURNS if wide else TURNS)
         for sign in signs
     ]
     narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
@@ -490,7 +512,10 @@ def program_wipe(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     and forth from edge to edge until it has gone over the whole surface; then lift it."""
     orn = v.upright()  # not turned while carried: the tool lies square to the surface, as it lay on the table
     x0, x1, y0, y1, z = surface(g.target, g.target_box)
-    hx, hy, _ = outline(g.held.label)
+    # the tool as it is held: one set down and picked up again may lie turned or tilted in the hand, and its
+    # corners must keep clear of the walls and its lowest one above the surface
+    hx, hy, drop = g.underside(v, orn)
+    z += drop
     xs = (x0 + hx + WIPE_CLEAR, x1 - hx - WIPE_CLEAR)
     rows = max(1, math.ceil((y1 - y0 - 2 * WIPE_CLEAR) / (2 * hy * WIPE_OVERLAP)))
     ys = np.linspace(y0 + hy + WIPE_CLEAR, y1 - hy - WIPE_CLEAR, rows) if rows > 1 else [(y0 + y1) / 2]
@@ -865,6 +890,7 @@ class Task:
     turns: bool = False  # the held object is turned over (pouring or dumping): either way will do
     motion: str = ""  # the class of motion it is (a learned verb's), else the predicate's own program
     square: bool = False  # the held object stays square to the table (the program turns it, if at all)
+    wide: bool = False  # the hand may also turn by WIDE_TURNS while carrying (a tool with a long handle)
     source_role: str = ""  # the role of a third object the motion works with (serve: what it scoops from)
     # ... that object, once the instruction's objects are known (`with_source`)
     source: SceneObject | None = field(default=None, compare=False)
@@ -904,7 +930,7 @@ TOOL_MOTIONS = {
 }
 # a verb of the serve class: a ladle (the Instrument, stated or found on the table) carries the Theme's
 # content into the Destination
-SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme")
+SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme", wide=True)
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
 TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers}
 
