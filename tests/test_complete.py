@@ -271,7 +271,8 @@ def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_obje
     assert out.missing_roles == ("Destination",) and out.unresolved == {"Theme": "chip"}
     assert {c.objects["Theme"] for c in out.candidates} == {"kettle chips", "multigrain chips"}
     assert all(c.object == c.objects["Destination"] for c in out.candidates)  # a candidate names the missing role
-    assert out.frame.role_map["Destination"] == "cup" and out.question.startswith("I see more than one chip. Should I pour ")
+    assert out.frame.role_map["Destination"] == "cup"
+    assert out.question.startswith("I see more than one chip. Should I pour ")
     unnamed = complete(parser, scorer, "pour the crisps", ["kettle chips", "cup", "bowl"])  # names no object
     assert unnamed.missing_roles == ("Destination",) and {c.objects["Theme"] for c in unnamed.candidates} == {
         "kettle chips",
