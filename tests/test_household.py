@@ -380,6 +380,11 @@ def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_
     assert out["reply"] == f"I {verb} the {layout[0][0]} with the {tool}."
 
 
+def _prefers(label: str):
+    """A model-free scorer: the frames that name `label` score 1, the others 0."""
+    return lambda frames, context="": [1.0 if label in f.role_map.values() else 0.0 for f in frames]
+
+
 def test_a_serving_verb_takes_the_ladle_it_finds_on_the_table(sim, tmp_path, learned_parser):
     """ "scoop the soup": the Destination is missing (the scorer prefers the bowl), the Instrument is not
     a role the verb's requests state: the robot takes the ladle on the table, fills it in the soup and
@@ -388,19 +393,14 @@ def test_a_serving_verb_takes_the_ladle_it_finds_on_the_table(sim, tmp_path, lea
     from lmcr.robot.execute import ExecutionError, execute
 
     layout = [("soup", [0.1, -0.2]), ("ladle", [-0.1, 0.25]), ("bowl", [0.05, 0.05]), ("cup", [0.2, 0.3])]
-    prefers_bowl = lambda frames, context="": [1.0 if "bowl" in f.role_map.values() else 0.0 for f in frames]  # noqa: E731
-    out = execute("scoop the soup", make_scene(layout), learned_parser, prefers_bowl, CompletionConfig(), tmp_path)
+    out = execute("scoop the soup", make_scene(layout), learned_parser, _prefers("bowl"), CompletionConfig(), tmp_path)
     assert out["frame"] == {"predicate": "scoop", "roles": {"Theme": "soup", "Destination": "bowl"}}, out
     assert out["role_ids"] == {"Instrument": "ladle", "Destination": "bowl", "Theme": "soup"}
     assert out["motion"] == "serve" and out["success"] and out["checks"]["served_share"] >= 0.9, out
     assert out["reply"] == "I served the soup into the bowl."
     without = make_scene([o for o in layout if o[0] != "ladle"])
     with pytest.raises(ExecutionError, match="cannot scoop here: nothing to scoop with on the table"):
-        execute("scoop the soup", without, learned_parser, prefers_bowl, CompletionConfig(), tmp_path)
-
-
-def _prefers(label: str):
-    return lambda frames, context="": [1.0 if label in f.role_map.values() else 0.0 for f in frames]
+        execute("scoop the soup", without, learned_parser, _prefers("bowl"), CompletionConfig(), tmp_path)
 
 
 def test_a_ladle_is_headed_over_a_far_bowl_where_its_bowl_can_be_tipped(sim, tmp_path, learned_parser):

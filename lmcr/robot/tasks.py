@@ -213,17 +213,22 @@ class Geometry:
         """The held object's opening in the gripper's frame."""
         return self.point_in_hand(variant, [0, 0, self.opening])
 
+    @property
+    def underside_z(self) -> float:
+        """How far the held object's underside is above its origin, in its own frame."""
+        return self.held_top[2] - height(self.held.label) - self.held_pos[2]
+
     def bottom(self, variant: Variant) -> np.ndarray:
         """The middle of the held object's underside in the gripper's frame."""
-        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) - self.held_pos[2]])
+        return self.point_in_hand(variant, [0, 0, self.underside_z])
 
     def underside(self, variant: Variant, orientation) -> tuple[float, float, float]:
         """The held object's underside as the gripper holds it at `orientation`: its half-extents along the
         world's x and y about its middle (one the grasp left turned in the hand spans more than its outline)
         and how far its lowest corner hangs below its middle (one left tilted)."""
         half_x, half_y, _ = outline(self.held.label)
-        z = self.held_top[2] - height(self.held.label) - self.held_pos[2]
-        middle = self.point_in_hand(variant, [0, 0, z])
+        z = self.underside_z
+        middle = self.bottom(variant)
         corners = [self.point_in_hand(variant, [x * half_x, y * half_y, z]) - middle for x in (1, -1) for y in (1, -1)]
         # each corner's offset from the middle in the world, the gripper at `orientation`
         offsets = [p.multiplyTransforms([0, 0, 0], orientation, list(c), [0, 0, 0, 1])[0] for c in corners]

@@ -126,10 +126,12 @@ def argument_value(token: Token, lex: Lexicon, compounds: Compounds | None = Non
     # "the steak seasoning": a gerund that ends the name is its head word; so is a word misread as a verb
     # that the corpus says ends the name ("the bay leaves/VBZ")
     after = head.doc[head.i + 1] if head.i + 1 < len(head.doc) else None
-    gerund = next((c for c in head.children if noun_gerund(c)), None)
-    gerund = after if after is not None and misread_name_end(after, compounds) else gerund
-    if gerund is not None:
-        value = " ".join([p.lower_ for p in parts] + [head.lower_, gerund.lower_])
-        return value, start, gerund.idx + len(gerund)
+    if after is not None and misread_name_end(after, compounds):
+        last = after
+    else:
+        last = next((c for c in head.children if noun_gerund(c)), None)
+    if last is not None:
+        value = " ".join([p.lower_ for p in parts] + [head.lower_, last.lower_])
+        return value, start, last.idx + len(last)
     value = " ".join([p.lower_ for p in parts] + [_singular(head)])
     return value, start, head.idx + len(head)
