@@ -3,7 +3,8 @@
 Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill,place]
        [--urdf PATH] [--holding] [--videos DIR] [--json PATH]
 For each of the 11 predicates, and for a learned verb of each motion that puts a Theme at a Destination
-(place: put away on a shelf, or in a drawer that is opened and shut; dispose: throw out into a bin; hand
+(place: put away on a shelf, in a drawer that is opened and shut, or in a chest fridge whose lid is
+lifted open and lowered shut; dispose: throw out into a bin; hand
 over: hand to a person), and of each class that works with a tool (stir the soup with a spoon, wipe the
 cutting board with a sponge, cut the bread with a knife, cover the pot with a lid; serve: scoop the soup
 into a bowl with the ladle on the table), an incomplete
@@ -56,6 +57,7 @@ TASKS = {
     # the motions of the learned verbs, by the Destination's kind (lmcr/robot/household.json)
     "place": ("put the apple away", "apple", "shelf", "Destination"),
     "place in a drawer": ("put the apple away", "apple", "drawer", "Destination"),
+    "place in the fridge": ("put the milk away", "milk", "fridge", "Destination"),
     "dispose": ("throw out the banana", "banana", "trash can", "Destination"),
     "hand over": ("hand me the knife", "knife", "person", "Destination"),
     # ... and of the learned verbs whose class works with a tool (the Instrument) on the Theme
@@ -69,7 +71,7 @@ TASKS = {
 ALSO = {"serve": ("ladle",)}  # on the table too: what the motion needs that the instruction leaves unsaid
 TOOLS = {"stir", "wipe", "cut", "cover"}  # the tool is held: the object filled in, not the one stated
 # distractors: the household's receptacles and tools too
-LEARNED = {"place", "place in a drawer", "dispose", "hand over", "serve", *TOOLS}
+LEARNED = {"place", "place in a drawer", "place in the fridge", "dispose", "hand over", "serve", *TOOLS}
 SLOW = 30  # seconds: no instruction should take longer to plan (or refuse) and execute
 HELD_IS_STATED = {"pour", "sprinkle", "heat", "fry", "blend", "dump", "dip", "brush", "rub", *LEARNED} - TOOLS
 

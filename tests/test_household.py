@@ -35,6 +35,10 @@ def test_the_shipped_household_has_bins_a_shelf_and_a_person():
 BOX = {"open_box": [0.2, 0.2, 0.1], "wall": 0.01, "mass": 1, "surface": "inside", "motion": "place"}
 ON_TABLE = [{"half": [0.1, 0.1, 0.1], "at": [0, 0, 0.1]}]
 SUNK = [{"half": [0.1, 0.1, 0.1], "at": [0, 0, 0]}]  # half of it under the table top
+URDF = {"urdf": "bodies/fridge.urdf", "size": [0.16, 0.34, 0.24], "depth": 0.17, "mass": 0}
+URDF |= {"surface": "inside", "motion": "place"}
+OPENING = {"link": "box", "joint": "hinge", "opens": 1.9, "handle": [-0.145, 0, 0.045], "middle": [0, 0, 0.01]}
+OPENING |= {"headroom": 0.165}
 
 
 @pytest.mark.parametrize(
@@ -50,9 +54,15 @@ SUNK = [{"half": [0.1, 0.1, 0.1], "at": [0, 0, 0]}]  # half of it under the tabl
         ({"parts": SUNK, "mass": 1, "surface": "top", "motion": "place"}, "below the table top"),
         ({"parts": ON_TABLE, "surface": "top", "motion": "place"}, "'mass'"),
         ("a bin", "is not a JSON object"),
+        ({**URDF, "opening": {**OPENING, "joint": 3}}, "opening: needs the 'link' and the 'joint'"),
+        ({**URDF, "opening": {**OPENING, "opens": -1.6}}, "'opens' must be a number"),
+        ({**URDF, "opening": {**OPENING, "shut": "almost"}}, "'shut' must be a number"),
+        ({**URDF, "opening": {k: v for k, v in OPENING.items() if k != "handle"}}, "handle"),
     ],
 )
 def test_a_bad_receptacle_is_one_line_naming_the_file_and_label(tmp_path, entry, reason):
+    (tmp_path / "bodies").mkdir()
+    (tmp_path / "bodies" / "fridge.urdf").write_text("<robot/>")  # only its being there is checked here
     path = tmp_path / "household.json"
     path.write_text(json.dumps({"receptacles": {"bin": entry}}))
     with pytest.raises(HouseholdError, match=reason) as err:
@@ -128,7 +138,7 @@ def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> di
     planner = Planner(build_world(scene, tmp_path), scene, scene.table)
     task = tasks.task_for(frame, verb_motion)
     held, target = (scene.find(frame.role_map[r]) for r in (task.held_role, task.target_role))
-    plan = (planner.plan_drawer if target.joint >= 0 else planner.plan)(task, held, target, holding=False)
+    plan = (planner.plan_shut_receptacle if target.joint >= 0 else planner.plan)(task, held, target, holding=False)
     assert isinstance(plan, Plan), plan
     others = [o for o in scene.objects if o not in (held, target)]
     return {**run_plan(plan, held, target, others, planner), "held": held, "target": target}
@@ -226,22 +236,48 @@ def test_a_drawer_is_pulled_open_filled_and_pushed_shut_with_the_object_inside_i
     names = [w["name"] for w in out["waypoints"]]
     assert names.index("pull the drawer open") < names.index("lower into drawer") < names.index("push the drawer shut")
     drawer, apple = out["target"], out["held"]
-    assert abs(p.getJointState(drawer.body, drawer.joint)[0]) < tasks.SHUT
+    assert abs(p.getJointState(drawer.body, drawer.joint)[0]) < household()["drawer"].opening.shut
     cabinet_lo, cabinet_hi = p.getAABB(drawer.body)  # the cabinet (the body's base)
     pos = p.getBasePositionAndOrientation(apple.body)[0]
     assert cabinet_lo[0] <= pos[0] <= cabinet_hi[0] and cabinet_lo[1] <= pos[1] <= cabinet_hi[1]
-    assert p.getAABB(apple.body)[1][2] < cabinet_hi[2] and household()["drawer"].slide.opens == 0.14
+    assert p.getAABB(apple.body)[1][2] < cabinet_hi[2] and household()["drawer"].opening.opens == 0.14
 
 
-def test_what_is_too_tall_for_the_drawer_is_refused_before_moving(sim, tmp_path):
+def test_a_chest_fridge_lid_is_lifted_open_the_milk_put_in_and_the_lid_lowered_shut(sim, tmp_path):
+    """The lid turns up on its hinge, held by its handle's bar (which turns in the hold), the milk is put in,
+    the lid turned down over it: the milk stands in the box, under the shut lid; the success check looks
+    at the world (inside, shut), so a lid left open fails it."""
+    from lmcr.robot.household import household
+
+    out = _run(
+        tmp_path,
+        [("milk", [-0.1, 0.25]), ("fridge", [0.05, -0.2])],
+        Frame.of("put away", {"Theme": "milk", "Destination": "fridge"}),
+    )
+    names = [w["name"] for w in out["waypoints"]]
+    assert names.index("lift the fridge open (1/11)") < names.index("lower into fridge")
+    assert names.index("lower into fridge") < names.index("lower the fridge shut (11/11)")
+    assert out["success"] and out["checks"]["in_target"] and out["checks"]["shut"], out["checks"]
+    fridge, milk = out["target"], out["held"]
+    box_lo, box_hi = p.getAABB(fridge.body, -1)
+    pos = p.getBasePositionAndOrientation(milk.body)[0]
+    assert box_lo[0] <= pos[0] <= box_hi[0] and box_lo[1] <= pos[1] <= box_hi[1]
+    assert p.getAABB(milk.body)[1][2] < p.getAABB(fridge.body, fridge.joint)[0][2]  # under the lid
+    p.resetJointState(fridge.body, fridge.joint, -household()["fridge"].opening.opens)
+    assert not tasks.check_in_target(milk, fridge, None)["ok"]
+
+
+@pytest.mark.parametrize("tall, receptacle", [("milk", "drawer"), ("blender", "fridge")])
+def test_what_is_too_tall_to_shut_a_receptacle_over_is_refused_before_moving(sim, tmp_path, tall, receptacle):
     from lmcr.robot.plan import Infeasible, Planner
 
-    scene = make_scene([("milk", [-0.1, 0.25]), ("drawer", [0.05, -0.2])])
+    scene = make_scene([(tall, [-0.1, 0.25]), (receptacle, [0.05, -0.2])])
     planner = Planner(build_world(scene, tmp_path), scene, scene.table)
-    task = tasks.task_for(Frame.of("put away", {"Theme": "milk", "Destination": "drawer"}))
-    refused = planner.plan_drawer(task, scene.find("milk"), scene.find("drawer"), holding=False)
-    assert isinstance(refused, Infeasible) and refused.reason == "the milk is too tall to shut the drawer over it"
-    assert p.getJointState(scene.find("drawer").body, scene.find("drawer").joint)[0] == 0.0
+    task = tasks.task_for(Frame.of("put away", {"Theme": tall, "Destination": receptacle}))
+    refused = planner.plan_shut_receptacle(task, scene.find(tall), scene.find(receptacle), holding=False)
+    assert isinstance(refused, Infeasible)
+    assert refused.reason == f"the {tall} is too tall to shut the {receptacle} over it"
+    assert p.getJointState(scene.find(receptacle).body, scene.find(receptacle).joint)[0] == 0.0
 
 
 def test_the_person_holds_what_was_handed_over_and_not_what_was_not(sim, tmp_path):
@@ -464,3 +500,22 @@ def test_the_motion_names_agree_wherever_they_are_used():
     assert "place" in MOTION_CLASSES  # the class a kitchen container's placing asks for (task_for)
     assert tasks.SERVE.motion in MOTION_CLASSES  # the serve class's motion, said in its own words
     assert motion_done("serve", {"Theme": "soup", "Destination": "bowl"}) == "served the soup into the bowl"
+
+
+def test_what_stands_behind_an_open_lid_is_set_down_nearer_first(sim, tmp_path):
+    """The milk behind the fridge: with the lid standing open, the arm would meet it on the way to the
+    milk, so the milk is set down elsewhere first; then the lid is lifted, the milk put in, the lid shut."""
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.execute import plan_task
+    from lmcr.robot.plan import Infeasible, Plan, Planner
+
+    scene = make_scene([("milk", [0.15, 0.25]), ("fridge", [-0.12, 0.3])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = tasks.task_for(Frame.of("put away", {"Theme": "milk", "Destination": "fridge"}))
+    milk, fridge = scene.find("milk"), scene.find("fridge")
+    direct = planner.plan_shut_receptacle(task, milk, fridge, holding=False)
+    assert isinstance(direct, Infeasible) and direct.blocker == "the fridge", direct
+    plan = plan_task(planner, scene, task, {"Theme": milk, "Destination": fridge})
+    assert isinstance(plan, Plan) and plan.first is not None and plan.opens is not None
+    out = run_plan(plan, milk, fridge, [], planner)
+    assert out["success"] and out["checks"]["shut"], out["checks"]

@@ -60,3 +60,18 @@ def test_without_a_budget_only_the_straight_motion_is_taken():
         list(q0 + over),
         list(q1 + over),
     ]
+
+
+def test_a_motion_to_or_from_a_clashing_configuration_is_refused_at_once():
+    """RRT-Connect waits for a valid goal without counting a check: a goal inside the wall (an open lid in
+    the way of the arm's start) searched for ever."""
+    checks = []
+
+    def counted(q):
+        checks.append(1)
+        return _wall(q)
+
+    outside, inside = np.zeros(7) + [-1, 0, 0, 0, 0, 0, 0], np.zeros(7)
+    assert joint_path(counted, outside, inside, LIMITS) is None
+    assert joint_path(counted, inside, outside, LIMITS) is None
+    assert len(checks) < 200

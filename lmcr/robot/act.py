@@ -10,7 +10,7 @@ from lmcr.robot.arm import relative_pose, settle
 from lmcr.robot.pieces import cut_through
 from lmcr.robot.plan import Plan, Planner, pick_steps, shifted
 from lmcr.robot.scene import TOOLS, SceneObject, depth
-from lmcr.robot.tasks import SCOOP_GRAINS, Outcome, in_palm
+from lmcr.robot.tasks import SCOOP_GRAINS, Outcome, hinged, in_palm
 
 TOLERANCE = 0.02  # metres: a waypoint counts as reached within this
 MOVED = 0.02  # metres: an object not in the task that moved further was knocked
@@ -39,13 +39,13 @@ def run_plan(
     target_at = p.getBasePositionAndOrientation(target.body)[0]
     out = Outcome()
     knocked_during: dict[str, str] = {}
-    if plan.opens is not None:  # a drawer pulled open first
+    if plan.opens is not None:  # a drawer or a lid opened first
         knocked_during = _act(plan.opens, target, Outcome(), others, before)[2]
     grasped, released, knocked = _act(plan, held, out, others, before, planner)
     knocked_during = {**knocked, **knocked_during}  # the step it was first seen moved in
     if out.particles or released:
         settle(480)  # let what was poured or let go come to rest
-    if plan.shuts is not None and grasped:  # and pushed shut over what was put in
+    if plan.shuts is not None and grasped:  # and shut over what was put in
         knocked_during = {**_act(plan.shuts, target, Outcome(), others, before)[2], **knocked_during}
         settle(120)
     checks = plan.task.check(held, target, out) if grasped else {"ok": False}
@@ -145,7 +145,8 @@ def _give(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
 
 
 def _hook(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:
-    arm.hook(held.body, held.link)
+    # what an opening plan holds is the target itself, by the link its joint moves (pybullet numbers them alike)
+    arm.hook(held.body, held.joint, turns=hinged(held))
 
 
 def _unhook(arm, step, plan: Plan, held: SceneObject, out: Outcome) -> None:

@@ -294,14 +294,22 @@ class Arm:
         robot_collisions(self.robot, body, False)  # held in the hand, it must not push the arm around
         self.held = body
 
-    def hook(self, body: int, link: int) -> None:
-        """Hold a link of `body` (a drawer, by its handle) rigidly where it is relative to the gripper: the
-        arm's motion then pulls or pushes it along its joint."""
+    def hook(self, body: int, link: int, turns: bool = False) -> None:
+        """Hold a link of `body` (a drawer or a lid, by its handle's bar) where it is relative to the gripper:
+        the arm's motion then pulls or pushes it along its joint. A drawer is held rigidly; a lid's bar
+        (`turns`) only at the gripper's point, so that it turns in the hold as the lid turns about its
+        hinge (a rigid hold would fight the hinge)."""
         com_pos, com_orn = p.getLinkState(body, link)[:2]
-        rel_pos, rel_orn = relative_pose(*self.ee_pose(), com_pos, com_orn)
-        self.constraint = p.createConstraint(
-            self.robot, self.ee, body, link, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn
-        )
+        if turns:
+            here = relative_pose(com_pos, com_orn, *self.ee_pose())[0]
+            self.constraint = p.createConstraint(
+                self.robot, self.ee, body, link, p.JOINT_POINT2POINT, [0, 0, 0], [0, 0, 0], here
+            )
+        else:
+            rel_pos, rel_orn = relative_pose(*self.ee_pose(), com_pos, com_orn)
+            self.constraint = p.createConstraint(
+                self.robot, self.ee, body, link, p.JOINT_FIXED, [0, 0, 0], rel_pos, [0, 0, 0], rel_orn
+            )
         p.changeConstraint(self.constraint, maxForce=500)
 
     def unhook(self) -> None:

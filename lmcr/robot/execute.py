@@ -24,6 +24,7 @@ from lmcr.lexicon import Lexicon
 from lmcr.robot.act import run_plan
 from lmcr.robot.budget import Budget
 from lmcr.robot.detect import detect
+from lmcr.robot.household import household
 from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
@@ -177,7 +178,7 @@ def _search(planner: Planner, scene: Scene, options: list, seen: set[str]) -> li
             tried.append((frame, candidate, {}, _no_motion(frame)))
             continue
         for objects in _assignments(scene, frame, task, seen)[:MAX_INSTANCES]:
-            tried.append((frame, candidate, objects, _plan(planner, scene, task, objects)))
+            tried.append((frame, candidate, objects, plan_task(planner, scene, task, objects)))
             if isinstance(tried[-1][3], Plan) or planner.stopped:
                 break
         if isinstance(tried[-1][3], Plan) or planner.stopped:
@@ -235,26 +236,41 @@ def _instances(scene: Scene, frame: Frame, task: Task, role: str, seen: set[str]
     return found
 
 
-def _plan(planner: Planner, scene: Scene, task: Task, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, SceneObject]) -> Plan | Infeasible:
+    """The plan for a task with its objects (role -> object), or why there is none: the hand emptied first
+    when it holds something else; a drawer or a fridge opened, filled and shut by one arm; else directly.
+    Where that is refused, something is set down elsewhere first (`_set_aside`)."""
     task = task.with_source(objects)
     held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
-    if target.joint >= 0:  # a drawer: opened, filled and shut by one arm
-        return planner.plan_drawer(task, held, target, holding)
-    direct = planner.plan(task, held, target, holding)
+    shut = target.joint >= 0
+    direct = (planner.plan_shut_receptacle if shut else planner.plan)(task, held, target, holding)
     if isinstance(direct, Plan) or planner.stopped:
         return direct
-    # set down elsewhere first: the held object when no arm reaches all the task as it stands (from the
-    # table it may be picked up by either arm, in any grasp), else, with the hand free, the object on
-    # the table a pose would put the arm against
-    blocking = None if holding else planner.on_table(direct.blocker)
-    moved = held if direct.out_of_reach else blocking
-    if moved is None:
-        return direct
-    rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
-    return replace(rearranged, instead_of=direct) if isinstance(rearranged, Plan) else direct
+    for moved in _set_aside(planner, direct, held, target, holding):
+        rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
+        if isinstance(rearranged, Plan):
+            return replace(rearranged, instead_of=direct)
+        if planner.stopped:
+            break
+    return direct
+
+
+def _set_aside(planner: Planner, refused: Infeasible, held: SceneObject, target: SceneObject, holding: bool) -> list:
+    """What to set down elsewhere first, in the order to try, after `refused`: the held object when no arm
+    reaches all the task as it stands (from the table it may be picked up by either arm, in any grasp);
+    else, with the hand free, the object on the table a pose would put the arm against (unless it is a
+    fixed receptacle), then the held object, moved away from it (a bin beside the banana, a fridge's
+    open lid in the way to the milk)."""
+    if refused.out_of_reach:
+        return [held]
+    blocking = None if holding else planner.on_table(refused.blocker)
+    if blocking is None:
+        return []
+    fixed = getattr(household().get(blocking.label), "mass", None) == 0
+    return [*([] if fixed else [blocking]), *([] if blocking is held else [held])]
 
 
 def _set_down(plan: Plan) -> dict:

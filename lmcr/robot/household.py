@@ -31,11 +31,13 @@ class HouseholdError(LMCRError, ValueError):
 
 
 @dataclass(frozen=True)
-class Slide:
-    """A drawer: the `link` things are put in slides on the prismatic `joint`, pulled `opens` metres
-    towards the robot by its `handle` (the bar's middle, in the body's frame, closed) and pushed back;
-    things go to the `middle` of its floor (body frame, closed) and are at most `headroom` tall (the
-    cabinet's top passes over them)."""
+class Opening:
+    """How a shut receptacle is opened, filled and shut again: a drawer slides out on a prismatic `joint`, a
+    chest fridge's lid turns up on a revolute one. The hand holds the `handle` (the bar's middle, in the
+    frame of the link the joint moves) and moves it along the joint's travel, `opens` (metres or radians:
+    the joint stands at -opens when open), and back; things go to the `middle` of the floor of the `link`
+    they are put in (its frame; the URDF's root link for a box that stays put), at most `headroom` tall (what
+    shuts passes over them). Within `shut` of its closed end (joint units) it counts as shut."""
 
     link: str
     joint: str
@@ -43,6 +45,7 @@ class Slide:
     handle: tuple[float, float, float]
     middle: tuple[float, float, float]
     headroom: float
+    shut: float = 0.01
 
 
 @dataclass(frozen=True)
@@ -90,7 +93,7 @@ class Receptacle:
     """One receptacle: its shape (boxes in a frame whose origin is the middle of its footprint on the
     table top, or a URDF body), the box it needs (`size`: width along x, depth along y, height), how far
     below its top things put inside go (`depth`, 0 when they rest on top), mass, where things go, the
-    motion that puts them there, and its `slide` when it is a drawer."""
+    motion that puts them there, and its `opening` when it is shut (a drawer, a lidded chest)."""
 
     label: str
     parts: tuple[Box, ...]
@@ -101,7 +104,7 @@ class Receptacle:
     motion: str
     colour: tuple[float, float, float, float]
     urdf: Path | None = None
-    slide: Slide | None = None
+    opening: Opening | None = None
 
 
 def _around(parts: tuple[Box, ...]) -> tuple[float, float, float]:
@@ -254,17 +257,18 @@ def _receptacle(label: str, entry: object, path: Path, where: str) -> Receptacle
     depth = _number(entry, "depth", where)
     if depth > size[2]:
         raise HouseholdError(f"{where}: 'depth' {depth} is deeper than the body is tall ({size[2]})")
-    slide = _slide(entry["slide"], f"{where}: slide") if "slide" in entry else None
-    return Receptacle(label, (), size, depth, mass, surface, motion, colour, path.parent / urdf, slide)
+    opening = _opening(entry["opening"], f"{where}: opening") if "opening" in entry else None
+    return Receptacle(label, (), size, depth, mass, surface, motion, colour, path.parent / urdf, opening)
 
 
-def _slide(entry: object, where: str) -> Slide:
+def _opening(entry: object, where: str) -> Opening:
     if not isinstance(entry, dict) or not all(isinstance(entry.get(k), str) for k in ("link", "joint")):
         raise HouseholdError(f"{where}: needs the 'link' and the 'joint' (names in the URDF)")
     handle = _numbers(entry.get("handle"), 3, f"{where}: handle")
     middle = _numbers(entry.get("middle"), 3, f"{where}: middle")
     opens, headroom = _number(entry, "opens", where), _number(entry, "headroom", where)
-    return Slide(entry["link"], entry["joint"], opens, handle, middle, headroom)
+    shut = _number(entry, "shut", where, default=Opening.shut)
+    return Opening(entry["link"], entry["joint"], opens, handle, middle, headroom, shut)
 
 
 @cache

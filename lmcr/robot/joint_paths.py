@@ -32,7 +32,9 @@ def joint_path(
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if segment_clash(clash, q0, q1) is None:
         return [q0, q1]
-    if budget <= 0:  # the straight motion or none
+    # the straight motion or none; and none to or from a configuration that clashes: RRT-Connect waits
+    # for a valid goal state without counting a check, so the budget would never end its search
+    if budget <= 0 or clash(q0) or clash(q1):
         return None
     ou.RNG.setSeed(seed)  # before the search makes its samplers (OMPL logs, unseen, that seeds were drawn before)
     space = ob.RealVectorStateSpace(len(q0))

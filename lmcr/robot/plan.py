@@ -26,14 +26,14 @@ from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, height, world_xy
 from lmcr.robot.tasks import (
     GRIP_GAP,
-    SLIDE,
+    OPENING,
     Geometry,
     Step,
     Task,
     Variant,
+    opening_point,
+    opening_steps,
     put_down,
-    slide_point,
-    slide_steps,
     variants,
 )
 
@@ -63,8 +63,8 @@ class Plan:
     task: Task
     first: Plan | None = None  # run before: an object set down elsewhere (`plan_via`)
     instead_of: Infeasible | None = None  # with `first`: why the task alone was not planned
-    opens: Plan | None = None  # run before the task: the target drawer pulled open (`plan_drawer`)
-    shuts: Plan | None = None  # run after it: the drawer pushed shut
+    opens: Plan | None = None  # run before the task: the target drawer or lid opened (`plan_shut_receptacle`)
+    shuts: Plan | None = None  # run after it: shut again
 
     @property
     def fingers(self) -> list[float]:
@@ -206,7 +206,8 @@ class Planner:
                 if not on_table:
                     self.scene.objects.append(moved)
                 try:
-                    rest = self.plan(task, held, target, holding=False, start="parked")
+                    then = self.plan_shut_receptacle if target.joint >= 0 else self.plan
+                    rest = then(task, held, target, holding=False, start="parked")
                 finally:
                     if not on_table:
                         self.scene.objects.remove(moved)
@@ -217,30 +218,33 @@ class Planner:
                 best = rest if rest.progress >= best.progress else best
         return best
 
-    def plan_drawer(self, task: Task, held: SceneObject, target: SceneObject, holding: bool) -> Plan | Infeasible:
-        """Into a drawer: pull it open, do the task with it open, push it shut, all three with one arm (the
-        nearer first; the other parked), each part planned in the world the one before leaves (the held
-        object lying in the drawer for the push). Refused at once when the held object is too tall for the
-        drawer to shut over it. A spent budget ends the search."""
-        slide = household()[target.label].slide
-        if height(held.label) > slide.headroom:
+    def plan_shut_receptacle(
+        self, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str = "home"
+    ) -> Plan | Infeasible:
+        """Into a drawer or a chest fridge: open it, do the task with it open, shut it, all three with one
+        arm (the nearer first; the other parked), each part planned in the world the one before leaves (the
+        held object lying in it for the shutting), the arm from its `start` ("home" or "parked"). Refused
+        at once when the held object is too tall to shut the drawer or the lid over it. A spent budget ends
+        the search."""
+        found = household()[target.label].opening
+        if height(held.label) > found.headroom:
             return Infeasible(f"{_named(held)} is too tall to shut {_named(target)} over it", 0, False, _named(target))
         best = Infeasible("nothing was tried", -1)
         for side in _nearer_first(target, SIDES):
             if self.spent():
                 return best
-            result = self._drawer_with(side, task, held, target, holding, slide.opens)
+            result = self._opened_with(side, task, held, target, holding, found.opens, start)
             if isinstance(result, Plan):
                 return result
             best = result if result.progress > best.progress else best
         return best
 
-    def _drawer_with(
-        self, side: str, task: Task, held: SceneObject, target: SceneObject, holding: bool, opens: float
+    def _opened_with(
+        self, side: str, task: Task, held: SceneObject, target: SceneObject, holding: bool, opens: float, start: str
     ) -> Plan | Infeasible:
         arm, other = self.arms[side], self.arms[SIDES[1 - SIDES.index(side)]]
         other.set_config(other.parked)
-        opening = self._slide(arm, other, target, True, arm.home)
+        opening = self._open_or_shut(arm, other, target, True, getattr(arm, start))
         if isinstance(opening, Infeasible):
             return opening
         saved = _save(held)
@@ -249,12 +253,12 @@ class Planner:
             rest = self.plan(task, held, target, holding, arms=(side,), start="home")
             if isinstance(rest, Infeasible):
                 return replace(rest, progress=rest.progress + len(opening.segments))
-            bottom = slide_point(target, "middle") + [0, 0, 0.002]  # as it will lie in the drawer, upright
+            bottom = opening_point(target, "middle") + [0, 0, 0.002]  # as it will lie in it, upright
             p.resetBasePositionAndOrientation(
                 held.body, [*bottom[:2], bottom[2] + height(held.label) / 2], (0, 0, 0, 1)
             )
             end = next(s.path[-1] for s in reversed(rest.segments) if s.path is not None)
-            shutting = self._slide(arm, other, target, False, end, moving=held)
+            shutting = self._open_or_shut(arm, other, target, False, end, moving=held)
         finally:
             p.resetJointState(target.body, target.joint, 0.0)
             _restore(held, saved)
@@ -263,7 +267,7 @@ class Planner:
             return replace(shutting, progress=shutting.progress + len(opening.segments) + len(rest.segments))
         return replace(rest, opens=opening, shuts=shutting)
 
-    def _slide(
+    def _open_or_shut(
         self,
         arm: Arm,
         other: Arm,
@@ -272,17 +276,33 @@ class Planner:
         start: np.ndarray,
         moving: SceneObject | None = None,
     ) -> Plan | Infeasible:
-        """The drawer pulled open (then the arm back at its start) or pushed shut, from joints `start`;
-        `moving`: what lies in it (it slides with the drawer, no obstacle)."""
-        steps = slide_steps(target, opening) + ([Step("home", "to its start")] if opening else [])
-        arm.set_config(start)
+        """The drawer or lid opened (then the arm back at its start) or shut, from joints `start`; `moving`:
+        what lies in it (a drawer carries it along, no obstacle). What follows the motion along the joint is
+        planned with the drawer or lid where that motion leaves it (an open lid stands in the way home);
+        the joint is left as it was."""
+        away = opening and not np.array_equal(start, arm.home)  # parked: it comes to its start first
+        steps = [
+            *([Step("home", "to its start")] if away else []),
+            *opening_steps(target, opening),
+            *([Step("home", "to its start")] if opening else []),
+        ]
+        moved = next(i for i, step in enumerate(steps) if step.kind == "unhook")
         obstacles = {
             body: name for body, name in self._obstacles(target).items() if moving is None or body != moving.body
         }
-        found = self._plan_variant(arm, Clearance(arm, obstacles), steps, target, target, None, start)
+        clearance, was = Clearance(arm, obstacles), p.getJointState(target.body, target.joint)[0]
+        arm.set_config(start)
+        found = self._plan_variant(arm, clearance, steps[:moved], target, target, None, start)
         if isinstance(found, Infeasible):
             return found
-        return Plan(arm, other, Variant(), found, None, Geometry.measure(target, target), SLIDE)
+        p.resetJointState(target.body, target.joint, -household()[target.label].opening.opens if opening else 0.0)
+        try:
+            rest = self._plan_variant(arm, clearance, steps[moved:], target, target, None, found[-1].path[-1])
+        finally:
+            p.resetJointState(target.body, target.joint, was)
+        if isinstance(rest, Infeasible):
+            return replace(rest, progress=rest.progress + moved)
+        return Plan(arm, other, Variant(), found + rest, None, Geometry.measure(target, target), OPENING)
 
     def replan_in_hand(self, plan: Plan, in_hand: tuple) -> Plan | None:
         """The rest of `plan` (after the pick-up) planned afresh from where its arm is, for the held object
@@ -423,7 +443,7 @@ class Planner:
                     else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
                 )
                 if straight and path is None:
-                    way = "straight down" if into else "straight"  # into a container, or along a slide or a row
+                    way = "straight down" if into else "straight"  # into a container, or along a slide, an arc or a row
                     why, reach = f"the {arm.side} arm cannot go {way} to '{step.name}'", False
                     continue
                 blocker = _path_clash(clash, path) if straight else None

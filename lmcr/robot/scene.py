@@ -104,7 +104,7 @@ class SceneObject:
     body: int = -1
     id: str = ""  # this object among those sharing its label (lmcr.instances); assigned by its Scene when empty
     link: int = -1  # the body's link things are put in (a drawer's), -1 the body itself
-    joint: int = -1  # the joint that link slides on (a drawer's), -1 none
+    joint: int = -1  # the joint that opens it (a drawer's slide, a lid's hinge), -1 none
 
     @property
     def name(self) -> str:

@@ -60,8 +60,12 @@ WIPE_APPROACH = 0.05  # it comes down onto the surface, and leaves it, straight 
 WIPE_OVERLAP, WIPED = 0.9, 0.95  # rows overlap by a tenth of the tool's width; this share of the surface is wiped
 STIR_RADIUS, STIR_TURNS = 0.025, 2  # the tool's tip circles this far round the middle, this many times
 STIR_DEPTH, STIR_CLEAR = 0.03, 0.015  # its tip this far below the rim, this far clear of the walls
-HANDLE_BAR = 0.015  # a drawer handle's bar, this thick
-SHUT = 0.01  # metres: a drawer this near its closed end is shut
+HANDLE_BAR = 0.015  # a drawer's or a lid's handle bar, this thick
+# a lid is turned along its arc in chords this far apart (0.15 m out, a chord bows under 1 mm off the arc),
+# the hand leaning forward this far (radians) all the while: held straight down, the bar of an open lid on
+# the far side of the table is out of reach (its hold lets the bar turn, so the hand need not turn with it)
+CHORD, LID_LEAN = math.radians(10), 0.3
+HANDLE_APPROACH = 0.1  # the hand comes onto a handle, and leaves it, along its own axis from this far
 PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
 CUT_STROKES, SAW = 3, 0.015  # a cut saws down through the food in this many strokes, the blade this far back and forth
 CUT_ABOVE, CUT_CLEAR = 0.03, 0.004  # the edge starts this far above the food; it ends this far above the board
@@ -167,7 +171,7 @@ class Geometry:
     def measure(cls, held: SceneObject, target: SceneObject, source: SceneObject | None = None) -> Geometry:
         pos, orn = p.getBasePositionAndOrientation(held.body)
         lo, hi = p.getAABB(target.body, target.link)  # a drawer's: what things are put in
-        tpos = slide_point(target, "middle") if target.joint >= 0 else p.getBasePositionAndOrientation(target.body)[0]
+        tpos = opening_point(target, "middle") if target.joint >= 0 else p.getBasePositionAndOrientation(target.body)[0]
         return cls(
             held,
             target,
@@ -244,29 +248,68 @@ class Geometry:
         return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
 
 
-def slide_point(target: SceneObject, which: str) -> np.ndarray:
-    """A drawer's `handle` or the `middle` of its floor (household.json) in the world, where the drawer
-    now stands (open or shut)."""
-    frame = np.asarray(p.getLinkState(target.body, target.link)[4])  # moves with the drawer
-    return frame + getattr(household()[target.label].slide, which)
+def opening_point(target: SceneObject, which: str) -> np.ndarray:
+    """A shut receptacle's `handle` (on the link its joint moves) or the `middle` of the floor things are put
+    on (on the link that holds them) in the world, where it now stands (open or shut; household.json)."""
+    link = target.joint if which == "handle" else target.link  # pybullet numbers a joint's child link as it
+    pos, orn = p.getLinkState(target.body, link)[4:6] if link >= 0 else p.getBasePositionAndOrientation(target.body)
+    return np.asarray(
+        p.multiplyTransforms(pos, orn, getattr(household()[target.label].opening, which), (0, 0, 0, 1))[0]
+    )
 
 
-def slide_steps(target: SceneObject, opening: bool) -> list[Step]:
-    """Pull a drawer open (or push it shut) by its handle: the gripper comes down over the bar, holds it,
-    moves straight along the slide for its whole travel, lets go and rises."""
-    slide = household()[target.label].slide
-    orn = Variant().upright()  # the fingers along the bar, over it: across it, one would meet the drawer's front
-    grip = slide_point(target, "handle") + [0, 0, HANDLE_BAR / 2 + GRIP_GAP]
-    to = grip + [-slide.opens if opening else slide.opens, 0, 0]
-    name, way = target.name, ("pull", "open") if opening else ("push", "shut")
+def hinged(target: SceneObject) -> bool:
+    """Whether the joint that opens the target turns (a lid's hinge) rather than slides (a drawer)."""
+    return p.getJointInfo(target.body, target.joint)[2] == p.JOINT_REVOLUTE
+
+
+def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
+    """Open a drawer or a lid (or shut it) by its handle: the gripper comes onto the bar along its own axis,
+    holds it, moves it along the joint's whole travel (straight along a slide; round a hinge in chords of
+    CHORD, leaning LID_LEAN forward, the bar turning in the hold), lets go and draws back straight."""
+    found = household()[target.label].opening
+    turns = hinged(target)
+    start, end = p.getJointState(target.body, target.joint)[0], -found.opens if opening else 0.0
+    pieces = max(1, math.ceil(abs(end - start) / CHORD)) if turns else 1
+    lean = LID_LEAN if turns else 0.0
+    orn = Variant(
+        pitch=lean
+    ).upright()  # the fingers along the bar, over it: across it, one would meet a drawer's front
+    axis = np.array([math.sin(lean), 0.0, -math.cos(lean)])  # the way the fingers point
+    grip = opening_point(target, "handle") - axis * (HANDLE_BAR / 2 + GRIP_GAP)
+    path = _moved_with(target, grip, [start + (end - start) * k / pieces for k in range(1, pieces + 1)])
+    way = {(False, True): "pull {} open", (False, False): "push {} shut", (True, True): "lift {} open"}
+    name = way.get((turns, opening), "lower {} shut").format(f"the {target.name}")
     return [
-        move(f"above the {name}'s handle", grip + [0, 0, 0.1], orn),
-        move(f"on the {name}'s handle", grip, orn, touches="target"),
-        Step("hook", f"hold the {name}'s handle"),
-        Step("move", f"{way[0]} the {name} {way[1]}", (to,), orn, "target", straight=True),
+        move(f"above the {target.name}'s handle", grip - axis * HANDLE_APPROACH, orn),
+        move(f"on the {target.name}'s handle", grip, orn, touches="target"),
+        Step("hook", f"hold the {target.name}'s handle"),
+        *(
+            Step("move", name if pieces == 1 else f"{name} ({k}/{pieces})", (to,), orn, "target", straight=True)
+            for k, to in enumerate(path, 1)
+        ),
         Step("unhook", "let go of the handle"),
-        move("up from the handle", to + [0, 0, 0.1], orn, touches="target"),
+        # straight off the bar: a joint-space move with the target ignored swept a hand through an open lid
+        Step("move", "up from the handle", (path[-1] - axis * HANDLE_APPROACH,), orn, "target", straight=True),
     ]
+
+
+def _moved_with(target: SceneObject, point: np.ndarray, values: list[float]) -> list[np.ndarray]:
+    """Where a point held to the link the target's joint moves goes as the joint takes each of `values`
+    (the joint is left where it was)."""
+    joint, body = target.joint, target.body
+    was = p.getJointState(body, joint)[0]
+    pos, orn = p.getLinkState(body, joint)[4:6]
+    local = p.multiplyTransforms(*p.invertTransform(pos, orn), point, (0, 0, 0, 1))[0]
+    found = []
+    try:
+        for value in values:
+            p.resetJointState(body, joint, value)
+            pos, orn = p.getLinkState(body, joint)[4:6]
+            found.append(np.asarray(p.multiplyTransforms(pos, orn, local, (0, 0, 0, 1))[0]))
+    finally:
+        p.resetJointState(body, joint, was)
+    return found
 
 
 def side_grip_height(label: str) -> float:
@@ -775,11 +818,11 @@ def check_sprinkle(held: SceneObject, target: SceneObject, out: Outcome) -> dict
 
 
 def check_in_target(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
-    """In (or on) the target; a drawer must also be shut again."""
+    """In (or on) the target; a drawer or a lidded box must also be shut again."""
     ok = inside(target, p.getBasePositionAndOrientation(held.body)[0])
     if target.joint < 0:
         return {"in_target": ok, "ok": ok}
-    shut = bool(p.getJointState(target.body, target.joint)[0] > -SHUT)
+    shut = bool(p.getJointState(target.body, target.joint)[0] > -household()[target.label].opening.shut)
     return {"in_target": ok, "shut": shut, "ok": ok and shut}
 
 
@@ -940,9 +983,9 @@ SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="s
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
 TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers}
 
-# pulling a drawer open or pushing it shut (`slide_steps`, planned beside the task): a part of putting
+# opening a drawer or a lid or shutting it (`opening_steps`, planned beside the task): a part of putting
 # something into it, checked with the task
-SLIDE = Task("", "", lambda g, v, holding: [], lambda held, target, out: {"ok": True}, motion="slide")
+OPENING = Task("", "", lambda g, v, holding: [], lambda held, target, out: {"ok": True}, motion="opening")
 
 
 def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:

@@ -25,7 +25,9 @@ from lmcr.robot.scene import (
     world_xy,
 )
 
-SLIDE_FRICTION = 3.0  # newtons that hold a drawer where it was left (the hand pulls with up to 500)
+# what holds a drawer or a lid where the hand left it: 3 newtons on a slide, 3 newton-metres on a hinge (a
+# chest fridge's lid weighs under 0.5 N m held out flat; the hand pulls with up to 500 N)
+JOINT_FRICTION = 3.0
 ROLLING_RESISTANCE = 0.01  # of round food (spheres) on the table, metres: the lever of its contact patch
 
 
@@ -86,19 +88,20 @@ def _solid(label: str, x: float, y: float, z: float = TABLE_TOP) -> int:
 
 
 def _articulated(found: Receptacle, x: float, y: float) -> tuple[int, int, int]:
-    """A receptacle described by a URDF (a drawer unit), fixed when its mass is 0: its body, and the link
-    things go in and the joint it slides on (-1 when it has no slide). The slide's motor is a little
-    friction, so that a drawer stays where the hand leaves it."""
+    """A receptacle described by a URDF (a drawer unit, a chest fridge), fixed when its mass is 0: its body,
+    the link things go in (-1: the root) and the joint that opens it (-1 when it has no opening). The
+    joint's motor is a little friction, so that a drawer or a lid stays where the hand leaves it."""
     body = p.loadURDF(str(found.urdf), [x, y, TABLE_TOP], useFixedBase=found.mass == 0)
-    if found.slide is None:
+    if found.opening is None:
         return body, -1, -1
     joints = {p.getJointInfo(body, j)[1].decode(): j for j in range(p.getNumJoints(body))}
     links = {p.getJointInfo(body, j)[12].decode(): j for j in range(p.getNumJoints(body))}
-    if found.slide.joint not in joints or found.slide.link not in links:
-        raise HouseholdError(f"{found.urdf}: has no joint {found.slide.joint!r} or link {found.slide.link!r}")
-    joint = joints[found.slide.joint]
-    p.setJointMotorControl2(body, joint, p.VELOCITY_CONTROL, targetVelocity=0, force=SLIDE_FRICTION)
-    return body, links[found.slide.link], joint
+    links[p.getBodyInfo(body)[0].decode()] = -1
+    if found.opening.joint not in joints or found.opening.link not in links:
+        raise HouseholdError(f"{found.urdf}: has no joint {found.opening.joint!r} or link {found.opening.link!r}")
+    joint = joints[found.opening.joint]
+    p.setJointMotorControl2(body, joint, p.VELOCITY_CONTROL, targetVelocity=0, force=JOINT_FRICTION)
+    return body, links[found.opening.link], joint
 
 
 # how each kind of object is built (SceneObject.kind)
