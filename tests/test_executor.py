@@ -1131,3 +1131,21 @@ def test_an_object_lowered_into_a_container_passes_its_walls_clear(sim, tmp_path
     out = execute("heat the milk please", scene, load_parser(), _prefers("glass"), CompletionConfig(), tmp_path)
     assert out["frame"]["roles"] == {"Theme": "milk", "Instrument": "glass"}
     assert out["success"] and out["checks"]["in_target"], out["checks"]
+
+
+def test_a_straight_motion_stays_in_one_arm_configuration_to_its_end(sim, tmp_path):
+    """A straight line's waypoints are each solved from the last, its end too: the end solved from
+    elsewhere may be another configuration of the arm, and the arm then swings off the line between
+    them (a ladle tipped so flung its content off the table)."""
+    from lmcr.robot.plan import BRANCH_JUMP, Planner, _straight_line
+
+    scene = make_scene([("cup", [0.1, 0.2])])
+    arm = Planner(build_world(scene, tmp_path), scene, scene.table).arms["left"]
+    arm.set_config(arm.home)
+    here, orn = arm.ee_pose()
+    elsewhere = np.asarray(arm.parked, dtype=float)  # the "goal" of another solve: far from home's joints
+    path = _straight_line(arm, arm.home, elsewhere, np.add(here, [0.03, 0.0, -0.02]), orn)
+    assert path is not None and np.allclose(path[0], arm.home)
+    assert all(np.max(np.abs(b - a)) <= BRANCH_JUMP for a, b in zip(path, path[1:]))
+    arm.set_config(path[-1])
+    assert np.linalg.norm(np.subtract(arm.ee_pose()[0], np.add(here, [0.03, 0.0, -0.02]))) < 0.003

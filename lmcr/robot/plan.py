@@ -43,6 +43,7 @@ SHIFTED, TURNED = 0.005, 0.05
 # an object put into a container passes its walls this far clear, on a straight line through waypoints
 # this far apart (a joint-space segment between far-apart poses bows off the line by millimetres)
 FIT_MARGIN, INTO_STEP = 0.002, 0.01
+BRANCH_JUMP = 0.3  # radians: a joint turning this much between two waypoints 1 cm apart is another arm configuration
 
 
 @dataclass
@@ -457,7 +458,7 @@ class Planner:
                 if into and not _fits_through(arm, path, carried, target):
                     why, reach, blocker = f"{_named(held)} would not fit into {_named(target)}", False, _named(target)
                     continue
-                found = (path, goal, position)
+                found = (path, path[-1], position)  # a straight line's end is its own (the goal's pose)
                 break
             if found is None:
                 return Infeasible(why, i, reach, blocker)
@@ -518,21 +519,23 @@ def shifted(planned: tuple, found: tuple) -> bool:
 
 def _straight_line(arm: Arm, start: np.ndarray, goal: np.ndarray, position, orientation) -> list[np.ndarray] | None:
     """Joints that move the gripper from where it is at `start` to `position` along the straight line,
-    a waypoint every INTO_STEP (each solved from the last, the last one `goal`); None when one is out of
-    reach."""
+    a waypoint every INTO_STEP, each solved from the last (the end too: `goal`, solved from elsewhere, may
+    be another arm configuration); None when one is out of reach, or when one is another configuration
+    than the last (a joint turns more than BRANCH_JUMP between them: the arm would swing off the line
+    between them, and a ladle tipped so flung its content off the table)."""
     arm.set_config(start)
     here, turned = arm.ee_pose()
     n = max(1, int(np.ceil(np.linalg.norm(np.asarray(position) - here) / INTO_STEP)))
     path = [np.asarray(start, dtype=float)]
-    for k in range(1, n):
+    for k in range(1, n + 1):
         f = k / n
         q, err_pos, err_rot = arm.solve(
             here + (np.asarray(position) - here) * f, p.getQuaternionSlerp(turned, orientation, f), [path[-1]]
         )
-        if err_pos > IK_POSITION or err_rot > IK_ROTATION:
+        if err_pos > IK_POSITION or err_rot > IK_ROTATION or np.max(np.abs(q - path[-1])) > BRANCH_JUMP:
             return None
-        path.append(q)
-    return [*path, np.asarray(goal, dtype=float)]
+        path.append(np.asarray(q, dtype=float))
+    return path
 
 
 def _path_clash(clash, path: list[np.ndarray]) -> str | None:
