@@ -138,7 +138,7 @@ def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> di
     planner = Planner(build_world(scene, tmp_path), scene, scene.table)
     task = tasks.task_for(frame, verb_motion)
     held, target = (scene.find(frame.role_map[r]) for r in (task.held_role, task.target_role))
-    plan = (planner.plan_shut_receptacle if target.joint >= 0 else planner.plan)(task, held, target, holding=False)
+    plan = planner.plan_as_it_stands(task, held, target, holding=False)
     assert isinstance(plan, Plan), plan
     others = [o for o in scene.objects if o not in (held, target)]
     return {**run_plan(plan, held, target, others, planner), "held": held, "target": target}

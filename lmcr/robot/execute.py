@@ -245,11 +245,10 @@ def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, Sce
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
         return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
-    shut = target.joint >= 0
-    direct = (planner.plan_shut_receptacle if shut else planner.plan)(task, held, target, holding)
+    direct = planner.plan_as_it_stands(task, held, target, holding)
     if isinstance(direct, Plan) or planner.stopped:
         return direct
-    for moved in _set_aside(planner, direct, held, target, holding):
+    for moved in _set_aside(planner, direct, held, holding):
         rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
         if isinstance(rearranged, Plan):
             return replace(rearranged, instead_of=direct)
@@ -258,7 +257,7 @@ def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, Sce
     return direct
 
 
-def _set_aside(planner: Planner, refused: Infeasible, held: SceneObject, target: SceneObject, holding: bool) -> list:
+def _set_aside(planner: Planner, refused: Infeasible, held: SceneObject, holding: bool) -> list[SceneObject]:
     """What to set down elsewhere first, in the order to try, after `refused`: the held object when no arm
     reaches all the task as it stands (from the table it may be picked up by either arm, in any grasp);
     else, with the hand free, the object on the table a pose would put the arm against (unless it is a

@@ -47,6 +47,10 @@ class Opening:
     headroom: float
     shut: float = 0.01
 
+    def joint_at(self, open_: bool) -> float:
+        """The joint's value with the receptacle open (-opens) or shut (0)."""
+        return -self.opens if open_ else 0.0
+
 
 @dataclass(frozen=True)
 class Tool:

@@ -207,8 +207,7 @@ class Planner:
                 if not on_table:
                     self.scene.objects.append(moved)
                 try:
-                    then = self.plan_shut_receptacle if target.joint >= 0 else self.plan
-                    rest = then(task, held, target, holding=False, start="parked")
+                    rest = self.plan_as_it_stands(task, held, target, holding=False, start="parked")
                 finally:
                     if not on_table:
                         self.scene.objects.remove(moved)
@@ -218,6 +217,15 @@ class Planner:
                     return replace(rest, first=first)
                 best = rest if rest.progress >= best.progress else best
         return best
+
+    def plan_as_it_stands(
+        self, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str = "home"
+    ) -> Plan | Infeasible:
+        """The task planned with nothing set down first: into a shut receptacle (a drawer, a fridge) through
+        its opening (`plan_shut_receptacle`), else directly (`plan`), the arm from its `start`."""
+        if target.joint >= 0:
+            return self.plan_shut_receptacle(task, held, target, holding, start)
+        return self.plan(task, held, target, holding, start=start)
 
     def plan_shut_receptacle(
         self, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str = "home"
@@ -234,14 +242,14 @@ class Planner:
         for side in _nearer_first(target, SIDES):
             if self.spent():
                 return best
-            result = self._opened_with(side, task, held, target, holding, found.opens, start)
+            result = self._opened_with(side, task, held, target, holding, start)
             if isinstance(result, Plan):
                 return result
             best = result if result.progress > best.progress else best
         return best
 
     def _opened_with(
-        self, side: str, task: Task, held: SceneObject, target: SceneObject, holding: bool, opens: float, start: str
+        self, side: str, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str
     ) -> Plan | Infeasible:
         arm, other = self.arms[side], self.arms[SIDES[1 - SIDES.index(side)]]
         other.set_config(other.parked)
@@ -249,7 +257,7 @@ class Planner:
         if isinstance(opening, Infeasible):
             return opening
         saved = _save(held)
-        p.resetJointState(target.body, target.joint, -opens)
+        p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(True))
         try:
             rest = self.plan(task, held, target, holding, arms=(side,), start="home")
             if isinstance(rest, Infeasible):
@@ -261,7 +269,7 @@ class Planner:
             end = next(s.path[-1] for s in reversed(rest.segments) if s.path is not None)
             shutting = self._open_or_shut(arm, other, target, False, end, moving=held)
         finally:
-            p.resetJointState(target.body, target.joint, 0.0)
+            p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(False))
             _restore(held, saved)
             arm.set_config(arm.home)
         if isinstance(shutting, Infeasible):
@@ -296,7 +304,7 @@ class Planner:
         found = self._plan_variant(arm, clearance, steps[:moved], target, target, None, start)
         if isinstance(found, Infeasible):
             return found
-        p.resetJointState(target.body, target.joint, -household()[target.label].opening.opens if opening else 0.0)
+        p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(opening))
         try:
             rest = self._plan_variant(arm, clearance, steps[moved:], target, target, None, found[-1].path[-1])
         finally:
@@ -439,7 +447,7 @@ class Planner:
                 into = step.into and carried is not None
                 straight = into or step.straight
                 path = (
-                    _straight_line(arm, q, goal, position, step.orientation)
+                    _straight_line(arm, q, position, step.orientation)
                     if straight
                     else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
                 )
@@ -517,9 +525,9 @@ def shifted(planned: tuple, found: tuple) -> bool:
     return float(np.linalg.norm(np.subtract(found[0], planned[0]))) > SHIFTED or turned > TURNED
 
 
-def _straight_line(arm: Arm, start: np.ndarray, goal: np.ndarray, position, orientation) -> list[np.ndarray] | None:
+def _straight_line(arm: Arm, start: np.ndarray, position, orientation) -> list[np.ndarray] | None:
     """Joints that move the gripper from where it is at `start` to `position` along the straight line,
-    a waypoint every INTO_STEP, each solved from the last (the end too: `goal`, solved from elsewhere, may
+    a waypoint every INTO_STEP, each solved from the last (the end too: the goal, solved from elsewhere, may
     be another arm configuration); None when one is out of reach, or when one is another configuration
     than the last (a joint turns more than BRANCH_JUMP between them: the arm would swing off the line
     between them, and a ladle tipped so flung its content off the table)."""

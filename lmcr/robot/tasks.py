@@ -269,7 +269,7 @@ def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
     CHORD, leaning LID_LEAN forward, the bar turning in the hold), lets go and draws back straight."""
     found = household()[target.label].opening
     turns = hinged(target)
-    start, end = p.getJointState(target.body, target.joint)[0], -found.opens if opening else 0.0
+    start, end = p.getJointState(target.body, target.joint)[0], found.joint_at(opening)
     pieces = max(1, math.ceil(abs(end - start) / CHORD)) if turns else 1
     lean = LID_LEAN if turns else 0.0
     orn = Variant(
