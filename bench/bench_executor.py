@@ -58,10 +58,12 @@ TASKS = {
     "place": ("put the apple away", "apple", "shelf", "Destination"),
     "place in a drawer": ("put the apple away", "apple", "drawer", "Destination"),
     "place in the fridge": ("put the milk away", "milk", "fridge", "Destination"),
+    "place on the stove": ("put the pot", "pot", "stove", "Destination"),
     "dispose": ("throw out the banana", "banana", "trash can", "Destination"),
     "hand over": ("hand me the knife", "knife", "person", "Destination"),
     # ... and of the learned verbs whose class works with a tool (the Instrument) on the Theme
     "stir": ("stir the soup", "soup", "spoon", "Instrument"),
+    "whisk": ("whisk the batter", "batter", "whisk", "Instrument"),
     "wipe": ("wipe the cutting board", "cutting board", "sponge", "Instrument"),
     "cut": ("cut the bread", "bread", "knife", "Instrument"),
     "cover": ("cover the pot", "pot", "lid", "Instrument"),
@@ -69,9 +71,18 @@ TASKS = {
     "serve": ("scoop the soup", "soup", "bowl", "Destination"),
 }
 ALSO = {"serve": ("ladle",)}  # on the table too: what the motion needs that the instruction leaves unsaid
-TOOLS = {"stir", "wipe", "cut", "cover"}  # the tool is held: the object filled in, not the one stated
+TOOLS = {"stir", "whisk", "wipe", "cut", "cover"}  # the tool is held: the object filled in, not the one stated
 # distractors: the household's receptacles and tools too
-LEARNED = {"place", "place in a drawer", "place in the fridge", "dispose", "hand over", "serve", *TOOLS}
+LEARNED = {
+    "place",
+    "place in a drawer",
+    "place in the fridge",
+    "place on the stove",
+    "dispose",
+    "hand over",
+    "serve",
+    *TOOLS,
+}
 SLOW = 30  # seconds: no instruction should take longer to plan (or refuse) and execute
 HELD_IS_STATED = {"pour", "sprinkle", "heat", "fry", "blend", "dump", "dip", "brush", "rub", *LEARNED} - TOOLS
 

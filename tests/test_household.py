@@ -5,6 +5,7 @@ a shelf, dispose into a bin, hand over to a person) planned, executed and checke
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pybullet as p
@@ -53,6 +54,12 @@ OPENING |= {"headroom": 0.165}
         ({"parts": [], "mass": 1, "surface": "top", "motion": "place"}, "needs an 'open_box' or"),
         ({"parts": SUNK, "mass": 1, "surface": "top", "motion": "place"}, "below the table top"),
         ({"parts": ON_TABLE, "surface": "top", "motion": "place"}, "'mass'"),
+        # a knob on the front face only: the outline, measured from the origin both ways, would be wrong
+        (
+            {"parts": [*ON_TABLE, {"half": [0.01, 0.01, 0.01], "at": [-0.11, 0, 0.05]}], "mass": 0}
+            | {"surface": "top", "motion": "place"},
+            "footprint must be centred on the origin, but runs -0.12 to 0.1 along x",
+        ),
         ("a bin", "is not a JSON object"),
         ({**URDF, "opening": {**OPENING, "joint": 3}}, "opening: needs the 'link' and the 'joint'"),
         ({**URDF, "opening": {**OPENING, "opens": -1.6}}, "'opens' must be a number"),
@@ -177,6 +184,16 @@ def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> di
             Frame.of("clean", {"Theme": "cutting board", "Instrument": "sponge"}),
             "wiped_share",
         ),
+        (
+            [("pot", [-0.1, 0.25]), ("stove", [0.1, -0.2]), ("cup", [0.2, 0.25])],
+            Frame.of("put", {"Theme": "pot", "Destination": "stove"}),
+            "in_target",
+        ),
+        (
+            [("whisk", [-0.1, 0.25]), ("batter", [0.1, -0.2]), ("cup", [0.2, 0.25])],
+            Frame.of("whisk", {"Theme": "batter", "Instrument": "whisk"}),
+            "stirred",
+        ),
     ],
 )
 def test_each_motion_is_carried_out_and_checked_in_the_world(sim, tmp_path, layout, frame, check):
@@ -188,6 +205,45 @@ def test_each_motion_is_carried_out_and_checked_in_the_world(sim, tmp_path, layo
     pos = p.getBasePositionAndOrientation(out["held"].body)[0]
     assert lo[0] <= pos[0] <= hi[0] and lo[1] <= pos[1] <= hi[1]  # it is (or it stirred, wiped) there
     assert out["target_moved_m"] < 0.01
+
+
+def test_a_pot_is_lowered_onto_the_stoves_top_and_rests_on_it(sim, tmp_path):
+    out = _run(
+        tmp_path,
+        [("pot", [-0.1, 0.25]), ("stove", [0.1, -0.2])],
+        Frame.of("put", {"Theme": "pot", "Destination": "stove"}),
+    )
+    assert "lower onto stove" in [w["name"] for w in out["waypoints"]], out["waypoints"]
+    top = p.getAABB(out["target"].body)[1][2]
+    assert abs(p.getAABB(out["held"].body)[0][2] - top) < 0.005  # on the burner's grate, not dropped beside it
+
+
+def test_a_whisk_stirs_head_down_held_by_its_handle(sim, tmp_path):
+    """A tool stands on its working end, the end away from its grip: the whisk's head goes into the batter
+    and the handle stays up in the hand (a spoon, held by its middle, may stand on either end)."""
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+
+    scene = make_scene([("whisk", [-0.1, 0.25]), ("batter", [0.1, -0.2])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    held, target = scene.find("whisk"), scene.find("batter")
+    task = tasks.task_for(Frame.of("whisk", {"Theme": "batter", "Instrument": "whisk"}), "stir")
+    plan = planner.plan_as_it_stands(task, held, target, holding=False)
+    assert isinstance(plan, Plan), plan
+    grip, parts = tasks.TOOLS["whisk"].grip, tasks.TOOLS["whisk"].parts
+    half, centre = max(parts, key=lambda part: abs(part[1][0] - grip[0]))  # the head: furthest from the grip
+    head = (centre[0] + math.copysign(half[0], centre[0] - grip[0]), centre[1], centre[2])  # ... its far end
+    heights = {}
+
+    def seen(log=plan.arm.log):
+        pos, orn = p.getBasePositionAndOrientation(held.body)
+        heights[log[-1]["name"]] = [p.multiplyTransforms(pos, orn, x, (0, 0, 0, 1))[0][2] for x in (head, grip)]
+
+    plan.arm.on_waypoint = seen
+    out = run_plan(plan, held, target, [], planner)
+    assert out["checks"]["stirred"], out["checks"]
+    head_z, grip_z = heights["into batter"]
+    assert head_z < p.getAABB(target.body)[1][2] < grip_z - 0.1
 
 
 def test_a_tool_that_stays_above_the_rim_has_not_stirred(sim, tmp_path, monkeypatch):
@@ -519,3 +575,10 @@ def test_what_stands_behind_an_open_lid_is_set_down_nearer_first(sim, tmp_path):
     assert isinstance(plan, Plan) and plan.first is not None and plan.opens is not None
     out = run_plan(plan, milk, fridge, [], planner)
     assert out["success"] and out["checks"]["shut"], out["checks"]
+
+
+def test_the_sample_scenes_are_valid_and_use_the_household(sample_dir):
+    from lmcr.robot.scene import load_scene
+
+    labels = {o.label for path in sorted((sample_dir / "scenes").glob("*.json")) for o in load_scene(path).objects}
+    assert {"fridge", "stove", "whisk"} <= labels

@@ -1,11 +1,12 @@
 """The household's receptacles, the person and the tools, described in data (`household.json`), not code:
-bins, boxes, a shelf, a hand held out over the table; a knife, a lid, foil. Each receptacle is its shape (an
-open box, or boxes put together), its mass (0: fixed in place), the surface things are put on (inside it
-below the rim, or on its top) and the motion that puts a Theme there (place, dispose, hand over). The scene
-takes them as objects like the kitchen's containers; the world builds them from their parts; a learned
-verb's frame with a Theme and a Destination is carried out with the Destination's motion
-(`tasks.task_for`). A tool is its shape, its mass, where the hand holds it (`grip`) and, for a knife, its
-blade's edge, for a ladle, its bowl.
+bins, boxes, a shelf, a stove, a drawer, a fridge, a hand held out over the table; a knife, a lid, a ladle,
+a whisk, foil. Each receptacle is its shape (an open box, or boxes put together, or a URDF body with
+joints), its mass (0: fixed in place), the surface things are put on (inside it below the rim, or on its
+top) and the motion that puts a Theme there (place, dispose, hand over). The scene takes them as objects
+like the kitchen's containers; the world builds them from their parts; a learned verb's frame with a
+Theme and a Destination is carried out with the Destination's motion (`tasks.task_for`). A tool is its
+shape, its mass, where the hand holds it (`grip`) and, for a knife, its blade's edge, for a ladle, its
+bowl.
 
 A light module (json only): the scene's validation reads the vocabulary without loading the simulator."""
 
@@ -22,6 +23,7 @@ from lmcr.errors import LMCRError
 HOUSEHOLD_FILE = Path(__file__).with_name("household.json")
 MOTIONS = ("place", "dispose", "hand over")  # the motions that put a Theme at a Destination
 SURFACES = ("inside", "top")
+CENTRED = 0.001  # metres: how far off the origin the middle of a body's parts may lie
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # half extents, centre
 
@@ -174,6 +176,13 @@ def _parts(entry: dict, where: str) -> tuple[Box, ...]:
     )
     if min(c[2] - h[2] for h, c in boxes) < -1e-9:
         raise HouseholdError(f"{where}: a part reaches below the table top")
+    for k, axis in enumerate("xy"):
+        # the outline, and so a tool's ends and where things go, is measured from the origin both ways
+        lo, hi = min(c[k] - h[k] for h, c in boxes), max(c[k] + h[k] for h, c in boxes)
+        if abs(lo + hi) > CENTRED:
+            raise HouseholdError(
+                f"{where}: the parts' footprint must be centred on the origin, but runs {lo:g} to {hi:g} along {axis}"
+            )
     return boxes
 
 

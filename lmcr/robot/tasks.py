@@ -467,7 +467,8 @@ def _lower_into(g: Geometry, v: Variant) -> Step:
     bottom = max(t[2] - depth(g.target.label) + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
     # into a container it passes the walls clear (a bottle wider than a glass's opening would end on its rim)
-    return move(f"lower into {g.target.name}", lower, orn, touches="target", into=_walled(g.target.label))
+    walled = _walled(g.target.label)
+    return move(f"lower {'into' if walled else 'onto'} {g.target.name}", lower, orn, touches="target", into=walled)
 
 
 def program_hand_over(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -585,20 +586,41 @@ def program_wipe(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     ]
 
 
+def long_ends(g: Geometry) -> list[list[float]]:
+    """The two ends of the held object's long side, halfway up, in its body frame."""
+    half_x, half_y, _ = outline(g.held.label)
+    middle = g.held_top[2] - height(g.held.label) / 2 - g.held_pos[2]
+    return [[s * half_x, 0, middle] if half_x >= half_y else [0, s * half_y, middle] for s in (1, -1)]
+
+
 def lower_end(g: Geometry, v: Variant, orientation) -> np.ndarray:
     """The end of the held object's long side that points down with the gripper at `orientation` (a tool
     stood on its end), in the gripper's frame."""
-    half_x, half_y, _ = outline(g.held.label)
-    middle = g.held_top[2] - height(g.held.label) / 2 - g.held_pos[2]
-    ends = [[s * half_x, 0, middle] if half_x >= half_y else [0, s * half_y, middle] for s in (1, -1)]
-    in_hand = [g.point_in_hand(v, end) for end in ends]
+    in_hand = [g.point_in_hand(v, end) for end in long_ends(g)]
     # the lower the point, the higher the gripper that puts it at a given height
     return max(in_hand, key=lambda e: gripper_for(e, orientation, [0, 0, 0])[2])
 
 
+def working_end_down(g: Geometry, v: Variant) -> Variant:
+    """The variant whose quarter turn stands the held tool on its working end: the end of its long side
+    away from where the hand holds it (a whisk's head, not its handle). An object without a grip (a spoon)
+    stands on either end, as the variant turns it. The hand then points towards the handle's end, so a
+    variant that would have tilted the other way turns the hand half round instead: a tool has as many
+    headings over the target to try as a spoon."""
+    tool = TOOLS.get(g.held.label)
+    if tool is None:
+        return v
+    v = v if v.tilt_sign > 0 else replace(v, turn=v.turn + math.pi)
+    working = g.point_in_hand(v, max(long_ends(g), key=lambda end: math.dist(end[:2], tool.grip[:2])))
+    # the lower the point, the higher the gripper that puts it at a given height
+    sign = max((1, -1), key=lambda s: gripper_for(working, tilted(replace(v, tilt_sign=s), math.pi / 2), [0, 0, 0])[2])
+    return replace(v, tilt_sign=sign)
+
+
 def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
-    """Stand the tool on its end over the container, lower its tip STIR_DEPTH below the rim (between the
-    walls), circle it STIR_TURNS times round the middle, and lift it out."""
+    """Stand the tool on its (working) end over the container, lower its tip STIR_DEPTH below the rim
+    (between the walls), circle it STIR_TURNS times round the middle, and lift it out."""
+    v = working_end_down(g, v)
     orn, t = tilted(v, math.pi / 2), g.target_top
     tip = lower_end(g, v, orn)
     lo, hi = g.target_box
