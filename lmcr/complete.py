@@ -170,9 +170,12 @@ def complete(
     objects: list[str],
     config: CompletionConfig = CompletionConfig(),
     ids: list[str] | None = None,
+    held: tuple[str, ...] = (),
 ) -> Completion:
     """The completion of one instruction (`Completion.to_json` is the CLI contract's output line without the
     id); the scorer also reads the rest of the instruction (`context`: "for my tea") when the config says so.
+    `held`: the labels of what the robot holds, which a stated word grounds in ("stir the batter with the
+    whisk" in the hand) but which never fill a missing role.
 
     Objects are scored by label: several objects with one label (three cups) are one candidate, whose
     `ids` list them (`ids`: the objects' ids, in order; assigned as a scene assigns them when not given),
@@ -190,7 +193,8 @@ def complete(
     roles = {r: referred.get(r) or served.get(r) or (None if v in pronouns else v) for r, v in frame.roles.items()}
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
-    roles, unresolved = ground_roles(roles, parser.lex.objects, detected, instruction)
+    vocabulary = (*parser.lex.objects, *held) if parser.lex.objects else ()
+    roles, unresolved = ground_roles(roles, vocabulary, detected, instruction)
     # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
     # seen: the mug): its phrase is read as context, as the rest of the utterance is.
     context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""

@@ -397,6 +397,22 @@ def test_a_learned_verb_is_completed_and_executed_with_its_motion(sim, tmp_path,
     assert out["reply"] == "I threw the milk into the trash can."
 
 
+def test_a_tool_in_the_hand_is_the_one_the_request_names(sim, tmp_path, learned_parser):
+    """ "stir the batter with the whisk" with the whisk in the hand: the stated whisk is the held one (no
+    whisk on the table, and the word is no kitchen object the lexicon knows), so nothing is asked and the
+    robot stirs with it; the held whisk is still no candidate for a role left missing."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+    from lmcr.robot.scene import scene_from_json
+
+    layout = {"objects": [{"label": "batter", "xy": [0.05, 0.1]}, {"label": "cup", "xy": [-0.15, -0.2]}]}
+    scene = scene_from_json({**layout, "holding": "whisk"}, "scene")
+    anything = lambda frames, context="": [0.0] * len(frames)  # noqa: E731
+    out = execute("stir the batter with the whisk", scene, learned_parser, anything, CompletionConfig(), tmp_path)
+    assert out["frame"] == {"predicate": "stir", "roles": {"Theme": "batter", "Instrument": "whisk"}}, out
+    assert out["question"] is None and out["success"] and out["checks"]["stirred"], out
+
+
 def test_a_choice_the_robot_has_no_motion_for_is_refused_and_the_next_offered(sim, tmp_path, learned_parser):
     """ "warm the milk": the scorer prefers the microwave as warm's Instrument, which the robot cannot act
     on (no motion warms with an instrument); nothing moves and it offers a Destination it can put the milk in."""

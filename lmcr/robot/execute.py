@@ -29,7 +29,7 @@ from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
-from lmcr.robot.tasks import TASKS, Task, scoops, task_for
+from lmcr.robot.tasks import MOTIONS, SERVE, TASKS, TOOL_MOTIONS, Task, scoops, task_for
 from lmcr.robot.world import build_world
 from lmcr.srl.instruction import NoPredicateError
 
@@ -38,14 +38,19 @@ MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (
 ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (table frame): both arms reach there
 
 
+# the motions a learned verb may have: by its Destination's kind, and its class's with a tool or a ladle
+LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion})
+
+
 class NoMotionError(NoPredicateError):
-    """A predicate the robot understands (learned from the corpora) but has no motion for yet."""
+    """A predicate the robot understands (learned from the corpora) but has no motion for with the objects
+    it sees: none yet for the verb's class, or none that the candidates fit (no tool on the table)."""
 
     def __init__(self, predicate: str):
-        can = ", ".join(sorted(TASKS))
+        can, learned = ", ".join(sorted(TASKS)), ", ".join(LEARNED_MOTIONS[:-1]) + " or " + LEARNED_MOTIONS[-1]
         super().__init__(
-            f"the simulated Baxter has no motion for {predicate!r} yet (it can {can}; and place, dispose, "
-            "hand over, stir or wipe for a verb learned as one of those)"
+            f"the simulated Baxter has no motion for {predicate!r} with the objects it sees (it can {can}; and "
+            f"{learned} for a verb learned as one of those, its tool on the table)"
         )
         self.predicate = predicate
 
@@ -109,7 +114,8 @@ def execute(
     _connect()
     robot = build_world(scene, cache_dir, urdf)
     seen = detect(scene.bodies)
-    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, ids=[d.id for d in seen])
+    held = (scene.holding.label,) if scene.holding else ()
+    completion = complete(parser, scorer, instruction, [d.label for d in seen], config, [d.id for d in seen], held)
     options = _with_tasks(completion, _options(completion, answer), parser.lex)[:MAX_TRIED]
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget)

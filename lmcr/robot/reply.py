@@ -24,7 +24,8 @@ _SLOT = re.compile(r"(the )?\{(\w+)\}")
 _AUTO_ID = re.compile(r"(.+)#(\d+)")
 ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth")
 LEAVE_IT = "I'll leave it."
-MOTIONS_SAID = "and put things away, throw them out or hand them over"  # household.MOTIONS, as a person hears them
+# household.MOTIONS, tasks.TOOL_MOTIONS and serving, as a person hears them
+MOTIONS_SAID = "and put things away, throw them out, hand them over, stir, wipe, cut, cover or serve with a tool"
 
 
 def past_tense(verb: str, irregular: str | None = None) -> str:
@@ -158,7 +159,7 @@ def _error(outcome: Mapping, lexicon: Lexicon) -> str:
 
 def _cannot_do(predicate: str | None, lexicon: Lexicon) -> str:
     """'Sorry, I don't know how to do that. I can blend, brush, ... or sprinkle things, and put things
-    away, throw them out or hand them over.' (the paper's predicates' motions, and the learned verbs')"""
+    away, throw them out, hand them over, ...' (the paper's predicates' motions, and the learned verbs')"""
     verbs = lexicon.hand_written  # what the robot has motions for
     can = ", ".join(verbs[:-1]) + f" or {verbs[-1]}" if len(verbs) > 1 else "".join(verbs)
     return f"Sorry, I don't know how to {predicate or 'do that'}. I can {can} things, {MOTIONS_SAID}."
