@@ -5,7 +5,7 @@ from __future__ import annotations
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.mentions import extract_frames
-from lmcr.srl.repair import rejoin_split_compounds
+from lmcr.srl.repair import mend_modal_nouns, rejoin_split_compounds
 from tests.srl_docs import make_doc
 
 LEX = load_lexicon()
@@ -68,3 +68,30 @@ def test_a_gerund_read_as_a_verb_with_its_object():
     # a gerund and its object the corpus does not join are a verb and its object
     spec = "start/VB/ROOT/0 frying/VBG/xcomp/0/fry onions/NNS/dobj/1/onion"
     assert roles(spec, learned) == [{"Theme": "onion", "Instrument": None}]
+
+
+def modal_mended(spec: str) -> list[tuple[str, dict]]:
+    doc = mend_modal_nouns(make_doc(spec))
+    return [(f.predicate, f.roles) for f in extract_frames(doc, LEX, None) if f.known]
+
+
+def test_a_noun_read_as_a_modal_is_the_noun_of_its_phrase():
+    """ "can" after the words of a noun phrase and before no verb is the noun: as a preposition's object,
+    in the place of the adjective the parser made the object, and as the sentence's head, the verb read as
+    its subject."""
+    assert modal_mended("dump/VB/ROOT/0 it/PRP/dobj/0 into/IN/prep/0 that/DT/det/5 empty/JJ/amod/5 can/MD/pobj/2") == [
+        ("dump", {"Theme": "it", "Destination": "can"})
+    ]
+    assert modal_mended("dump/VB/ROOT/0 the/DT/det/2 empty/JJ/dobj/0 can/MD/punct/0") == [
+        ("dump", {"Theme": "can", "Destination": None})
+    ]
+    assert modal_mended("pour/NN/nsubj/4 into/IN/prep/0 the/DT/det/3 empty/JJ/pobj/1 can/MD/ROOT/4") == [
+        ("pour", {"Theme": None, "Destination": "can"})
+    ]
+
+
+def test_a_modal_that_governs_a_verb_stays_one():
+    spec = "you/PRP/nsubj/2 can/MD/aux/2 pour/VB/ROOT/2 the/DT/det/4 milk/NN/dobj/2"
+    assert modal_mended(spec) == [("pour", {"Theme": "milk", "Destination": None})]
+    spec = "the/DT/det/1 milk/NN/nsubj/3 can/MD/aux/3 boil/VB/ROOT/3"
+    assert [t.tag_ for t in mend_modal_nouns(make_doc(spec))] == ["DT", "NN", "MD", "VB"]

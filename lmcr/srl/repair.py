@@ -9,6 +9,12 @@ its compound. Terse narrations bring a fourth: "pour oil in frying pan" comes ou
 with the object "pan" (a fry frame of the pan, and no destination for the pour); when the two words are
 a strong bigram ("frying pan", "measuring cup", "cutting board") the noun takes the gerund's place and
 the gerund becomes its compound. Without learned compounds nothing is changed.
+
+A noun that is also a modal verb ("can") is read as the modal after the words of its noun phrase: "dispose of
+that empty can" leaves "empty" the object and "can" a modal with no verb to govern. A modal that follows
+a determiner, an adjective or a noun and is followed by no verb is a noun (English: a modal always
+governs a verb, and a determiner never precedes one): it takes the place of the phrase's head, whose
+words become its modifiers (`mend_modal_nouns`). That is grammar, the same for every word.
 """
 
 from __future__ import annotations
@@ -84,3 +90,39 @@ def rejoin_split_compounds(doc: Doc, compounds: Compounds | None) -> Doc:
         noun.head, noun.dep_ = plural, "compound"
         plural.tag_, plural.pos_ = "NNS", "NOUN"
     return doc
+
+
+NOMINAL_TAGS = frozenset({"DT", "JJ", "NN", "NNS", "NNP", "PRP$", "CD"})
+
+
+def mend_modal_nouns(doc: Doc) -> Doc:
+    """Make each modal that stands where a noun does (after a noun phrase's words, before no verb) the noun
+    it is: "recycle the soda can", "throw out the empty can", "dispose of that empty can" (module docstring)."""
+    for token in doc:
+        after = doc[token.i + 1] if token.i + 1 < len(doc) else None
+        if token.tag_ != "MD" or token.i == 0 or doc[token.i - 1].tag_ not in NOMINAL_TAGS:
+            continue
+        if after is not None and (after.tag_.startswith("VB") or after.tag_ in ("RB", "PRP", "TO", "MD")):
+            continue  # a modal governing a verb: "you can pour", "it can be", "can you"
+        _as_noun(token, doc[token.i - 1])
+    return doc
+
+
+def _as_noun(modal: Token, before: Token) -> None:
+    """The modal becomes the noun heading the phrase `before` ends: in its place when the parser made `before`
+    the phrase's head ("the empty/dobj can/punct"), with its determiner and modifiers."""
+    head = before if before.dep_ in PHRASE_DEPS else None
+    if modal.dep_ == "ROOT":  # "dispose/nsubj of the empty/pobj can/ROOT": the verb is the sentence's head
+        verb = next((c for c in modal.children if c.dep_ == "nsubj" and c.i < modal.i), None)
+        if verb is None or head is None:
+            return
+        verb.head, verb.dep_, verb.tag_, verb.pos_ = verb, "ROOT", "VB", "VERB"
+        for child in list(modal.children):
+            if child.i != verb.i:
+                child.head = verb
+    if head is not None:
+        modal.head, modal.dep_ = head.head, head.dep_
+        for child in list(head.children):
+            child.head = modal
+        head.head, head.dep_ = modal, "amod" if head.tag_ == "JJ" else "compound"
+    modal.tag_, modal.pos_ = "NN", "NOUN"
