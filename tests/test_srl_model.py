@@ -48,6 +48,24 @@ def test_parse_instruction_marks_the_missing_role(parser):
         parse_instruction(parser, "wash the dishes")
 
 
+def test_a_verb_the_corpora_say_too_little_about_is_named_by_the_srl_command_too(parser, monkeypatch):
+    """`lmcr srl "TEXT"` refuses a text with no predicate as the completion does: a verb seen too seldom to
+    learn is named with its evidence (it listed the eleven whatever the robot had learned)."""
+    from dataclasses import replace
+
+    from lmcr.srl.instruction import no_predicate
+
+    lex = replace(parser.lex, refused={"recycle": 5})
+    said = (
+        "no known predicate in 'recycle the bottle': the corpora say too little about 'recycle' to learn what it needs"
+    )
+    assert no_predicate(lex, "recycle the bottle", parser.parse("recycle the bottle")) == f"{said} (5 frames)"
+    monkeypatch.setattr(parser, "lex", lex)
+    monkeypatch.setattr(Workspace, "parser", lambda self, model=None, resources=None: parser)
+    result = CliRunner().invoke(app, ["srl", "recycle the bottle"])
+    assert result.exit_code == 1 and said in " ".join(result.output.split()), result.output
+
+
 def test_misread_imperatives_are_repaired(parser):
     frames = [f.to_json() for f in parser.parse("Heat oil in a pan, then season with salt and pepper.")]
     assert {"predicate": "heat", "roles": {"Theme": "oil", "Instrument": "pan"}} in frames

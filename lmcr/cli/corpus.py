@@ -213,7 +213,9 @@ def srl(
     for frame in found if all_predicates else [f for f in found if f.known]:
         Console().print(_frame_line(frame), highlight=False)
     if not any(f.known for f in found):
-        fail(f"no known predicate in {text!r}: the robot can {', '.join(parser.lex.hand_written)}")
+        from lmcr.srl.instruction import no_predicate
+
+        fail(no_predicate(parser.lex, text, found))
 
 
 def _frame_line(frame) -> str:

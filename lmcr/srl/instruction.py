@@ -52,16 +52,22 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
                 -_open_rate(parser.lex, f),
             ),
         )
-    refused = [f.predicate for f in frames if f.predicate in parser.lex.refused]
+    raise NoPredicateError(no_predicate(parser.lex, text, frames))
+
+
+def no_predicate(lex: Lexicon, text: str, frames: list[FrameMention]) -> str:
+    """Why a text with none of the robot's predicates has none, in one line: a verb the corpora say too
+    little about (named, with its evidence), else none of the learned verbs, else the hand-written ones."""
+    refused = [f.predicate for f in frames if f.predicate in lex.refused]
     if refused:
-        name, seen = refused[0], parser.lex.refused[refused[0]]
-        raise NoPredicateError(
+        name, seen = refused[0], lex.refused[refused[0]]
+        return (
             f"no known predicate in {text!r}: the corpora say too little about {name!r} to learn what it needs"
             f" ({seen:,} frames)"
         )
-    if parser.lex.learned:
-        raise NoPredicateError(
-            f"no known predicate in {text!r}: none of the {len(parser.lex.predicates):,} verbs the robot learned"
+    if lex.learned:
+        return (
+            f"no known predicate in {text!r}: none of the {len(lex.predicates):,} verbs the robot learned"
             " from its corpora (`lmcr predicates` lists them)"
         )
-    raise NoPredicateError(f"no known predicate in {text!r}: the robot can {', '.join(parser.lex.hand_written)}")
+    return f"no known predicate in {text!r}: the robot can {', '.join(lex.hand_written)}"
