@@ -113,11 +113,17 @@ class Receptacle:
     opening: Opening | None = None
 
 
+def _bounds(parts: tuple[Box, ...]) -> tuple[list[float], list[float]]:
+    """The lowest and highest coordinate the parts reach along x, y and z."""
+    return [min(c[k] - h[k] for h, c in parts) for k in range(3)], [
+        max(c[k] + h[k] for h, c in parts) for k in range(3)
+    ]
+
+
 def _around(parts: tuple[Box, ...]) -> tuple[float, float, float]:
     """Width (x), depth (y) and height of the box around the parts, from the table top up (the
-    footprint is centred on the origin by construction)."""
-    lo = [min(c[k] - h[k] for h, c in parts) for k in range(3)]
-    hi = [max(c[k] + h[k] for h, c in parts) for k in range(3)]
+    footprint is centred on the origin: `_parts` checks it)."""
+    lo, hi = _bounds(parts)
     return 2 * max(-lo[0], hi[0]), 2 * max(-lo[1], hi[1]), hi[2]
 
 
@@ -174,14 +180,15 @@ def _parts(entry: dict, where: str) -> tuple[Box, ...]:
         (_numbers(x.get("half"), 3, f"{where}: part {k} half", True), _numbers(x.get("at"), 3, f"{where}: part {k} at"))
         for k, x in enumerate(parts)
     )
-    if min(c[2] - h[2] for h, c in boxes) < -1e-9:
+    lo, hi = _bounds(boxes)
+    if lo[2] < -1e-9:
         raise HouseholdError(f"{where}: a part reaches below the table top")
     for k, axis in enumerate("xy"):
         # the outline, and so a tool's ends and where things go, is measured from the origin both ways
-        lo, hi = min(c[k] - h[k] for h, c in boxes), max(c[k] + h[k] for h, c in boxes)
-        if abs(lo + hi) > CENTRED:
+        if abs(lo[k] + hi[k]) > CENTRED:
             raise HouseholdError(
-                f"{where}: the parts' footprint must be centred on the origin, but runs {lo:g} to {hi:g} along {axis}"
+                f"{where}: the parts' footprint must be centred on the origin, but runs {lo[k]:g} to {hi[k]:g} "
+                f"along {axis}"
             )
     return boxes
 

@@ -339,6 +339,12 @@ def gripper_for(point_in_hand: np.ndarray, orientation, goal) -> np.ndarray:
     return np.asarray(goal) - offset
 
 
+def gripper_over(point_in_hand: np.ndarray, orientation) -> float:
+    """How high the gripper stands over a point of the hand (gripper frame) at `orientation`: the lower
+    the point hangs, the higher."""
+    return float(gripper_for(point_in_hand, orientation, [0, 0, 0])[2])
+
+
 def variants(
     held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False, wide: bool = False
 ) -> list[Variant]:
@@ -463,7 +469,7 @@ def _lower_into(g: Geometry, v: Variant) -> Step:
     """Lower the held object into the target (onto it, when things rest on its top): its bottom 1.5 cm
     above the target's floor, but the hand stays above a deep container's rim (it drops the rest)."""
     orn, t = v.at_target(), g.target_top
-    drop = -gripper_for(g.bottom(v), orn, [0, 0, 0])[2]  # how far the gripper is above the object's bottom
+    drop = -gripper_over(g.bottom(v), orn)  # how far the gripper is above the object's bottom
     bottom = max(t[2] - depth(g.target.label) + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
     # into a container it passes the walls clear (a bottle wider than a glass's opening would end on its rim)
@@ -597,8 +603,7 @@ def lower_end(g: Geometry, v: Variant, orientation) -> np.ndarray:
     """The end of the held object's long side that points down with the gripper at `orientation` (a tool
     stood on its end), in the gripper's frame."""
     in_hand = [g.point_in_hand(v, end) for end in long_ends(g)]
-    # the lower the point, the higher the gripper that puts it at a given height
-    return max(in_hand, key=lambda e: gripper_for(e, orientation, [0, 0, 0])[2])
+    return max(in_hand, key=lambda e: gripper_over(e, orientation))
 
 
 def working_end_down(g: Geometry, v: Variant) -> Variant:
@@ -612,8 +617,7 @@ def working_end_down(g: Geometry, v: Variant) -> Variant:
         return v
     v = v if v.tilt_sign > 0 else replace(v, turn=v.turn + math.pi)
     working = g.point_in_hand(v, max(long_ends(g), key=lambda end: math.dist(end[:2], tool.grip[:2])))
-    # the lower the point, the higher the gripper that puts it at a given height
-    sign = max((1, -1), key=lambda s: gripper_for(working, tilted(replace(v, tilt_sign=s), math.pi / 2), [0, 0, 0])[2])
+    sign = max((1, -1), key=lambda s: gripper_over(working, tilted(replace(v, tilt_sign=s), math.pi / 2)))
     return replace(v, tilt_sign=sign)
 
 
@@ -732,7 +736,7 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     bottom = max(hi[2] - SCOOP_DEPTH, hi[2] - depth(g.source.label) + SCOOP_FLOOR)
     dip, lifted = gripper_for(bowl, orn, [x, y, bottom]), gripper_for(bowl, orn, [x, y, hi[2] + 0.03])
     # the way of turning the hand that tips the bowl down (the other would run the content down the handle)
-    sign = min((1, -1), key=lambda s: -gripper_for(bowl, tilted(replace(v, tilt_sign=s), TIPS[-1]), [0, 0, 0])[2])
+    sign = max((1, -1), key=lambda s: gripper_over(bowl, tilted(replace(v, tilt_sign=s), TIPS[-1])))
     tips = [tilted(replace(v, tilt_sign=sign), angle) for angle in TIPS]
     spouts = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
     pours = tuple(gripper_for(lip, orn, spout) for spout in spouts)  # level, the spout over the target

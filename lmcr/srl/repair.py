@@ -99,9 +99,9 @@ def mend_modal_nouns(doc: Doc) -> Doc:
     """Make each modal that stands where a noun does (after a noun phrase's words, before no verb) the noun
     it is: "recycle the soda can", "throw out the empty can", "dispose of that empty can" (module docstring)."""
     for token in doc:
-        after = doc[token.i + 1] if token.i + 1 < len(doc) else None
         if token.tag_ != "MD" or token.i == 0 or doc[token.i - 1].tag_ not in NOMINAL_TAGS:
             continue
+        after = doc[token.i + 1] if token.i + 1 < len(doc) else None
         if after is not None and (after.tag_.startswith("VB") or after.tag_ in ("RB", "PRP", "TO", "MD")):
             continue  # a modal governing a verb: "you can pour", "it can be", "can you"
         _as_noun(token, doc[token.i - 1])
