@@ -56,3 +56,67 @@ def test_a_benchmark_that_fails_while_polling_ends_its_batch(bench, tmp_path):
         bench.timed_batch([sys.executable, "-c", batch], out)
     with pytest.raises(ProcessLookupError):  # ended and reaped with the benchmark, not left running
         os.kill(int(pid_file.read_text()), 0)
+
+
+@pytest.fixture
+def external_robot(monkeypatch):
+    monkeypatch.syspath_prepend(str(REPO_ROOT / "bench"))
+    import bench_external_robot
+
+    return bench_external_robot
+
+
+TIDY = {
+    "id": "t-1",
+    "instruction": "put the sweater away",
+    "objects": ["sweater", "basket", "drawer", "closet"],
+    "missing": "Destination",
+    "expected": {"predicate": "put", "roles": {"Theme": "sweater", "Destination": "basket"}},
+    "expected_any": ["basket", "closet"],
+    "verb": "put away",
+}
+
+
+def test_an_external_item_gets_a_scene_of_its_objects_built_like_known_ones(external_robot):
+    """Objects with a body keep it; the Theme without one is built like the stand-in of a moved thing, the
+    missing role's candidates like a place to put it; a tool's class decides an Instrument's stand-in."""
+    scene = external_robot.scene_for(TIDY, "place", seed=3)
+    assert scene["objects"] == [
+        {"label": "sweater", "like": "sponge"},
+        {"label": "basket"},
+        {"label": "drawer"},
+        {"label": "closet", "like": "basket"},
+    ]
+    wipe = {**TIDY, "objects": ["mirror", "cloth", "sponge"], "missing": "Instrument", "verb": "clean"}
+    wipe["expected"] = {"predicate": "clean", "roles": {"Theme": "mirror", "Instrument": "cloth"}}
+    assert external_robot.scene_for(wipe, "wipe", seed=3)["objects"][:2] == [
+        {"label": "mirror", "like": "cutting board"},
+        {"label": "cloth", "like": "sponge"},
+    ]
+
+
+def test_a_crowded_item_holds_its_theme_and_one_that_will_not_fit_is_an_error(external_robot):
+    """A plate that leaves no room beside a fridge, a drawer, a shelf and a stove is in the hand."""
+    from lmcr.jsonl import InputError
+
+    plate = {"predicate": "put", "roles": {"Theme": "plate", "Destination": "shelf"}}
+    crowded = {**TIDY, "objects": ["plate", "fridge", "drawer", "shelf", "stove"], "expected": plate}
+    scene = external_robot.scene_for(crowded, "place", seed=1)
+    assert scene["holding"] == {"label": "plate"} and "plate" not in [o["label"] for o in scene["objects"]]
+    more = {**crowded, "objects": [*crowded["objects"], "oven", "sink", "trash can"]}
+    with pytest.raises(InputError, match="cannot all fit|no free spot"):
+        external_robot.scene_for(more, "place", 1)
+
+
+@pytest.mark.parametrize(
+    "frame, right",
+    [
+        ({"predicate": "put away", "roles": {"Theme": "sweater", "Destination": "closet"}}, True),
+        ({"predicate": "put away", "roles": {"Theme": "sweater", "Destination": "drawer"}}, False),
+        ({"predicate": "put", "roles": {"Theme": "sweater", "Destination": "basket"}}, False),  # the particle
+        ({"predicate": "put away", "roles": {"Theme": "basket", "Destination": "closet"}}, False),
+    ],
+)
+def test_an_external_item_is_completed_right_by_its_verb_its_theme_and_any_right_object(external_robot, frame, right):
+    assert external_robot.completed_right(TIDY, {"frame": frame}) == right
+    assert not external_robot.completed_right(TIDY, {"error": "no known predicate"})

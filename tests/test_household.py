@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pybullet as p
@@ -135,6 +136,23 @@ def test_the_paper_predicates_keep_their_programs_and_other_classes_have_none():
     # cutting the bread into the bowl is no placing it there (a cut needs a blade: the Instrument)
     assert tasks.task_for(Frame.of("cut", {"Theme": "bread", "Destination": "bowl"}), "cut") is None
     assert tasks.task_for(Frame.of("put", {"Theme": "bread", "Destination": "bowl"})) is None  # class unknown
+
+
+@pytest.mark.parametrize(
+    "tool, label, stirs",
+    [
+        ("spoon", "soup", True),
+        ("whisk", "batter", True),
+        ("microwave", "butter", False),  # "melt the butter" learned as a stir: no vessel stirs, nor in food
+        ("spoon", "butter", False),  # a solid is no container to stir in
+        ("bowl", "soup", False),
+        ("spoon", "trash can", False),  # nor a bin
+        ("spoon", "cup", True),
+    ],
+)
+def test_a_stir_needs_a_tool_that_is_no_vessel_in_a_kitchen_container(tool, label, stirs):
+    frame = Frame.of("melt", {"Theme": label, "Instrument": tool})
+    assert tasks.stirs(tool, label) == stirs and (tasks.task_for(frame, "stir") is not None) == stirs
 
 
 def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> dict:
@@ -598,3 +616,61 @@ def test_the_sample_scenes_are_valid_and_use_the_household(sample_dir):
 
     labels = {o.label for path in sorted((sample_dir / "scenes").glob("*.json")) for o in load_scene(path).objects}
     assert {"fridge", "stove", "whisk"} <= labels
+
+
+def test_an_object_the_robot_has_no_model_of_is_built_like_a_known_one(sim, tmp_path):
+    """A sweater and a closet (no bodies of their own) built like a sponge and a storage box: the scene keeps
+    their labels and ids, and the world, the outlines and the placement use the known objects' shapes."""
+    data = {
+        "objects": [
+            {"label": "closet", "like": "storage box", "xy": [0.1, -0.2]},
+            {"label": "sweater", "like": "sponge"},
+        ]
+    }
+    scene = scene_from_json(data, "scene")
+    closet, sweater = scene.find("closet"), scene.find("sweater")
+    assert (closet.id, closet.shape, closet.kind) == ("closet", "storage box", "container")
+    assert (sweater.shape, sweater.kind) == ("sponge", "food") and scene.shapes()["sweater"] == "sponge"
+    build_world(scene, tmp_path)
+    lo, hi = p.getAABB(closet.body)
+    assert hi[0] - lo[0] == pytest.approx(household()["storage box"].size[0], abs=0.01)
+    held = scene_from_json({"objects": [], "holding": {"label": "book", "like": "sponge"}}, "scene").holding
+    assert (held.label, held.shape) == ("book", "sponge")
+
+
+@pytest.mark.parametrize(
+    "objects, holding, reason",
+    [
+        ([{"label": "closet"}], None, "unknown label 'closet' (give 'like'"),
+        ([{"label": "closet", "like": "wardrobe"}], None, "'like' must be a known object label"),
+        ([{"label": "closet", "like": "basket"}, {"label": "closet", "like": "shelf"}], None, "an earlier closet"),
+        ([{"label": " closet", "like": "basket"}], None, "unknown label"),
+        ([], {"label": "book", "like": "shelf"}, "'like' must be a known object the hand can hold"),
+        ([], {"label": "book"}, "'holding' must be a known object label"),
+    ],
+)
+def test_a_bad_like_is_a_one_line_error(objects, holding, reason):
+    with pytest.raises(InputError, match=re.escape(reason)):
+        scene_from_json({"objects": objects, **({"holding": holding} if holding else {})}, "scene.json")
+
+
+def test_a_request_about_objects_built_like_known_ones_is_carried_out(sim, tmp_path, learned_parser):
+    """ "put the sweater away" with a closet and a coffee table built like a storage box and a shelf: the
+    completion weighs the words (the scorer prefers the coffee table), the robot places the sweater on what
+    the coffee table is built as, checks it there, and says it with the coffee table's words ("on": a shelf's
+    top)."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import execute
+
+    objects = [
+        {"label": "sweater", "like": "sponge", "xy": [-0.2, 0.3]},
+        {"label": "closet", "like": "storage box", "xy": [0.1, -0.25]},
+        {"label": "coffee table", "like": "shelf", "xy": [0.12, 0.0]},
+    ]
+    scene = scene_from_json({"objects": objects}, "scene")
+    prefers = lambda frames, context="": [1.0 if "coffee table" in f.role_map.values() else 0.0 for f in frames]  # noqa: E731
+    out = execute("put the sweater away", scene, learned_parser, prefers, CompletionConfig(), tmp_path)
+    assert out["frame"] == {"predicate": "put away", "roles": {"Theme": "sweater", "Destination": "coffee table"}}
+    assert out["motion"] == "place" and out["success"] and out["checks"]["in_target"], out
+    assert out["built_like"] == {"sweater": "sponge", "closet": "storage box", "coffee table": "shelf"}
+    assert out["reply"] == "I put the sweater on the coffee table."

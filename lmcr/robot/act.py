@@ -239,12 +239,12 @@ def fill(ladle: SceneObject, source: SceneObject) -> list[int]:
     """SCOOP_GRAINS of the source's content in the ladle's bowl when the bowl is in the source, below its
     rim and above its floor (the simulation has no liquid to scoop: what the source holds is made where the
     ladle takes it); none when it is not there."""
-    scoop = TOOLS[ladle.label].scoop
+    scoop = TOOLS[ladle.shape].scoop
     pos, orn = p.getBasePositionAndOrientation(ladle.body)
     bowl = p.multiplyTransforms(pos, orn, scoop, [0, 0, 0, 1])[0]
     lo, hi = p.getAABB(source.body, source.link)
     within = lo[0] <= bowl[0] <= hi[0] and lo[1] <= bowl[1] <= hi[1]
-    if not within or not hi[2] - depth(source.label) < bowl[2] < hi[2]:
+    if not within or not hi[2] - depth(source.shape) < bowl[2] < hi[2]:
         return []
     # spread over the bowl's floor, a grain above it
     return _grains(ladle, np.add(scoop, [0, 0, 2 * GRAIN_RADIUS]), (0.008, 0.008, 0.001), SCOOP_GRAINS)

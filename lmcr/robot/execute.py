@@ -55,14 +55,25 @@ class NoMotionError(NoPredicateError):
         self.predicate = predicate
 
 
-def _with_tasks(completion: Completion, options: list[tuple[Frame, Candidate | None]], lex: Lexicon) -> list:
+def _with_tasks(
+    completion: Completion, options: list[tuple[Frame, Candidate | None]], lex: Lexicon, shapes: dict[str, str]
+) -> list:
     """The options with the task that carries each out (None when the robot has no motion for it: a
     learned verb whose class has none, "cut the bread into the bowl"; that one is refused as the robot
-    cannot do it, and the others are offered); NoMotionError when none has one."""
-    found = [(frame, candidate, task_for(frame, _verb_motion(frame, lex))) for frame, candidate in options]
+    cannot do it, and the others are offered); NoMotionError when none has one. The task is that of what
+    the frame's objects are built as (`shapes`, label -> shape: a closet built like a storage box is placed
+    into)."""
+    found = [
+        (frame, candidate, task_for(_as_built(frame, shapes), _verb_motion(frame, lex))) for frame, candidate in options
+    ]
     if all(task is None for _, _, task in found):
         raise NoMotionError(completion.frame.predicate)
     return found
+
+
+def _as_built(frame: Frame, shapes: dict[str, str]) -> Frame:
+    """The frame with each role's label replaced by what that object is built as (`Scene.shapes`)."""
+    return Frame.of(frame.predicate, {role: shapes.get(value, value) for role, value in frame.role_map.items()})
 
 
 def _verb_motion(frame: Frame, lex: Lexicon) -> str | None:
@@ -116,7 +127,7 @@ def execute(
     seen = detect(scene.bodies)
     held = (scene.holding.label,) if scene.holding else ()
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config, [d.id for d in seen], held)
-    options = _with_tasks(completion, _options(completion, answer), parser.lex)[:MAX_TRIED]
+    options = _with_tasks(completion, _options(completion, answer), parser.lex, scene.shapes())[:MAX_TRIED]
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget)
     tried = _search(planner, scene, options, {d.id for d in seen})
@@ -139,6 +150,7 @@ def execute(
         "missing": completion.missing,
         "question": completion.question,
         "holding": scene.holding.label if scene.holding else None,
+        "built_like": {o.label: o.like for o in scene.present if o.like},  # objects built as a known one
         "ranking": _ranking(completion, tried),
         "detections": [{"label": d.label, "id": d.id, "position": [round(v, 3) for v in d.position]} for d in seen],
         "budget_exhausted": isinstance(result, Infeasible) and bool(planner.stopped),
@@ -229,7 +241,7 @@ def _instances(scene: Scene, frame: Frame, task: Task, role: str, seen: set[str]
     hand, first); for a serving task's unsaid Instrument, the ladles on the table."""
     label = frame.role_map.get(role)
     if label is None and task.source_role:
-        found = [o for o in scene.present if scoops(o.label)]
+        found = [o for o in scene.present if scoops(o.shape)]
         if not found:
             raise ExecutionError(f"cannot {frame.predicate} here: nothing to scoop with on the table")
         return found
@@ -250,12 +262,12 @@ def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, Sce
     held, target = objects[task.held_role], objects[task.target_role]
     holding = scene.holding is not None and held is scene.holding
     if scene.holding is not None and not holding:  # the hand is needed: put down what it holds first
-        return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.label))
+        return planner.plan_via(task, held, target, scene.holding, True, free_spots(scene, scene.holding.shape))
     direct = planner.plan_as_it_stands(task, held, target, holding)
     if isinstance(direct, Plan) or planner.stopped:
         return direct
     for moved in _set_aside(planner, direct, held, holding):
-        rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.label))
+        rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.shape))
         if isinstance(rearranged, Plan):
             return replace(rearranged, instead_of=direct)
         if planner.stopped:
@@ -274,7 +286,7 @@ def _set_aside(planner: Planner, refused: Infeasible, held: SceneObject, holding
     blocking = None if holding else planner.on_table(refused.blocker)
     if blocking is None:
         return []
-    fixed = getattr(household().get(blocking.label), "mass", None) == 0
+    fixed = getattr(household().get(blocking.shape), "mass", None) == 0
     return [*([] if fixed else [blocking]), *([] if blocking is held else [held])]
 
 

@@ -20,7 +20,7 @@ def cut_through(knife: SceneObject, food: SceneObject) -> tuple[list[int], tuple
     """The food's pieces and the cut's plane (a point on it and its normal) when the knife's edge has gone
     through it, the food's body then swapped for them (`food.body` is the first piece); ([], ()) when it
     has not (the edge stayed above the underside, or beside the food)."""
-    tool = TOOLS[knife.label]
+    tool = TOOLS[knife.shape]
     pos, orn = p.getBasePositionAndOrientation(knife.body)
     edge = np.asarray(p.multiplyTransforms(pos, orn, tool.blade, [0, 0, 0, 1])[0])
     turn = np.asarray(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
@@ -41,7 +41,7 @@ def cut_apart(food: SceneObject, point: np.ndarray, normal: np.ndarray, gap: flo
     pos, orn = p.getBasePositionAndOrientation(food.body)
     colour = p.getVisualShapeData(food.body)[0][7]
     mass = p.getDynamicsInfo(food.body, -1)[0]
-    filled = _filling(food.label, np.asarray(pos), orn)
+    filled = _filling(food.shape, np.asarray(pos), orn)
     side = (filled - point) @ (normal / np.linalg.norm(normal))
     pieces = []
     for part in (filled[side >= gap / 2], filled[side <= -gap / 2]):

@@ -70,12 +70,12 @@ class Plan:
     @property
     def fingers(self) -> list[float]:
         """The finger joint targets the hand approaches the grasp with (and goes back to on letting go)."""
-        return approach_fingers(self.arm, self.variant, self.geometry.held.label)
+        return approach_fingers(self.arm, self.variant, self.geometry.held.shape)
 
     @property
     def half_width(self) -> float:
         """Half the held object's width between the fingers as they hold it."""
-        return self.variant.half_across(self.geometry.held.label)
+        return self.variant.half_across(self.geometry.held.shape)
 
     @property
     def moving_arms(self) -> list[Arm]:
@@ -152,7 +152,7 @@ class Planner:
                     # the last attempt's checks left the held object in its hand: it stands where it started
                     _restore(held, standing)
                     # the fingers as they will be on the way: collision checks see them so
-                    arm.shape_fingers(approach_fingers(arm, variant, held.label), now=True)
+                    arm.shape_fingers(approach_fingers(arm, variant, held.shape), now=True)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
                     steps = [
                         *([Step("home", "to its start")] if start != "home" else []),
@@ -235,8 +235,8 @@ class Planner:
         held object lying in it for the shutting), the arm from its `start` ("home" or "parked"). Refused
         at once when the held object is too tall to shut the drawer or the lid over it. A spent budget ends
         the search."""
-        found = household()[target.label].opening
-        if height(held.label) > found.headroom:
+        found = household()[target.shape].opening
+        if height(held.shape) > found.headroom:
             return Infeasible(f"{_named(held)} is too tall to shut {_named(target)} over it", 0, False, _named(target))
         best = Infeasible("nothing was tried", -1)
         for side in _nearer_first(target, SIDES):
@@ -257,19 +257,19 @@ class Planner:
         if isinstance(opening, Infeasible):
             return opening
         saved = _save(held)
-        p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(True))
+        p.resetJointState(target.body, target.joint, household()[target.shape].opening.joint_at(True))
         try:
             rest = self.plan(task, held, target, holding, arms=(side,), start="home")
             if isinstance(rest, Infeasible):
                 return replace(rest, progress=rest.progress + len(opening.segments))
             bottom = opening_point(target, "middle") + [0, 0, 0.002]  # as it will lie in it, upright
             p.resetBasePositionAndOrientation(
-                held.body, [*bottom[:2], bottom[2] + height(held.label) / 2], (0, 0, 0, 1)
+                held.body, [*bottom[:2], bottom[2] + height(held.shape) / 2], (0, 0, 0, 1)
             )
             end = next(s.path[-1] for s in reversed(rest.segments) if s.path is not None)
             shutting = self._open_or_shut(arm, other, target, False, end, moving=held)
         finally:
-            p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(False))
+            p.resetJointState(target.body, target.joint, household()[target.shape].opening.joint_at(False))
             _restore(held, saved)
             arm.set_config(arm.home)
         if isinstance(shutting, Infeasible):
@@ -304,7 +304,7 @@ class Planner:
         found = self._plan_variant(arm, clearance, steps[:moved], target, target, None, start)
         if isinstance(found, Infeasible):
             return found
-        p.resetJointState(target.body, target.joint, household()[target.label].opening.joint_at(opening))
+        p.resetJointState(target.body, target.joint, household()[target.shape].opening.joint_at(opening))
         try:
             rest = self._plan_variant(arm, clearance, steps[moved:], target, target, None, found[-1].path[-1])
         finally:
@@ -493,14 +493,14 @@ def _simulated_grasp(
     try:
         for a, q, fingers in (
             (other, other.parked, other.finger_open),
-            (arm, start, approach_fingers(arm, variant, held.label)),
+            (arm, start, approach_fingers(arm, variant, held.shape)),
         ):
             a.set_config(q)
             a.hold(q)
             a.shape_fingers(fingers, now=True)
         for segment in segments:
             if segment.step.kind == "grasp":
-                if not arm.close_on(held.body, variant.half_across(held.label)):
+                if not arm.close_on(held.body, variant.half_across(held.shape)):
                     return None
                 return relative_pose(*arm.ee_pose(), *p.getBasePositionAndOrientation(held.body))
             if segment.step.moves:

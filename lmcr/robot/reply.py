@@ -50,10 +50,13 @@ def past_tense(verb: str, irregular: str | None = None) -> str:
 TOOL_MOTIONS_SAID = {"stir": "stirred", "wipe": "wiped", "cut": "cut", "cover": "covered"}
 
 
-def motion_done(motion: str | None, roles: Mapping[str, str]) -> str | None:
+def motion_done(
+    motion: str | None, roles: Mapping[str, str], built_like: Mapping[str, str] | None = None
+) -> str | None:
     """What the robot did, in the past tense of its own motion ("threw the peel into the compost bin",
     "handed the knife to the person", "put the apple on the shelf", "stirred the batter with the spoon");
-    None for the paper's predicates, whose own verbs say it."""
+    None for the paper's predicates, whose own verbs say it. `built_like`: the known object each label the
+    robot has no model of is built as (a coffee table like a shelf: "on" it)."""
     if motion in TOOL_MOTIONS_SAID and {"Theme", "Instrument"} <= set(roles):
         return f"{TOOL_MOTIONS_SAID[motion]} the {roles['Theme']} with the {roles['Instrument']}"
     if motion not in (*MOTIONS, "serve") or not {"Theme", "Destination"} <= set(roles):
@@ -67,7 +70,7 @@ def motion_done(motion: str | None, roles: Mapping[str, str]) -> str | None:
         return f"handed the {theme} to the {place}"
     if motion == "dispose":
         return f"threw the {theme} into the {place}"
-    found = household().get(place)
+    found = household().get((built_like or {}).get(place, place))
     return f"put the {theme} {'on' if found and found.surface == 'top' else 'into'} the {place}"
 
 
@@ -119,7 +122,7 @@ def say(outcome: Mapping, lexicon: Lexicon | None = None) -> str:
     if not outcome["feasible"]:
         return _refusal(outcome, frame, lexicon)
     if outcome.get("success"):
-        done = motion_done(outcome.get("motion"), _parts(frame)[1])
+        done = motion_done(outcome.get("motion"), _parts(frame)[1], outcome.get("built_like") or {})
         return f"I {done or phrase(frame, lexicon, 'past')}."
     return f"I tried to {phrase(frame, lexicon)}, but {_what_failed(outcome.get('checks') or {})}."
 

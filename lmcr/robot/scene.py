@@ -6,7 +6,10 @@ within |x| <= 0.3 and |y| <= 0.5. Containers (cups, bowls, pots, the sink, ...) 
 from a floor and four walls; bottles and jugs hold liquids, shakers hold powders, food is a box,
 sphere or cylinder.
 
-Every object is an instance with an id: an object may give one (`{"label": "cup", "id": "red cup"}`),
+An object of a label the robot has no model of ("closet", "sweater") may say which known object it is
+built as (`"like": "storage box"`): the words (the completion, the replies) are its label's, its body,
+motions and checks those of the known one (`SceneObject.shape`). Every object is an instance with an id:
+an object may give one (`{"label": "cup", "id": "red cup"}`),
 else it is assigned in scene order: "cup" for the first cup, "cup#2", "cup#3" for the next ones (see
 lmcr.instances). Ids differ; an id that is a label belongs to an object of that label; the held object's
 id is its label. Objects without `xy` are placed only when all of them could fit: their outlines, with
@@ -105,6 +108,12 @@ class SceneObject:
     id: str = ""  # this object among those sharing its label (lmcr.instances); assigned by its Scene when empty
     link: int = -1  # the body's link things are put in (a drawer's), -1 the body itself
     joint: int = -1  # the joint that opens it (a drawer's slide, a lid's hinge), -1 none
+    like: str = ""  # the known label whose body it is built as (an object the robot has no model of), "" its own
+
+    @property
+    def shape(self) -> str:
+        """The label whose body, motions and checks the object has: its own, or the one it is built `like`."""
+        return self.like or self.label
 
     @property
     def name(self) -> str:
@@ -113,13 +122,13 @@ class SceneObject:
 
     @property
     def kind(self) -> str:
-        if self.label in CONTAINERS:
+        if self.shape in CONTAINERS:
             return "container"
-        if self.label in TOOLS:
+        if self.shape in TOOLS:
             return "tool"
-        if self.label in LIQUIDS:
+        if self.shape in LIQUIDS:
             return "bottle"
-        if self.label in POWDERS:
+        if self.shape in POWDERS:
             return "shaker"
         return "food"
 
@@ -155,6 +164,10 @@ class Scene:
     def instances(self, label: str) -> list[SceneObject]:
         """Every object labelled `label`, the one in the hand first."""
         return sorted((o for o in self.present if o.label == label), key=lambda o: o is not self.holding)
+
+    def shapes(self) -> dict[str, str]:
+        """Each label's shape (`SceneObject.shape`): what the labels a frame names are built as."""
+        return {o.label: o.shape for o in self.present}
 
 
 def solid_shape(label: str) -> tuple:
@@ -243,7 +256,7 @@ def room_needed(label: str) -> float:
 def _check_room(objects: list[SceneObject], where: str) -> None:
     """Fail at once when the objects cannot fit on the table whatever their places (their grown outlines
     need more area than there is): a scene of 10,000 cups is known not to fit without placing any."""
-    needed = sum(room_needed(o.label) for o in objects)
+    needed = sum(room_needed(o.shape) for o in objects)
     table = (2 * X_LIMIT + CLEAR) * (2 * Y_LIMIT + CLEAR)
     if needed > table:
         free = sum(1 for o in objects if o.xy is None)
@@ -270,13 +283,46 @@ def scene_from_json(data: object, where: str) -> Scene:
     for k, obj in enumerate(data["objects"]):
         if not isinstance(obj, dict):
             raise InputError(f"{where}: object {k} is not a JSON object")
-        items.append((obj.get("label"), obj.get("xy"), obj.get("id")))
-    holding = data.get("holding")
-    if holding is not None and (not isinstance(holding, str) or holding not in {*load_lexicon().objects, *TOOLS}):
-        raise InputError(f"{where}: 'holding' must be a known object label, not {holding!r:.60}")
+        items.append((obj.get("label"), obj.get("xy"), obj.get("id"), obj.get("like")))
+    holding, held_like = _held(data.get("holding"), where)
     if holding in [item[0] for item in items]:
         raise InputError(f"{where}: the {holding} cannot be both in the hand ('holding') and on the table")
-    return make_scene(items, seed, where, holding)
+    return make_scene(items, seed, where, holding, held_like)
+
+
+def _held(holding: object, where: str) -> tuple[str | None, str | None]:
+    """The held object's label and what it is built like: `"holding": "water"`, or an object
+    `{"label": "book", "like": "sponge"}` for one the robot has no model of."""
+    label, like = (holding.get("label"), holding.get("like")) if isinstance(holding, dict) else (holding, None)
+    known = {*load_lexicon().objects, *TOOLS}
+    if holding is None:
+        return None, None
+    if not isinstance(label, str) or (label not in known and like is None):
+        raise InputError(f"{where}: 'holding' must be a known object label, not {label!r:.60}")
+    if like is not None and like not in known:
+        raise InputError(
+            f"{where}: 'holding' ({label}): 'like' must be a known object the hand can hold, not {like!r:.60}"
+        )
+    return label, like
+
+
+def _check_like(labels: list, likes: list, vocabulary: set[str], where: str) -> None:
+    """Each object's label is known, or it is built like a known one; a label is built one way in a scene
+    (a frame names labels, and each names one shape)."""
+    built: dict[str, str | None] = {}
+    for k, (label, like) in enumerate(zip(labels, likes)):
+        if like is not None and (not isinstance(like, str) or like not in vocabulary):
+            raise InputError(
+                f"{where}: object {k} ({label!r:.60}): 'like' must be a known object label, not {like!r:.60}"
+            )
+        if not isinstance(label, str) or (label not in vocabulary and like is None) or id_problem(label):
+            raise InputError(
+                f"{where}: object {k}: unknown label {label!r:.60} (give 'like', the known object it is built as)"
+            )
+        if built.setdefault(label, like) != like:
+            raise InputError(
+                f"{where}: object {k} ({label}): built like {like!r}, but an earlier {label} like {built[label]!r}"
+            )
 
 
 def _check_ids(labels: list[str], given: list, vocabulary: set[str], holding: str | None, where: str) -> None:
@@ -306,35 +352,40 @@ def _valid_xy(xy: object) -> bool:
     )
 
 
-def make_scene(items: list[tuple], seed: int = 0, where: str = "scene", holding: str | None = None) -> Scene:
-    """Validated objects (known labels, finite on-table positions that do not overlap, different ids),
-    the ones without a position placed at random with `seed`; `holding` is the label of what the robot
-    holds. An item is (label, xy or None) or (label, xy or None, id or None)."""
+def make_scene(
+    items: list[tuple], seed: int = 0, where: str = "scene", holding: str | None = None, held_like: str | None = None
+) -> Scene:
+    """Validated objects (known labels or ones built `like` a known one, finite on-table positions that do
+    not overlap, different ids), the ones without a position placed at random with `seed`; `holding` is the
+    label of what the robot holds (`held_like` what it is built as). An item is (label, xy or None), or with
+    an id, or with an id and a like (each may be None)."""
     vocabulary = robot_objects()
-    labels, given = [item[0] for item in items], [item[2] if len(item) > 2 else None for item in items]
-    for k, label in enumerate(labels):
-        if not isinstance(label, str) or label not in vocabulary:
-            raise InputError(f"{where}: object {k}: unknown label {label!r:.60}")
+    labels = [item[0] for item in items]
+    given, likes = ([item[n] if len(item) > n else None for item in items] for n in (2, 3))
+    _check_like(labels, likes, vocabulary, where)
     _check_ids(labels, given, vocabulary, holding, where)
     placed: list[SceneObject] = []
     for k, (label, xy, *_) in enumerate(items):
+        obj = SceneObject(label, tuple(xy) if xy is not None else None, id=given[k] or "", like=likes[k] or "")
         if xy is not None:
-            _check_position(k, label, xy, placed, where)
-        placed.append(SceneObject(label, tuple(xy) if xy is not None else None, id=given[k] or ""))
+            _check_position(k, obj, xy, placed, where)
+        placed.append(obj)
     if any(o.xy is None for o in placed):
         _check_room(placed, where)
         _lay_out(placed, seed, where)
-    return Scene(placed, seed, SceneObject(holding, HAND_OFF) if holding else None)
+    held = SceneObject(holding, HAND_OFF, like=held_like or "") if holding else None
+    return Scene(placed, seed, held)
 
 
-def _check_position(k: int, label: str, xy: object, placed: list[SceneObject], where: str) -> None:
+def _check_position(k: int, obj: SceneObject, xy: object, placed: list[SceneObject], where: str) -> None:
     """Object `k`'s given position: two finite numbers on the table, clear of the objects placed so far."""
+    label = obj.label
     if not _valid_xy(xy):
         raise InputError(f"{where}: object {k} ({label}): xy must be two finite numbers [x, y], not {xy!r:.60}")
     if abs(xy[0]) > X_LIMIT or abs(xy[1]) > Y_LIMIT:
         raise InputError(f"{where}: object {k} ({label}): xy {xy} is off the table (|x| <= 0.3, |y| <= 0.5)")
     for other in placed:
-        if other.xy is not None and _overlap(label, xy, other.label, other.xy):
+        if other.xy is not None and _overlap(obj.shape, xy, other.shape, other.xy):
             raise InputError(f"{where}: object {k} ({label}) overlaps the {other.id or other.label}")
 
 
@@ -374,9 +425,9 @@ class _Tries:
 def _place(placed: list[SceneObject], spot, rng: random.Random, where: str, tries: _Tries) -> None:
     """Give the objects without a position one, big ones first (they need the room): `spot(label, others,
     rng, where, tries)` picks it clear of the objects placed so far."""
-    for obj in sorted(placed, key=lambda o: -footprint(o.label)):
+    for obj in sorted(placed, key=lambda o: -footprint(o.shape)):
         if obj.xy is None:
-            obj.xy = spot(obj.label, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
+            obj.xy = spot(obj.shape, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
 
 
 def _packed_spot(
@@ -387,7 +438,7 @@ def _packed_spot(
     uniform draws do not fit."""
     touching = _touching_spots(label, placed)
     tries.spend(len(touching) * max(len(placed), 1), label, where)
-    spots = [xy for xy in touching if not any(_overlap(label, xy, o.label, o.xy) for o in placed)]
+    spots = [xy for xy in touching if not any(_overlap(label, xy, o.shape, o.xy) for o in placed)]
     if not spots:
         raise InputError(f"{where}: no free spot for the {label} on the table")
     return rng.choice(spots)
@@ -399,7 +450,7 @@ def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, 
     half_x, half_y, _ = outline(label)
     xs, ys = {-X_LIMIT + half_x, X_LIMIT - half_x}, {-Y_LIMIT + half_y, Y_LIMIT - half_y}
     for other in placed:
-        other_x, other_y, _ = outline(other.label)
+        other_x, other_y, _ = outline(other.shape)
         xs |= {other.xy[0] + s * (other_x + PACKING_GAP + half_x) for s in (-1, 1)}
         ys |= {other.xy[1] + s * (other_y + PACKING_GAP + half_y) for s in (-1, 1)}
     on_table = [(round(x, 3), round(y, 3)) for x in sorted(xs) for y in sorted(ys)]
@@ -413,7 +464,7 @@ def _random_spot(
     for _ in range(500):
         tries.spend(max(len(placed), 1), label, where)
         xy = (rng.uniform(-X_LIMIT + margin, X_LIMIT - margin), rng.uniform(-Y_LIMIT + margin, Y_LIMIT - margin))
-        if not any(_overlap(label, xy, o.label, o.xy) for o in placed):
+        if not any(_overlap(label, xy, o.shape, o.xy) for o in placed):
             return round(xy[0], 3), round(xy[1], 3)
     raise InputError(f"{where}: no free spot for the {label} on the table")
 

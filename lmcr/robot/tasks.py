@@ -186,14 +186,14 @@ class Geometry:
     def grip_pose(self, variant: Variant) -> tuple[np.ndarray, tuple]:
         """The gripper pose that grasps the held object by its top (a tool by its grip's), or from the side
         around its body (high enough for the hand to clear the table)."""
-        if self.held.label in TOOLS and not variant.side:
-            grip = p.multiplyTransforms(self.held_pos, self.held_orn, TOOLS[self.held.label].grip, [0, 0, 0, 1])[0]
+        if self.held.shape in TOOLS and not variant.side:
+            grip = p.multiplyTransforms(self.held_pos, self.held_orn, TOOLS[self.held.shape].grip, [0, 0, 0, 1])[0]
             return np.asarray(grip) + [0, 0, GRIP_GAP], variant.upright()
         if variant.side:
             return self.held_top - [
                 0,
                 0,
-                height(self.held.label) - side_grip_height(self.held.label),
+                height(self.held.shape) - side_grip_height(self.held.shape),
             ], variant.upright()
         return self.held_top + [*variant.shift, GRIP_GAP], variant.upright()
 
@@ -220,7 +220,7 @@ class Geometry:
     @property
     def underside_z(self) -> float:
         """How far the held object's underside is above its origin, in its own frame."""
-        return self.held_top[2] - height(self.held.label) - self.held_pos[2]
+        return self.held_top[2] - height(self.held.shape) - self.held_pos[2]
 
     def bottom(self, variant: Variant) -> np.ndarray:
         """The middle of the held object's underside in the gripper's frame."""
@@ -230,7 +230,7 @@ class Geometry:
         """The held object's underside as the gripper holds it at `orientation`: its half-extents along the
         world's x and y about its middle (one the grasp left turned in the hand spans more than its outline)
         and how far its lowest corner hangs below its middle (one left tilted)."""
-        half_x, half_y, _ = outline(self.held.label)
+        half_x, half_y, _ = outline(self.held.shape)
         z = self.underside_z
         middle = self.bottom(variant)
         corners = [self.point_in_hand(variant, [x * half_x, y * half_y, z]) - middle for x in (1, -1) for y in (1, -1)]
@@ -245,7 +245,7 @@ class Geometry:
 
     def centre(self, variant: Variant) -> np.ndarray:
         """The held object's middle in the gripper's frame."""
-        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.label) / 2 - self.held_pos[2]])
+        return self.point_in_hand(variant, [0, 0, self.held_top[2] - height(self.held.shape) / 2 - self.held_pos[2]])
 
 
 def opening_point(target: SceneObject, which: str) -> np.ndarray:
@@ -254,7 +254,7 @@ def opening_point(target: SceneObject, which: str) -> np.ndarray:
     link = target.joint if which == "handle" else target.link  # pybullet numbers a joint's child link as it
     pos, orn = p.getLinkState(target.body, link)[4:6] if link >= 0 else p.getBasePositionAndOrientation(target.body)
     return np.asarray(
-        p.multiplyTransforms(pos, orn, getattr(household()[target.label].opening, which), (0, 0, 0, 1))[0]
+        p.multiplyTransforms(pos, orn, getattr(household()[target.shape].opening, which), (0, 0, 0, 1))[0]
     )
 
 
@@ -267,7 +267,7 @@ def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
     """Open a drawer or a lid (or shut it) by its handle: the gripper comes onto the bar along its own axis,
     holds it, moves it along the joint's whole travel (straight along a slide; round a hinge in chords of
     CHORD, leaning LID_LEAN forward, the bar turning in the hold), lets go and draws back straight."""
-    found = household()[target.label].opening
+    found = household()[target.shape].opening
     turns = hinged(target)
     start, end = p.getJointState(target.body, target.joint)[0], found.joint_at(opening)
     pieces = max(1, math.ceil(abs(end - start) / CHORD)) if turns else 1
@@ -353,7 +353,7 @@ def variants(
     forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
     object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it
     pours), headed from the robot towards the object. A `wide` task's hand also turns by WIDE_TURNS."""
-    half_x, half_y, round_ = outline(held.label)
+    half_x, half_y, round_ = outline(held.shape)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if round_:  # a square box held across its corners would not fit between fingers set for its sides
         yaws += [math.pi / 4, -math.pi / 4]
@@ -363,7 +363,7 @@ def variants(
         # a long object may also be held nearer either end, the hand then further from a neighbour (a
         # tool only by its grip)
         reach = (max(half_x, half_y) - GRIP_END) * np.array([1.0, 0.0] if long_x else [0.0, 1.0])
-        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 and held.label not in TOOLS else []
+        shifts += [tuple(reach), tuple(-reach)] if reach.max() > 0 and held.shape not in TOOLS else []
     signs = (1, -1) if turns else (1,)
     top = [
         Variant(yaw, pitch, sign, turn=turn, shift=shift)
@@ -374,7 +374,7 @@ def variants(
         for sign in signs
     ]
     narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
-    if not pours or 2 * footprint(held.label) > opening - 0.01 or side_grip_height(held.label) >= height(held.label):
+    if not pours or 2 * footprint(held.shape) > opening - 0.01 or side_grip_height(held.shape) >= height(held.shape):
         return (
             top + narrow
         )  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
@@ -470,10 +470,10 @@ def _lower_into(g: Geometry, v: Variant) -> Step:
     above the target's floor, but the hand stays above a deep container's rim (it drops the rest)."""
     orn, t = v.at_target(), g.target_top
     drop = -gripper_over(g.bottom(v), orn)  # how far the gripper is above the object's bottom
-    bottom = max(t[2] - depth(g.target.label) + 0.015, t[2] + 0.01 - drop)
+    bottom = max(t[2] - depth(g.target.shape) + 0.015, t[2] + 0.01 - drop)
     lower = gripper_for(g.bottom(v), orn, [t[0], t[1], bottom])
     # into a container it passes the walls clear (a bottle wider than a glass's opening would end on its rim)
-    walled = _walled(g.target.label)
+    walled = _walled(g.target.shape)
     return move(f"lower {'into' if walled else 'onto'} {g.target.name}", lower, orn, touches="target", into=walled)
 
 
@@ -496,7 +496,7 @@ def program_dump(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     tilt = tilted(v)
     # lowest first (what falls stays where it lands); higher ones when the hand, turned, would meet the rim
     turned = tuple(
-        gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.label) / 2]) for h in DUMP_HEIGHTS
+        gripper_for(g.centre(v), tilt, g.target_top + [0, 0, h + height(g.held.shape) / 2]) for h in DUMP_HEIGHTS
     )
     return [
         *pick(g, v, holding),
@@ -511,9 +511,9 @@ def program_dip(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Lower the held object below the target's rim, then lift it back out. Into a container (a bowl of
     batter) it must pass the walls; food that is not served in one (flour, a shaker here) it presses into."""
     orn, t = v.at_target(), g.target_top
-    dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.label)])
+    dip = gripper_for(g.bottom(v), orn, t - [0, 0, 0.02 + 0.3 * height(g.held.shape)])
     out = gripper_for(g.bottom(v), orn, t + [0, 0, 0.06])
-    into = g.target.label in CONTAINERS
+    into = g.target.shape in CONTAINERS
     return [
         *pick(g, v, holding),
         over_target(g, v),
@@ -549,8 +549,8 @@ def _walled(label: str) -> bool:
 def surface(target: SceneObject, box: tuple) -> tuple[float, float, float, float, float]:
     """The surface a tool wipes: a container's floor within its walls, else the object's top, as x and y
     bounds and height (`box` the target's AABB)."""
-    (lo, hi), inset = box, (WALL if _walled(target.label) else 0.0)
-    return lo[0] + inset, hi[0] - inset, lo[1] + inset, hi[1] - inset, hi[2] - depth(target.label)
+    (lo, hi), inset = box, (WALL if _walled(target.shape) else 0.0)
+    return lo[0] + inset, hi[0] - inset, lo[1] + inset, hi[1] - inset, hi[2] - depth(target.shape)
 
 
 def fits_on(tool: str, label: str) -> bool:
@@ -594,8 +594,8 @@ def program_wipe(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 
 def long_ends(g: Geometry) -> list[list[float]]:
     """The two ends of the held object's long side, halfway up, in its body frame."""
-    half_x, half_y, _ = outline(g.held.label)
-    middle = g.held_top[2] - height(g.held.label) / 2 - g.held_pos[2]
+    half_x, half_y, _ = outline(g.held.shape)
+    middle = g.held_top[2] - height(g.held.shape) / 2 - g.held_pos[2]
     return [[s * half_x, 0, middle] if half_x >= half_y else [0, s * half_y, middle] for s in (1, -1)]
 
 
@@ -612,13 +612,22 @@ def working_end_down(g: Geometry, v: Variant) -> Variant:
     stands on either end, as the variant turns it. The hand then points towards the handle's end, so a
     variant that would have tilted the other way turns the hand half round instead: a tool has as many
     headings over the target to try as a spoon."""
-    tool = TOOLS.get(g.held.label)
+    tool = TOOLS.get(g.held.shape)
     if tool is None:
         return v
     v = v if v.tilt_sign > 0 else replace(v, turn=v.turn + math.pi)
     working = g.point_in_hand(v, max(long_ends(g), key=lambda end: math.dist(end[:2], tool.grip[:2])))
     sign = max((1, -1), key=lambda s: gripper_over(working, tilted(replace(v, tilt_sign=s), math.pi / 2)))
     return replace(v, tilt_sign=sign)
+
+
+def stirs(tool: str, label: str) -> bool:
+    """Whether the `tool` stirs in the `label`: a tool that is no vessel, its end narrower than the inside
+    of a kitchen container (a spoon in the soup; not a microwave in the butter, nor a spoon in a bin)."""
+    if not has_shape(tool) or label not in CONTAINERS or tool in CONTAINERS or label in household():
+        return False
+    (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
+    return min(tx, ty) + STIR_CLEAR <= min(sx, sy) - WALL
 
 
 def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -628,8 +637,8 @@ def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     orn, t = tilted(v, math.pi / 2), g.target_top
     tip = lower_end(g, v, orn)
     lo, hi = g.target_box
-    room = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - STIR_CLEAR - footprint(g.held.label)
-    radius, below = max(0.0, min(STIR_RADIUS, room)), min(STIR_DEPTH, depth(g.target.label) - 0.015)
+    room = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - STIR_CLEAR - footprint(g.held.shape)
+    radius, below = max(0.0, min(STIR_RADIUS, room)), min(STIR_DEPTH, depth(g.target.shape) - 0.015)
     at = [
         [t[0] + radius * math.cos(a), t[1] + radius * math.sin(a), t[2] - below]
         for a in np.linspace(0, 2 * math.pi * STIR_TURNS, 6 * STIR_TURNS + 1)[1:]
@@ -662,7 +671,7 @@ def program_cut(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     """Hold the knife's blade upright over the food's middle, along its short side, and saw down through
     it to the board in CUT_STROKES strokes (the blade drawn back and forth), then lift it out. Whether the
     food was cut through is seen when the strokes end (`act` then swaps it for its pieces)."""
-    tool, (half_x, half_y, _) = TOOLS[g.held.label], outline(g.target.label)
+    tool, (half_x, half_y, _) = TOOLS[g.held.shape], outline(g.target.shape)
     # the handle to one side or the other (the two ways of doing it), the blade across a long food
     heading = (math.pi / 2 if half_x > half_y else 0.0) + (0.0 if v.tilt_sign > 0 else math.pi)
     orn = _turned(v.upright(), heading)
@@ -729,11 +738,11 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     least SCOOP_FLOOR above the container's floor), fill it there, lift it out level, carry it over the
     target, and tip it out spout first in TIPS, the spout held TIP_HEIGHTS above the target's middle; then
     level again the same way and lift it."""
-    tool, orn = TOOLS[g.held.label], v.at_target()
+    tool, orn = TOOLS[g.held.shape], v.at_target()
     bowl, lip = g.point_in_hand(v, tool.scoop), g.point_in_hand(v, tool.lip)
     lo, hi = p.getAABB(g.source.body, g.source.link)
     x, y = (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2
-    bottom = max(hi[2] - SCOOP_DEPTH, hi[2] - depth(g.source.label) + SCOOP_FLOOR)
+    bottom = max(hi[2] - SCOOP_DEPTH, hi[2] - depth(g.source.shape) + SCOOP_FLOOR)
     dip, lifted = gripper_for(bowl, orn, [x, y, bottom]), gripper_for(bowl, orn, [x, y, hi[2] + 0.03])
     # the way of turning the hand that tips the bowl down (the other would run the content down the handle)
     sign = max((1, -1), key=lambda s: gripper_over(bowl, tilted(replace(v, tilt_sign=s), TIPS[-1])))
@@ -848,7 +857,7 @@ def check_in_target(held: SceneObject, target: SceneObject, out: Outcome) -> dic
     ok = inside(target, p.getBasePositionAndOrientation(held.body)[0])
     if target.joint < 0:
         return {"in_target": ok, "ok": ok}
-    shut = bool(p.getJointState(target.body, target.joint)[0] > -household()[target.label].opening.shut)
+    shut = bool(p.getJointState(target.body, target.joint)[0] > -household()[target.shape].opening.shut)
     return {"in_target": ok, "shut": shut, "ok": ok and shut}
 
 
@@ -912,7 +921,7 @@ def check_cut(held: SceneObject, target: SceneObject, out: Outcome) -> dict:
     at = [np.asarray(p.getBasePositionAndOrientation(b)[0]) for b in out.pieces]
     sides = {bool(np.dot(x - point, normal) > 0) for x in at}
     # a piece may roll over onto its flat side (half an apple rolls about 1.6 of its radius), not further
-    near = all(np.linalg.norm((x - point)[:2]) <= 2 * footprint(target.label) + 0.03 and x[2] >= TABLE_TOP for x in at)
+    near = all(np.linalg.norm((x - point)[:2]) <= 2 * footprint(target.shape) + 0.03 and x[2] >= TABLE_TOP for x in at)
     top = max(p.getAABB(b)[1][2] for b in out.pieces)
     lifted = "lifted" in out.probes and out.probes["lifted"][1][0][2] > top
     pieces = len(out.pieces) >= 2 and sides == {True, False}
@@ -1007,7 +1016,7 @@ TOOL_MOTIONS = {
 # content into the Destination
 SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme", wide=True)
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
-TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers}
+TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers, "stir": stirs}
 
 # opening a drawer or a lid or shutting it (`opening_steps`, planned beside the task): a part of putting
 # something into it, checked with the task
@@ -1030,7 +1039,7 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
         served = serves(roles["Theme"], roles["Destination"], roles.get("Instrument"))
         return SERVE if served else None
     if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
-        fits = TOOL_FITS.get(verb_motion, lambda tool, label: True)(roles["Instrument"], roles["Theme"])
+        fits = TOOL_FITS[verb_motion](roles["Instrument"], roles["Theme"])
         return TOOL_MOTIONS[verb_motion] if fits else None
     if not {"Theme", "Destination"} <= set(roles):
         return None

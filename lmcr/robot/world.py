@@ -127,15 +127,15 @@ def build_world(scene: Scene, cache_dir: Path, urdf: Path | None = None) -> int:
     scene.bodies = {}
     for obj in scene.objects:
         x, y = world_xy(obj.xy)
-        found = household().get(obj.label)
+        found = household().get(obj.shape)
         if found is not None and found.urdf is not None:
             obj.body, obj.link, obj.joint = _articulated(found, x, y)
         else:
-            obj.body = _MAKERS[obj.kind](obj.label, x, y)
+            obj.body = _MAKERS[obj.kind](obj.shape, x, y)
         scene.bodies[obj.body] = obj
     if scene.holding is not None:
         x, y = world_xy(scene.holding.xy)
-        scene.holding.body = _MAKERS[scene.holding.kind](scene.holding.label, x, y, 0.0)  # on the floor
+        scene.holding.body = _MAKERS[scene.holding.kind](scene.holding.shape, x, y, 0.0)  # on the floor
     for _ in range(120):  # let everything settle
         p.stepSimulation()
     return robot
