@@ -8,8 +8,9 @@ sphere or cylinder.
 
 An object of a label the robot has no model of ("closet", "sweater") may say which known object it is
 built as (`"like": "storage box"`): the words (the completion, the replies) are its label's, its body,
-motions and checks those of the known one (`SceneObject.shape`). Every object is an instance with an id:
-an object may give one (`{"label": "cup", "id": "red cup"}`),
+motions and checks those of the known one (`SceneObject.shape`).
+
+Every object is an instance with an id: an object may give one (`{"label": "cup", "id": "red cup"}`),
 else it is assigned in scene order: "cup" for the first cup, "cup#2", "cup#3" for the next ones (see
 lmcr.instances). Ids differ; an id that is a label belongs to an object of that label; the held object's
 id is its label. Objects without `xy` are placed only when all of them could fit: their outlines, with
