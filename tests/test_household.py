@@ -647,6 +647,8 @@ def test_an_object_the_robot_has_no_model_of_is_built_like_a_known_one(sim, tmp_
         ([{"label": " closet", "like": "basket"}], None, "unknown label"),
         ([], {"label": "book", "like": "shelf"}, "'like' must be a known object the hand can hold"),
         ([], {"label": "book"}, "'holding' must be a known object label"),
+        ([], {"label": "book", "like": ["sponge"]}, "'like' must be a known object the hand can hold"),
+        ([], {"label": " book", "like": "sponge"}, "'holding' must be a known object label"),
     ],
 )
 def test_a_bad_like_is_a_one_line_error(objects, holding, reason):

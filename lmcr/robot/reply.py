@@ -122,7 +122,7 @@ def say(outcome: Mapping, lexicon: Lexicon | None = None) -> str:
     if not outcome["feasible"]:
         return _refusal(outcome, frame, lexicon)
     if outcome.get("success"):
-        done = motion_done(outcome.get("motion"), _parts(frame)[1], outcome.get("built_like") or {})
+        done = motion_done(outcome.get("motion"), _parts(frame)[1], outcome.get("built_like"))
         return f"I {done or phrase(frame, lexicon, 'past')}."
     return f"I tried to {phrase(frame, lexicon)}, but {_what_failed(outcome.get('checks') or {})}."
 

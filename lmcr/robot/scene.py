@@ -294,13 +294,13 @@ def scene_from_json(data: object, where: str) -> Scene:
 def _held(holding: object, where: str) -> tuple[str | None, str | None]:
     """The held object's label and what it is built like: `"holding": "water"`, or an object
     `{"label": "book", "like": "sponge"}` for one the robot has no model of."""
-    label, like = (holding.get("label"), holding.get("like")) if isinstance(holding, dict) else (holding, None)
-    known = {*load_lexicon().objects, *TOOLS}
     if holding is None:
         return None, None
-    if not isinstance(label, str) or (label not in known and like is None):
+    label, like = (holding.get("label"), holding.get("like")) if isinstance(holding, dict) else (holding, None)
+    known = {*load_lexicon().objects, *TOOLS}
+    if not isinstance(label, str) or (label not in known and like is None) or id_problem(label):
         raise InputError(f"{where}: 'holding' must be a known object label, not {label!r:.60}")
-    if like is not None and like not in known:
+    if like is not None and (not isinstance(like, str) or like not in known):
         raise InputError(
             f"{where}: 'holding' ({label}): 'like' must be a known object the hand can hold, not {like!r:.60}"
         )
