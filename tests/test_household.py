@@ -656,6 +656,14 @@ def test_a_bad_like_is_a_one_line_error(objects, holding, reason):
         scene_from_json({"objects": objects, **({"holding": holding} if holding else {})}, "scene.json")
 
 
+def test_a_scene_that_does_not_fit_names_the_object_by_its_own_label():
+    """Placement measures the shape an object is built like, and the error names the object as the scene
+    file does (a closet, not the storage box it stands in for)."""
+    closets = [{"label": "closet", "like": "storage box", "id": f"closet {k}"} for k in range(7)]
+    with pytest.raises(InputError, match="no free spot for the closet on the table"):
+        scene_from_json({"objects": closets}, "scene.json")
+
+
 def test_a_request_about_objects_built_like_known_ones_is_carried_out(sim, tmp_path, learned_parser):
     """ "put the sweater away" with a closet and a coffee table built like a storage box and a shelf: the
     completion weighs the words (the scorer prefers the coffee table), the robot places the sweater on what

@@ -424,24 +424,24 @@ class _Tries:
 
 
 def _place(placed: list[SceneObject], spot, rng: random.Random, where: str, tries: _Tries) -> None:
-    """Give the objects without a position one, big ones first (they need the room): `spot(label, others,
+    """Give the objects without a position one, big ones first (they need the room): `spot(obj, others,
     rng, where, tries)` picks it clear of the objects placed so far."""
     for obj in sorted(placed, key=lambda o: -footprint(o.shape)):
         if obj.xy is None:
-            obj.xy = spot(obj.shape, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
+            obj.xy = spot(obj, [o for o in placed if o.xy is not None and o is not obj], rng, where, tries)
 
 
 def _packed_spot(
-    label: str, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries
+    obj: SceneObject, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries
 ) -> tuple[float, float]:
-    """A free spot where `label` touches the table's edges or its neighbours, drawn at random among them (a
+    """A free spot where `obj` touches the table's edges or its neighbours, drawn at random among them (a
     corner-point packing): scenes crowded with big things (an oven, a sink, a cutting board, ...) that
     uniform draws do not fit."""
-    touching = _touching_spots(label, placed)
-    tries.spend(len(touching) * max(len(placed), 1), label, where)
-    spots = [xy for xy in touching if not any(_overlap(label, xy, o.shape, o.xy) for o in placed)]
+    touching = _touching_spots(obj.shape, placed)
+    tries.spend(len(touching) * max(len(placed), 1), obj.label, where)
+    spots = [xy for xy in touching if not any(_overlap(obj.shape, xy, o.shape, o.xy) for o in placed)]
     if not spots:
-        raise InputError(f"{where}: no free spot for the {label} on the table")
+        raise InputError(f"{where}: no free spot for the {obj.label} on the table")
     return rng.choice(spots)
 
 
@@ -459,15 +459,17 @@ def _touching_spots(label: str, placed: list[SceneObject]) -> list[tuple[float, 
 
 
 def _random_spot(
-    label: str, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries = _Tries()
+    obj: SceneObject, placed: list[SceneObject], rng: random.Random, where: str, tries: _Tries = _Tries()
 ) -> tuple[float, float]:
-    margin = footprint(label)
+    """A free spot for `obj` drawn uniformly (its shape's outline clear of the placed ones); errors name it
+    by its label."""
+    margin = footprint(obj.shape)
     for _ in range(500):
-        tries.spend(max(len(placed), 1), label, where)
+        tries.spend(max(len(placed), 1), obj.label, where)
         xy = (rng.uniform(-X_LIMIT + margin, X_LIMIT - margin), rng.uniform(-Y_LIMIT + margin, Y_LIMIT - margin))
-        if not any(_overlap(label, xy, o.shape, o.xy) for o in placed):
+        if not any(_overlap(obj.shape, xy, o.shape, o.xy) for o in placed):
             return round(xy[0], 3), round(xy[1], 3)
-    raise InputError(f"{where}: no free spot for the {label} on the table")
+    raise InputError(f"{where}: no free spot for the {obj.label} on the table")
 
 
 def free_spots(scene: Scene, label: str, n: int = 3) -> list[tuple[float, float]]:
@@ -477,7 +479,7 @@ def free_spots(scene: Scene, label: str, n: int = 3) -> list[tuple[float, float]
     rng, spots = random.Random(f"{scene.seed}:put down"), set()
     for _ in range(n):
         try:
-            spots.add(_random_spot(label, scene.objects, rng, "scene"))
+            spots.add(_random_spot(SceneObject(label, None), scene.objects, rng, "scene"))
         except InputError:
             break
     return sorted(spots, key=lambda xy: math.hypot(xy[0] + X_LIMIT, xy[1]))
