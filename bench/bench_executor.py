@@ -7,7 +7,8 @@ For each of the 11 predicates, and for a learned verb of each motion that puts a
 lifted open and lowered shut; dispose: throw out into a bin; hand
 over: hand to a person), and of each class that works with a tool (stir the soup with a spoon, wipe the
 cutting board with a sponge, cut the bread with a knife, cover the pot with a lid; serve: scoop the soup
-into a bowl with the ladle on the table), an incomplete
+into a bowl with the ladle on the table; cook: reheat the soup in the microwave, bake the bread in the
+oven), an incomplete
 instruction on `--placements` random layouts: the two objects the frame needs plus `--distractors` random
 other objects (obstacles, and other candidates for the completion; for the learned verbs drawn from the
 household's receptacles too), placed at random with a seed. The learned verbs need a frame build that
@@ -69,6 +70,9 @@ TASKS = {
     "cover": ("cover the pot", "pot", "lid", "Instrument"),
     # ... and of the serve class: a ladle the robot finds on the table carries the Theme's content
     "serve": ("scoop the soup", "soup", "bowl", "Destination"),
+    # ... and of the cook class: the Theme put where it cooks, its Instrument or its Destination
+    "cook": ("reheat the soup", "soup", "microwave", "Instrument"),
+    "cook in the oven": ("bake the bread", "bread", "oven", "Destination"),
 }
 ALSO = {"serve": ("ladle",)}  # on the table too: what the motion needs that the instruction leaves unsaid
 TOOLS = {"stir", "whisk", "wipe", "cut", "cover"}  # the tool is held: the object filled in, not the one stated
@@ -81,6 +85,8 @@ LEARNED = {
     "dispose",
     "hand over",
     "serve",
+    "cook",
+    "cook in the oven",
     *TOOLS,
 }
 SLOW = 30  # seconds: no instruction should take longer to plan (or refuse) and execute

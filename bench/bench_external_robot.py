@@ -7,7 +7,8 @@ no room for it beside the others. Most of those objects have no body in the simu
 closet, a sweater); each such one is built like a known object of the kind its role asks for
 (`"like"` in the scene format): the stated Theme like a sponge (moved) or like the surface, food or
 pot a tool acts on, and every candidate for the missing role like a basket (a Destination) or like the
-tool of the verb's learned class of motion (an Instrument) (`STAND_INS`). The completion sees the
+tool of the verb's learned class of motion (an Instrument), or a pot for a verb learned as a cook
+(`STAND_INS`). The completion sees the
 item's own words; the robot moves and checks the bodies.
 
 The robot is asked only the items whose words alone complete right (as `lmcr complete` does them, with
@@ -57,6 +58,8 @@ STAND_INS = {
     ("Instrument", "stir"): "whisk",
     ("Theme", "cover"): "pot",
     ("Instrument", "cover"): "lid",
+    ("Instrument", "cook"): "pot",  # where a Theme is cooked
+    ("Destination", "cook"): "pot",
     ("Instrument", None): "sponge",
 }
 

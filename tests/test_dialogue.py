@@ -87,8 +87,8 @@ def test_three_unusable_answers_and_the_robot_leaves_it(robot_parts):
     assert "no known predicate" in outcomes[1]["error"]  # the next instruction is heard again
     assert (
         said[-1] == "robot: Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, "
-        "pour, rub, season or sprinkle things, and put things away, throw them out, hand them over, stir, wipe, "
-        "cut, cover or serve with a tool."
+        "pour, rub, season or sprinkle things, and put things away, throw them out, hand them over, cook them in a "
+        "pan or an oven, stir, wipe, cut, cover or serve with a tool."
     )
 
 
@@ -255,8 +255,8 @@ POUR = {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
         (
             {"error": "no known predicate in 'juggle'", "error_kind": "unknown_predicate"},
             "Sorry, I don't know how to do that. I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or "
-            "sprinkle things, and put things away, throw them out, hand them over, stir, wipe, cut, cover or serve "
-            "with a tool.",
+            "sprinkle things, and put things away, throw them out, hand them over, cook them in a pan or an oven, "
+            "stir, wipe, cut, cover or serve with a tool.",
         ),
         ({"error": "...", "error_kind": "absent", "absent": "onion"}, "I see no onion on the table."),
         (

@@ -392,7 +392,10 @@ def test_the_robot_refuses_a_learned_verb_it_has_no_motion_for_in_one_line(learn
         p.disconnect()
     reply = say(error_outcome(NoMotionError("bake")), learned_parser.lex)
     can = "I can blend, brush, dip, dump, fill, fry, heat, pour, rub, season or sprinkle things"
-    learned = "put things away, throw them out, hand them over, stir, wipe, cut, cover or serve with a tool"
+    learned = (
+        "put things away, throw them out, hand them over, cook them in a pan or an oven, stir, wipe, cut, cover or "
+        "serve with a tool"
+    )
     assert reply == f"Sorry, I don't know how to bake. {can}, and {learned}."
 
 
@@ -408,11 +411,14 @@ def test_each_learned_verb_gets_the_class_of_motion_its_fillers_are_most_like(tm
     frames += [("whisk", {"Theme": "batter"}, False)] * 10
     frames += [("transfer", {"Theme": "milk", "into": "glass"}, False)] * 20
     frames += [("transfer", {"Theme": "cup", "in": "glass"}, False)] * 5
+    frames += [("cook", {"Theme": "soup", "in": "microwave"}, False)] * 20
+    frames += [("cook", {"Theme": "cake", "in": "oven"}, False)] * 10
     table = learn_predicates(_store(tmp_path, frames), HAND)
     motions = {name: p.motion for name, p in table.predicates.items()}
     assert MOTION_CLASSES["place"] == "put" and MOTION_CLASSES["stir"] == "stir"
     assert motions["put"] == "place" and motions["stir"] == "stir"  # a prototype is its own class
     assert motions["whisk"] == "stir" and motions["transfer"] == "place" and motions["put away"] == "place"
+    assert motions["cook"] == "cook" and motions["bake"] == "cook" and motions["warm"] == "cook"  # in ovens
     assert table.to_json()["predicates"]["whisk"]["spec"]["motion"] == "stir"
 
 

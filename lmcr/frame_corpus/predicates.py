@@ -43,7 +43,7 @@ import duckdb
 from lmcr.files import atomic_path
 from lmcr.lexicon import PREDICATES_FILE, Lexicon
 
-VERSION = 2  # 2: each predicate's class of motion
+VERSION = 3  # 2: each predicate's class of motion; 3: the cook class
 # Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
 PREP_ROLES: dict[str, tuple[str, ...]] = {
     "into": ("Destination",),
@@ -70,9 +70,17 @@ PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb st
 TOP_FILLERS = 300  # fillers per slot compared (the rest carry little of a cosine)
 REFUSED_LISTED = 5  # frames a refused verb needs to be listed with its evidence
 # The robot's classes of motion, each named by its own verb (the prototype): a learned verb's class is the
-# prototype its fillers are most like. Only `place` has a motion for any Destination today; the others
-# compete so that "cut the bread into the bowl" is not read as placing it (their motions are to come).
-MOTION_CLASSES = {"place": "put", "cut": "cut", "stir": "stir", "wipe": "wipe", "cover": "cover", "serve": "scoop"}
+# prototype its fillers are most like (`lmcr.robot.tasks.task_for` gives each class its motion; a class
+# also keeps verbs apart: "cut the bread into the bowl" is not read as placing it).
+MOTION_CLASSES = {
+    "place": "put",
+    "cut": "cut",
+    "stir": "stir",
+    "wipe": "wipe",
+    "cover": "cover",
+    "serve": "scoop",
+    "cook": "cook",
+}
 CLASS_ROLES = ("Theme", "Destination", "Instrument")  # whose fillers are compared, each role alike
 OPEN_ROLES = ("Destination", "Instrument")  # the roles a request can leave for the robot to choose
 # prepositions that can introduce the Theme of a prepositional verb ("of")

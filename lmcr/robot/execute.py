@@ -38,8 +38,9 @@ MAX_INSTANCES = 3  # of one candidate, the object combinations planned at most (
 ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (table frame): both arms reach there
 
 
-# the motions a learned verb may have: by its Destination's kind, and its class's with a tool or a ladle
-LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion})
+# the motions a learned verb may have: by its Destination's kind, and its class's with a tool or a ladle,
+# or putting the Theme where it cooks
+LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion, "cook"})
 
 
 class NoMotionError(NoPredicateError):

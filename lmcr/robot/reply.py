@@ -25,7 +25,10 @@ _AUTO_ID = re.compile(r"(.+)#(\d+)")
 ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth", "tenth")
 LEAVE_IT = "I'll leave it."
 # household.MOTIONS, tasks.TOOL_MOTIONS and serving, as a person hears them
-MOTIONS_SAID = "and put things away, throw them out, hand them over, stir, wipe, cut, cover or serve with a tool"
+MOTIONS_SAID = (
+    "and put things away, throw them out, hand them over, cook them in a pan or an oven, stir, wipe, cut, cover or "
+    "serve with a tool"
+)
 
 
 def past_tense(verb: str, irregular: str | None = None) -> str:

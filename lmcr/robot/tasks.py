@@ -1,5 +1,5 @@
 """One motion program per predicate, and per class of motion of the learned verbs (place, dispose, hand
-over, stir, wipe, cut, cover, serve): the steps (gripper poses, grasp, release, pouring) that act out a
+over, cook, stir, wipe, cut, cover, serve): the steps (gripper poses, grasp, release, pouring) that act out a
 completed frame, computed from the objects' geometry, and the checks that say whether it worked.
 
 A program is built for one way of doing the task (`Variant`: the gripper's turn about the vertical when
@@ -1017,6 +1017,12 @@ TOOL_MOTIONS = {
 SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme", wide=True)
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
 TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers, "stir": stirs}
+# a verb of the cook class puts the Theme in or on what cooks it, as the paper's heat does: the Instrument
+# ("reheat the soup in the microwave") or, when the verb takes none, the Destination ("bake the bread in
+# the oven"); by the role it is put at
+COOK = {
+    role: Task("Theme", role, program_place, check_in_target, motion="cook") for role in ("Instrument", "Destination")
+}
 
 # opening a drawer or a lid or shutting it (`opening_steps`, planned beside the task): a part of putting
 # something into it, checked with the task
@@ -1031,13 +1037,16 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
     apple in the bowl"; not "cut the bread into the bowl"); for a frame with a tool, the tool motion of the
     verb's class ("whisk the batter with the spoon": stir; "slice the bread with the knife": cut; "cover the pot
     with the lid": cover) when the tool's shape can do it; a verb of the serve class ladles the Theme's
-    content into the Destination ("ladle the soup into the bowl"). None when the robot has no motion for it."""
+    content into the Destination ("ladle the soup into the bowl"); one of the cook class puts the Theme in
+    or on what cooks it (`cooks`). None when the robot has no motion for it."""
     if frame.predicate in TASKS:
         return TASKS[frame.predicate]
     roles = frame.role_map
     if verb_motion == "serve" and {"Theme", "Destination"} <= set(roles) and roles["Destination"] not in household():
         served = serves(roles["Theme"], roles["Destination"], roles.get("Instrument"))
         return SERVE if served else None
+    if verb_motion == "cook":
+        return _cook_task(roles)
     if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
         fits = TOOL_FITS[verb_motion](roles["Instrument"], roles["Theme"])
         return TOOL_MOTIONS[verb_motion] if fits else None
@@ -1047,3 +1056,19 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
     if found is not None:
         return MOTIONS[found.motion]
     return MOTIONS["place"] if verb_motion == "place" else None
+
+
+def cooks(label: str) -> bool:
+    """Whether a Theme can be put in or on `label` to be cooked there: a kitchen container with walls (a
+    pan, a pot, a microwave, an oven), or a household place things are put (the stove, a shelf); not a bin,
+    the person, or a tool."""
+    found = household().get(label)
+    if found is not None:
+        return found.motion == "place"
+    return _walled(label) and label not in TOOLS
+
+
+def _cook_task(roles: dict[str, str]) -> Task | None:
+    """The cook class's task for a frame's roles: the Theme put at its Instrument, else its Destination."""
+    role = "Instrument" if "Instrument" in roles else "Destination"
+    return COOK[role] if "Theme" in roles and role in roles and cooks(roles[role]) else None
