@@ -79,6 +79,10 @@ def test_misread_imperatives_are_repaired(parser):
     assert modifier.to_json() == {"predicate": "pour", "roles": {"Theme": "milk", "Destination": None}}
     narration = parse_instruction(parser, "pour spice into pan")  # EPIC-KITCHENS' terse register
     assert narration.to_json() == {"predicate": "pour", "roles": {"Theme": "spice", "Destination": "pan"}}
+    # tagged toast/NN, and behind "Please" toast/VB with "the bread" an adverbial: "You should" has the object
+    assert [f.to_json() for f in parser.parse("Toast the bread.")] == [
+        {"predicate": "toast", "roles": {"Theme": "bread"}}
+    ]
 
 
 @pytest.mark.shared

@@ -9,7 +9,7 @@ import pytest
 from lmcr.lexicon import load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.mentions import extract_frames
-from lmcr.srl.parser import find_split, needs_reparse
+from lmcr.srl.parser import _object_lost, find_split, needs_reparse
 from lmcr.srl.priors import RolePriors
 from tests.srl_docs import make_doc
 
@@ -253,6 +253,18 @@ def test_imperative_repair_triggers():
     clause = make_doc("brush/VB/ROOT/0 bread/NN/dobj/0 and/CC/cc/1 season/NN/conj/1 with/IN/prep/3 salt/NN/pobj/4")
     assert find_split(clause[:], LEX).text == "season"
     assert find_split(make_doc("add/VB/ROOT/0 salt/NN/dobj/0 and/CC/cc/1 pepper/NN/conj/1")[:], LEX) is None
+
+
+def test_a_reparse_that_hangs_the_object_as_an_adverbial_loses_it():
+    """ "toast the bread": behind "Please" the tagger reads toast as a verb but hangs "the bread" on it as an
+    adverbial noun phrase; behind "You should" it is the object. A span of time stays an adverbial."""
+    please = make_doc("Please/UH/intj/1 toast/VB/ROOT/1 the/DT/det/3 bread/NN/npadvmod/1")
+    should = make_doc("You/PRP/nsubj/2 should/MD/aux/2 toast/VB/ROOT/2 the/DT/det/4 bread/NN/dobj/2")
+    assert _object_lost(please, "Please ") and not _object_lost(should, "You should ")
+    minutes = make_doc("Please/UH/intj/1 bake/VB/ROOT/1 another/DT/det/4 20/CD/nummod/4 minutes/NNS/npadvmod/1")
+    assert not _object_lost(minutes, "Please ")
+    later = make_doc("Please/UH/intj/1 stir/VB/ROOT/1 the/DT/det/3 soup/NN/dobj/1 the/DT/det/5 day/NN/npadvmod/1")
+    assert not _object_lost(later, "Please ")  # it has its object
 
 
 def _participles(doc_spec: str, words: set[str]):

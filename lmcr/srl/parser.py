@@ -24,7 +24,7 @@ from lmcr.files import read_resource
 from lmcr.lexicon import PREDICATES_FILE, Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import LazyLemmas
-from lmcr.srl.mentions import FrameMention, extract_frames
+from lmcr.srl.mentions import OBJECT_DEPS, FrameMention, extract_frames
 from lmcr.srl.priors import RolePriors
 from lmcr.srl.repair import mend_modal_nouns, rejoin_split_compounds
 from lmcr.srl.spacy_model import spacy_model_from_env
@@ -47,6 +47,9 @@ FIRST_WORD = re.compile(r"^\W*([A-Za-z]+)")
 DIRECT_AFTER = 3
 DIRECT_RATE = 0.9
 COORDINATORS = frozenset({"and", "or", "then", ";", ","})
+# determiners that open a thing's noun phrase ("the bread", "some bread"); not "another", "every", "each",
+# which open spans of time ("bake another 10 minutes")
+THING_DETERMINERS = frozenset({"the", "a", "an", "some", "this", "that", "these", "those"})
 MAX_DEPTH = 3
 # Components frame extraction never reads, and ones replaced by lazy lemmas (half the model's time).
 UNUSED = ("ner",)
@@ -103,6 +106,21 @@ def _reparse_accepted(doc: Doc, prefix: str) -> bool:
     pour/VB/compound spice into pan": the next prefix may do better)."""
     k = len(prefix.split())
     return len(doc) > k and doc[k].tag_.startswith("VB") and doc[k].dep_ not in PREMODIFIER_DEPS
+
+
+def _object_lost(doc: Doc, prefix: str) -> bool:
+    """The re-parse reads the first word as a verb but hangs the noun phrase right after it on the verb as an
+    adverbial, not as its object ("Please toast/VB the bread/npadvmod"; "You should" reads "the bread" as the
+    object). Only a phrase that opens with a thing's determiner (`THING_DETERMINERS`): "bake 20 minutes"
+    and "stir every minute" keep their adverbials."""
+    k = len(prefix.split())
+    verb = doc[k]
+    if any(c.dep_ in OBJECT_DEPS for c in verb.children):
+        return False
+    return any(
+        c.dep_ == "npadvmod" and c.left_edge.i == k + 1 and c.left_edge.lower_ in THING_DETERMINERS
+        for c in verb.children
+    )
 
 
 def find_split(span: Span, lex: Lexicon) -> Token | None:
@@ -252,7 +270,7 @@ class FrameParser:
         parses, requests = [], []
         prefix = PREFIXES[0]
         for seg, doc in zip(direct, self._parse([as_request(s.text, prefix) for s in direct])):
-            if not _reparse_accepted(doc, prefix):
+            if not _reparse_accepted(doc, prefix) or _object_lost(doc, prefix):  # re-parsed as a request then
                 plain.append(seg)
                 continue
             self.stats.direct += 1
@@ -293,22 +311,33 @@ class FrameParser:
                 self.stats.texts += 1
 
     def _reparse_requests(self, requests: list[_Piece]) -> list[_Piece]:
-        """Each request re-parsed behind each prefix in turn until one reads as a command; the parse that
-        was accepted, else the original sentence."""
-        parses = []
+        """Each request re-parsed behind each prefix in turn until one reads as a command with its object
+        (`_object_lost`: else the first that read as a command); the parse that was accepted, else the
+        original sentence."""
+        parses, without_object = [], {}
         for prefix in PREFIXES:
             retry = []
             redone = self._parse([as_request(piece.parse.text, prefix) for piece in requests])
             for piece, again in zip(requests, redone):
-                if _reparse_accepted(again, prefix):
-                    self.stats.accepted += 1
-                    if piece.segment.depth == 0 and piece.parse.start == 0:
-                        self._learn_first_word(piece.parse, True)
-                    parses.append(_Piece(piece.segment, again[:], piece.offset + piece.parse.start_char - len(prefix)))
-                else:
+                if not _reparse_accepted(again, prefix):
                     retry.append(piece)
+                elif _object_lost(again, prefix):
+                    without_object.setdefault(id(piece), (again, prefix))
+                    retry.append(piece)
+                else:
+                    parses.append(self._accepted(piece, again, prefix))
             requests = retry
-        return parses + requests
+        for piece in requests:
+            found = without_object.get(id(piece))
+            parses.append(self._accepted(piece, *found) if found else piece)
+        return parses
+
+    def _accepted(self, piece: _Piece, again: Doc, prefix: str) -> _Piece:
+        """The re-parse of a request behind `prefix`, placed in its text (and its first word learned)."""
+        self.stats.accepted += 1
+        if piece.segment.depth == 0 and piece.parse.start == 0:
+            self._learn_first_word(piece.parse, True)
+        return _Piece(piece.segment, again[:], piece.offset + piece.parse.start_char - len(prefix))
 
     def _collect(self, parses: list[_Piece], frames: list[list[FrameMention]]) -> list[_Segment]:
         """Frames of each parse, shifted to its text; a second clause ("... and then ...") is cut off and
