@@ -20,7 +20,7 @@ from pathlib import Path
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
-from lmcr.grounding import ground_roles, objects_named, referents, served_vessel
+from lmcr.grounding import ground_roles, objects_named, referents, served_vessel, speaker_destination
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
@@ -186,7 +186,8 @@ def complete(
     ids_of = ids_by_label([labels[k] for k in kept], [(ids or assign_ids(labels))[k] for k in kept])
     detected = list(ids_of)
     pronouns = parser.lex.object_pronouns
-    referred = referents(parser, doc, frame, detected)
+    # "I'd love some wine, could you pour it?": the wine; "bring me the soap": to the person who asks
+    referred = referents(parser, doc, frame, detected) | speaker_destination(parser, doc, frame, detected)
     # "pour me a glass of water": the person asked for the glass as well as the water
     served = served_vessel(parser, doc, frame, detected, referred)
     # "pour it": who knows what, unless "it" points back to an object named before ("some wine")

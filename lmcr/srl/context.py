@@ -32,7 +32,8 @@ def _covered(token: Token, spans: list[tuple[int, int]]) -> bool:
     return any(start <= token.idx < end for start, end in spans)
 
 
-def _predicate(doc: Doc, mention: FrameMention) -> Token | None:
+def predicate_token(doc: Doc, mention: FrameMention) -> Token | None:
+    """The token of the mention's predicate in `doc`."""
     return next((t for t in doc if t.idx <= mention.start < t.idx + max(len(t), 1)), None)
 
 
@@ -94,7 +95,7 @@ def utterance_context(doc: Doc, mention: FrameMention, said: frozenset[str] = fr
     tea"); "" when none of them is a content word. `doc` is a parse of the text `mention` came from.
     The roles in `said` count as words of the utterance, not of the frame ("pour milk in my coffee"
     with no coffee to pour it into: "in my coffee")."""
-    predicate = _predicate(doc, mention)
+    predicate = predicate_token(doc, mention)
     if predicate is None:
         return ""
     skip = _request_before(doc, predicate) | _role_words(doc, mention, predicate, said) | {predicate.i}
@@ -116,7 +117,7 @@ def antecedents(
     pronoun = mention.roles.get(role)
     if pronoun not in ANAPHOR_PLURAL or role not in mention.spans:
         return []
-    predicate = _predicate(doc, mention)
+    predicate = predicate_token(doc, mention)
     frame_words = _role_words(doc, mention, predicate) if predicate is not None else set()
     found: list[tuple[bool, int, str]] = []
     for token in doc:
@@ -144,7 +145,7 @@ def served_in(doc: Doc, mention: FrameMention, lex: Lexicon) -> str | None:
     recipient pronoun (the person served) and one uncounted measure noun with an of-phrase (the parser
     gives its role to the of-phrase, "water"). A measure alone is a quantity ("pour a cup of milk into
     the batter", "pour me half a cup of milk", "pour us two glasses of wine")."""
-    predicate = _predicate(doc, mention)
+    predicate = predicate_token(doc, mention)
     if predicate is None:
         return None
     objects = [c for c in predicate.children if c.dep_ in ("dative", "dobj")]

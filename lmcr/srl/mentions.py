@@ -14,6 +14,7 @@ from lmcr.srl.lemmas import lemma as lemma_of
 
 OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
 NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})
+NOUN_CLAUSE_DEPS = frozenset({"relcl", "acl"})  # a clause that modifies a noun ("something to drink from")
 SKIPPED_LEMMAS = frozenset({"be", "have", "do", "let", "go", "will", "would", "can", "could", "should"})
 # forms of "be" the lemmatiser leaves as they are when the tagger misreads them
 BE_FORMS = frozenset({"is", "are", "was", "were", "am", "been", "being"})
@@ -302,7 +303,10 @@ def _generic_frame(verb: Token, lemma: str, args: _Args, lex: Lexicon, compounds
 
 def _addressed(verb: Token) -> bool:
     """Whether the verb is said to the robot: no subject of its own (an imperative, or one coordinated
-    with it) or "you" ("can you dispose of it"), not "I drank it" or "the crispy one was eaten"."""
+    with it) or "you" ("can you dispose of it"), not "I drank it" or "the crispy one was eaten"; nor a
+    clause that says what a thing is for ("hand me something to cut the bread with": cut)."""
+    if verb.dep_ in NOUN_CLAUSE_DEPS:
+        return False
     subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass")]
     return all(c.lower_ == "you" for c in subjects)
 
