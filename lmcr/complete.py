@@ -24,7 +24,7 @@ from lmcr.grounding import ground_roles, objects_named, referents, served_vessel
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
-from lmcr.srl.context import utterance_context
+from lmcr.srl.context import Purpose, purpose_of, utterance_context
 from lmcr.srl.instruction import read_instruction
 from lmcr.srl.parser import FrameParser
 
@@ -226,6 +226,10 @@ def complete(
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
         scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
+    # "hand me something to cut the bread with": the thing is also scored as what it is for (cut bread with it)
+    purpose = purpose_of(doc, frame, parser.lex, parser.compounds) if "Theme" in missing else None
+    if purpose is not None and all("Theme" in f for f in fillings):
+        scores = [s + p for s, p in zip(scores, _purpose_scores(scorer, purpose, fillings))]
     probs = softmax(scores, config.temperature)
     ranked = sorted(zip(fillings, scores, probs), key=lambda x: -x[1])
     candidates = tuple(
@@ -245,6 +249,13 @@ def complete(
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )
+
+
+def _purpose_scores(scorer: Scorer, purpose: Purpose, fillings: list[dict[str, str]]) -> list[float]:
+    """Each filling's Theme scored as the thing its purpose frame needs ("cut bread with the knife"); the
+    purpose is that frame, so it is no context of it."""
+    frames = [Frame.of(purpose.predicate, {**purpose.roles, purpose.gap: f["Theme"]}) for f in fillings]
+    return list(scorer(frames, ""))
 
 
 def _scores(scorer: Scorer, frames: list[Frame], fillings: list[dict[str, str]], context: str) -> list[float]:

@@ -463,6 +463,25 @@ def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser)
     assert unsaid.frame.role_map["Destination"] == "bowl"
 
 
+def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):
+    """ "bring me something to cut the bread with": "something" leaves the Theme to complete, and each
+    candidate is also scored as the Instrument of cutting the bread; the scorer likes bringing a spoon,
+    and cutting with the knife far more, so the knife is brought to the person who asks."""
+    from lmcr.complete import CompletionConfig, complete
+
+    def scorer(frames, context=""):
+        wanted = {"bring": ("Theme", "spoon", 0.5), "cut": ("Instrument", "knife", 2.0)}
+        found = [wanted.get(f.predicate) for f in frames]
+        return [w[2] if w and f.role_map.get(w[0]) == w[1] else 0.0 for f, w in zip(frames, found)]
+
+    objects = ["bread", "knife", "spoon", "person"]
+    out = complete(learned_parser, scorer, "bring me something to cut the bread with", objects, CompletionConfig())
+    assert out.frame.to_json() == {"predicate": "bring", "roles": {"Theme": "knife", "Destination": "person"}}
+    assert out.missing == "Theme" and out.referred == {"Destination": "person"}
+    named = complete(learned_parser, scorer, "bring me the spoon", objects, CompletionConfig())
+    assert named.frame.role_map == {"Theme": "spoon", "Destination": "person"} and named.missing is None
+
+
 def test_a_tool_in_the_hand_is_the_one_the_request_names(sim, tmp_path, learned_parser):
     """ "stir the batter with the whisk" with the whisk in the hand: the stated whisk is the held one (no
     whisk on the table, and the word is no kitchen object the lexicon knows), so nothing is asked and the

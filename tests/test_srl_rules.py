@@ -266,6 +266,28 @@ def test_a_clause_that_says_what_a_thing_is_for_is_not_the_request():
     assert addressed["cut"] is False
 
 
+def test_a_thing_asked_for_by_its_purpose_fills_a_role_of_the_purpose_frame():
+    """ "hand me something to season the steak with": the thing is season's Instrument (the stranded
+    "with"); "get me something to pour into the bowl": pour's object, the Theme; a request that names its
+    thing has no purpose frame."""
+    from lmcr.srl.context import Purpose, purpose_of
+
+    doc = make_doc(
+        "hand/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 season/VB/relcl/2 the/DT/det/6 "
+        "steak/NN/dobj/4 with/IN/prep/4"
+    )
+    hand = next(f for f in extract_frames(doc, LEX) if f.predicate == "hand")
+    assert purpose_of(doc, hand, LEX) == Purpose("season", {"Theme": "steak"}, "Instrument")
+    doc = make_doc(
+        "get/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 pour/VB/relcl/2 into/IN/prep/4 "
+        "the/DT/det/7 bowl/NN/pobj/5"
+    )
+    get = next(f for f in extract_frames(doc, LEX) if f.predicate == "get")
+    assert purpose_of(doc, get, LEX) == Purpose("pour", {"Destination": "bowl"}, "Theme")
+    doc = make_doc("hand/VB/ROOT/0 me/PRP/dative/0 the/DT/det/3 knife/NN/dobj/0")
+    assert purpose_of(doc, extract_frames(doc, LEX)[0], LEX) is None
+
+
 def test_a_reparse_that_hangs_the_object_as_an_adverbial_loses_it():
     """ "toast the bread": behind "Please" the tagger reads toast as a verb but hangs "the bread" on it as an
     adverbial noun phrase; behind "You should" it is the object. A span of time stays an adverbial."""

@@ -8,10 +8,13 @@ context only when it holds a content word: "for me" or "a little" leave the inst
 A pronoun role may point back to a thing named before it ("I'd love some wine, could you pour it?",
 "take the strawberries and dip them in the chocolate"): `antecedents` lists what it may refer to. A
 request that serves someone may name the vessel as the measure of what it serves ("pour me a glass of
-water"): `served_in` finds it.
+water"): `served_in` finds it. A request that names only what a thing is for ("hand me something to cut
+the bread with") says it as a frame of its own: `purpose_of` finds it.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 from spacy.tokens import Doc, Token
 
@@ -19,7 +22,7 @@ from lmcr.lexicon import Lexicon
 from lmcr.srl.arguments import NOUN_TAGS, argument_value
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import lemma as lemma_of
-from lmcr.srl.mentions import FrameMention
+from lmcr.srl.mentions import NOUN_CLAUSE_DEPS, FrameMention, extract_frames
 
 CONTENT_TAGS = ("NN", "VB", "JJ")  # nouns, verbs, adjectives (Penn tags: hand-built Docs have no POS)
 CLAUSE_BREAKS = frozenset({",", ";", ":", ".", "!", "?"})
@@ -155,3 +158,36 @@ def served_in(doc: Doc, mention: FrameMention, lex: Lexicon) -> str | None:
     counted = any(c.dep_ in COUNTING_DEPS for c in measure.children)
     has_of = any(c.dep_ == "prep" and c.lower_ == "of" for c in measure.children)
     return name if measure.tag_ == "NN" and not counted and has_of and name in lex.measure_nouns else None
+
+
+@dataclass(frozen=True)
+class Purpose:
+    """What a thing asked for is for, as a frame of its own: the purpose clause's predicate, the roles the
+    clause states, and the role the thing fills in it (`gap`)."""
+
+    predicate: str
+    roles: dict[str, str]
+    gap: str
+
+
+def purpose_of(doc: Doc, mention: FrameMention, lex: Lexicon, compounds: Compounds | None = None) -> Purpose | None:
+    """ "hand me something to cut the bread with": the request's object is an indefinite pronoun
+    ("something") with a clause that says what it is for; the thing is the role of that clause's frame
+    its stranded preposition introduces (cut, Theme bread: the Instrument, "with"), or the clause verb's
+    object when no preposition is stranded ("something to eat"). None when the request says no such
+    thing or the clause's verb is no predicate the robot knows. English grammar, not knowledge of things."""
+    verb = predicate_token(doc, mention)
+    thing = (
+        next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ in lex.object_pronouns), None) if verb else None
+    )
+    clause = next((c for c in thing.children if c.dep_ in NOUN_CLAUSE_DEPS), None) if thing is not None else None
+    found = clause is not None and next((f for f in extract_frames(doc, lex, compounds) if f.start == clause.idx), None)
+    spec = lex.predicates.get(found.predicate) if found else None
+    if spec is None:
+        return None
+    stranded = [c.lower_ for c in clause.children if c.dep_ == "prep" and not any(g.dep_ == "pobj" for g in c.children)]
+    gap = spec.prep_role(stranded[0]) if stranded else spec.object_role
+    roles = {r: v for r, v in found.roles.items() if v and r != gap and v not in lex.object_pronouns}
+    if gap is None or gap not in (*spec.roles, *spec.alternatives) or gap in roles:
+        return None
+    return Purpose(found.predicate, roles, gap)
