@@ -288,6 +288,43 @@ def test_a_thing_asked_for_by_its_purpose_fills_a_role_of_the_purpose_frame():
     assert purpose_of(doc, extract_frames(doc, LEX)[0], LEX) is None
 
 
+def test_an_object_after_a_particle_read_as_an_adverbial_is_the_object():
+    """ "fry up some bacon": the parser hangs "some bacon" on fry as an adverbial after the particle; it is
+    the object. A span of time stays an adverbial ("fry up every minute")."""
+    bacon = make_doc("fry/VB/ROOT/0 up/RP/prt/0 some/DT/det/3 bacon/NN/npadvmod/0")
+    assert extract_frames(bacon, LEX)[0].to_json() == {
+        "predicate": "fry",
+        "roles": {"Theme": "bacon", "Instrument": None},
+    }
+    minute = make_doc("fry/VB/ROOT/0 up/RP/prt/0 every/DT/det/3 minute/NN/npadvmod/0")
+    assert extract_frames(minute, LEX)[0].roles["Theme"] is None
+
+
+def test_a_learned_verbs_particle_stays_a_particle():
+    """ "bring over the salt": over is one of bring's learned Destination prepositions, but the parser read
+    it as a particle with "the salt" the object, and so it stays; a paper verb's particle that is its
+    role's preposition is that role's ("sprinkle over the salad")."""
+    from dataclasses import replace
+
+    from lmcr.lexicon import PredicateSpec
+
+    bring = PredicateSpec(
+        name="bring",
+        roles=("Theme", "Destination"),
+        object_role="Theme",
+        with_role=None,
+        preps={"Destination": ("over", "into")},
+        particles=frozenset(),
+        alternating=False,
+        sentence="bring {Theme} into the {Destination}",
+    )
+    lex = replace(LEX, predicates={**LEX.predicates, "bring": bring}, learned=frozenset({"bring"}))
+    salt = make_doc("bring/VB/ROOT/0 over/RP/prt/0 the/DT/det/3 salt/NN/dobj/0")
+    assert extract_frames(salt, lex)[0].roles == {"Theme": "salt", "Destination": None}
+    salad = make_doc("sprinkle/VB/ROOT/0 over/RP/prt/0 the/DT/det/3 salad/NN/dobj/0")
+    assert extract_frames(salad, lex)[0].roles == {"Theme": None, "Destination": "salad"}
+
+
 def test_a_reparse_that_hangs_the_object_as_an_adverbial_loses_it():
     """ "toast the bread": behind "Please" the tagger reads toast as a verb but hangs "the bread" on it as an
     adverbial noun phrase; behind "You should" it is the object. A span of time stays an adverbial."""

@@ -14,6 +14,9 @@ from lmcr.srl.lemmas import lemma as lemma_of
 
 OBJECT_DEPS = frozenset({"dobj", "obj", "nsubjpass"})
 NOT_PREDICATE_DEPS = frozenset({"amod", "compound", "aux", "auxpass", "nmod"})
+# determiners that open a thing's noun phrase ("the bread", "some bread"); not "another", "every", "each",
+# which open spans of time ("bake another 10 minutes")
+THING_DETERMINERS = frozenset({"the", "a", "an", "some", "this", "that", "these", "those"})
 NOUN_CLAUSE_DEPS = frozenset({"relcl", "acl"})  # a clause that modifies a noun ("something to drink from")
 SKIPPED_LEMMAS = frozenset({"be", "have", "do", "let", "go", "will", "would", "can", "could", "should"})
 # forms of "be" the lemmatiser leaves as they are when the tagger misreads them
@@ -155,6 +158,21 @@ def _measured(token: Token, lex: Lexicon) -> bool:
     )
 
 
+def _object_after_particle(verb: Token) -> list[Token]:
+    """The noun phrase right after the verb's particle, when the parser hung it on the verb as an adverbial
+    and it opens as a thing's does ("fry up some bacon", "top off my glass"; not "stir up every minute")."""
+    prt = next((c for c in verb.children if c.dep_ == "prt"), None)
+    if prt is None:
+        return []
+    return [
+        c
+        for c in verb.children
+        if c.dep_ == "npadvmod"
+        and c.left_edge.i == prt.i + 1
+        and (c.left_edge.lower_ in THING_DETERMINERS or c.left_edge.tag_ == "PRP$")
+    ][:1]
+
+
 def _attached_preps(token: Token, skip: frozenset[str]) -> list[tuple[str, Token]]:
     """PPs the parser hung on `token` rather than on the verb, other than `skip` ("of" of a measure)."""
     return [
@@ -170,6 +188,8 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:  #
         objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i]  # "fry me an egg"
     if not objects:  # "fry a couple of eggs": the quantity read as an adverbial noun phrase
         objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i and _measured(c, lex)][:1]
+    if not objects:  # "fry up some bacon", "top off my glass": the object read as an adverbial after the particle
+        objects = _object_after_particle(verb)
     if len(objects) > 1:  # "fry me an egg" parsed as two objects: the recipient is not the theme
         objects = [o for o in objects if o.lower_ not in lex.recipient_pronouns] or objects[:1]
     preps: list[tuple[str, Token]] = []
@@ -182,8 +202,9 @@ def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:  #
             preps.append((child.lower_, obj))
         elif child.dep_ == "prt" or child.lower_ in (spec.particles if spec else ()):
             particles.append(child.lower_)
-    # "sprinkle over the salad": the parser's particle is this verb's role preposition, not a particle.
-    if spec and objects and particles:
+    # "sprinkle over the salad": the parser's particle is this verb's role preposition, not a particle; a
+    # learned verb's particle stays one ("bring over the salt": its Destination prepositions are many)
+    if spec and objects and particles and spec.name not in lex.learned:
         prt = next((c for c in verb.children if c.dep_ == "prt"), None)
         if (
             prt is not None

@@ -24,7 +24,7 @@ from lmcr.files import read_resource
 from lmcr.lexicon import PREDICATES_FILE, Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds
 from lmcr.srl.lemmas import LazyLemmas
-from lmcr.srl.mentions import OBJECT_DEPS, FrameMention, extract_frames
+from lmcr.srl.mentions import OBJECT_DEPS, THING_DETERMINERS, FrameMention, extract_frames
 from lmcr.srl.priors import RolePriors
 from lmcr.srl.repair import mend_modal_nouns, rejoin_split_compounds
 from lmcr.srl.spacy_model import spacy_model_from_env
@@ -47,9 +47,6 @@ FIRST_WORD = re.compile(r"^\W*([A-Za-z]+)")
 DIRECT_AFTER = 3
 DIRECT_RATE = 0.9
 COORDINATORS = frozenset({"and", "or", "then", ";", ","})
-# determiners that open a thing's noun phrase ("the bread", "some bread"); not "another", "every", "each",
-# which open spans of time ("bake another 10 minutes")
-THING_DETERMINERS = frozenset({"the", "a", "an", "some", "this", "that", "these", "those"})
 MAX_DEPTH = 3
 # Components frame extraction never reads, and ones replaced by lazy lemmas (half the model's time).
 UNUSED = ("ner",)
