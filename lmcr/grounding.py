@@ -41,10 +41,11 @@ MADE_AT_DESTINATION = frozenset({"cut", "cook"})
 
 
 def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
-    """ "bring me the soap", "get me something to drink from": a learned verb of the place class said to
-    the person who asks as its recipient ("me", "us": `Lexicon.speaker_pronouns`) puts its Theme in their
-    hands, so the detected object that is that person (`Lexicon.speaker_labels`) fills its open
-    Destination. The paper's verbs keep their own reading ("pour me some water": into a cup)."""
+    """ "bring me the soap", "get me something to drink from": a learned verb said to the person who asks
+    as its recipient ("me", "us": `Lexicon.speaker_pronouns`) puts its Theme in their hands, so the
+    detected object that is that person (`Lexicon.speaker_labels`) fills its open Destination. Not for a
+    verb of a class that makes something at its Destination (`MADE_AT_DESTINATION`); the paper's verbs
+    keep their own reading ("pour me some water": into a cup)."""
     lex, open_role = parser.lex, "Destination"
     spec = lex.predicates.get(frame.predicate)
     if frame.predicate not in lex.learned or spec is None or spec.motion in MADE_AT_DESTINATION:

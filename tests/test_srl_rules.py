@@ -286,6 +286,12 @@ def test_a_thing_asked_for_by_its_purpose_fills_a_role_of_the_purpose_frame():
     assert purpose_of(doc, get, LEX) == Purpose("pour", {"Destination": "bowl"}, "Theme")
     doc = make_doc("hand/VB/ROOT/0 me/PRP/dative/0 the/DT/det/3 knife/NN/dobj/0")
     assert purpose_of(doc, extract_frames(doc, LEX)[0], LEX) is None
+    # the clause states every role the thing could fill: what it is for leaves it none
+    doc = make_doc(
+        "hand/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 season/VB/relcl/2 the/DT/det/6 "
+        "steak/NN/dobj/4 with/IN/prep/4 salt/NN/pobj/7"
+    )
+    assert purpose_of(doc, next(f for f in extract_frames(doc, LEX) if f.predicate == "hand"), LEX) is None
 
 
 def test_an_object_after_a_particle_read_as_an_adverbial_is_the_object():

@@ -181,13 +181,17 @@ def purpose_of(doc: Doc, mention: FrameMention, lex: Lexicon, compounds: Compoun
         next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ in lex.object_pronouns), None) if verb else None
     )
     clause = next((c for c in thing.children if c.dep_ in NOUN_CLAUSE_DEPS), None) if thing is not None else None
-    found = clause is not None and next((f for f in extract_frames(doc, lex, compounds) if f.start == clause.idx), None)
-    spec = lex.predicates.get(found.predicate) if found else None
+    found = next((f for f in extract_frames(doc, lex, compounds) if f.start == clause.idx), None) if clause else None
+    spec = lex.predicates.get(found.predicate) if found is not None else None
     if spec is None:
         return None
     stranded = [c.lower_ for c in clause.children if c.dep_ == "prep" and not any(g.dep_ == "pobj" for g in c.children)]
     gap = spec.prep_role(stranded[0]) if stranded else spec.object_role
+    if (
+        gap is None
+        or gap not in (*spec.roles, *spec.alternatives)
+        or found.roles.get(gap) not in (None, *lex.object_pronouns)
+    ):
+        return None  # no role the thing could fill, or the clause states it ("to season the steak with salt")
     roles = {r: v for r, v in found.roles.items() if v and r != gap and v not in lex.object_pronouns}
-    if gap is None or gap not in (*spec.roles, *spec.alternatives) or gap in roles:
-        return None
     return Purpose(found.predicate, roles, gap)
