@@ -34,14 +34,12 @@ from pathlib import Path
 from bench_end_to_end import SLOW, timed_batch
 from record import add_json_option, write_results
 
-from lmcr.complete import CompletionError, complete
-from lmcr.evaluate.external import right_predicate
+from lmcr.evaluate.external import complete_line, right_predicate
 from lmcr.jsonl import InputError, read_jsonl
 from lmcr.lexicon import normalize_name as normalize
 from lmcr.partial import SIDECAR
 from lmcr.robot.scene import has_shape, scene_from_json
 from lmcr.scorers.registry import COMPLETION_METHOD
-from lmcr.srl.instruction import NoPredicateError
 from lmcr.workspace import Workspace
 
 FIELDS = {"id": (str, int), "instruction": str, "objects": list, "missing": str, "expected": dict, "verb": str}
@@ -116,10 +114,7 @@ def batch_lines(sets: Path, seed: int) -> tuple[list[dict], list[dict], collecti
     records, lines, unfit, wrong = [], [], collections.Counter(), collections.Counter()
     for path in sorted(sets.glob("*.jsonl")):
         for k, (_, record) in enumerate(read_jsonl(path, FIELDS)):
-            try:
-                said = complete(parser, scorer, record["instruction"], record["objects"], config).to_json()
-            except (NoPredicateError, CompletionError, InputError) as exc:
-                said = {"error": str(exc)}
+            said = complete_line(parser, scorer, config, record["instruction"], record["objects"])
             if not completed_right(record, said):
                 wrong[path.stem] += 1
                 continue

@@ -181,11 +181,19 @@ def complete_item(
     """The item completed as `lmcr complete` completes an input line (its output line, `{"error": reason}`
     where there is no completion) and the milliseconds it took."""
     started = time.perf_counter()
-    try:
-        line = complete(parser, scorer, item.instruction, list(item.objects), config).to_json()
-    except (NoPredicateError, CompletionError, InputError) as exc:  # what `lmcr complete` reports per line
-        line = {"error": one_line(exc)}
+    line = complete_line(parser, scorer, config, item.instruction, list(item.objects))
     return {"id": item.id, **line}, 1000 * (time.perf_counter() - started)
+
+
+def complete_line(
+    parser: FrameParser, scorer: Scorer, config: CompletionConfig, instruction: str, objects: list[str]
+) -> dict:
+    """The instruction completed with the objects as `lmcr complete` writes its output line (without the
+    id), or `{"error": reason}` where there is no completion."""
+    try:
+        return complete(parser, scorer, instruction, objects, config).to_json()
+    except (NoPredicateError, CompletionError, InputError) as exc:  # what `lmcr complete` reports per line
+        return {"error": one_line(exc)}
 
 
 def run_set(

@@ -29,7 +29,7 @@ from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
-from lmcr.robot.tasks import MOTIONS, SERVE, TASKS, TOOL_MOTIONS, Task, scoops, task_for
+from lmcr.robot.tasks import COOK, MOTIONS, SERVE, TASKS, TOOL_MOTIONS, Task, scoops, task_for
 from lmcr.robot.world import build_world
 from lmcr.srl.instruction import NoPredicateError
 
@@ -40,7 +40,7 @@ ROBOT_EDGE = (-X_LIMIT, 0.0)  # the middle of the table's edge at the robot (tab
 
 # the motions a learned verb may have: by its Destination's kind, and its class's with a tool or a ladle,
 # or putting the Theme where it cooks
-LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion, "cook"})
+LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion, *(task.motion for task in COOK.values())})
 
 
 class NoMotionError(NoPredicateError):
