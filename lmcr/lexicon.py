@@ -126,6 +126,11 @@ class Lexicon:
         """The predicates of the hand-written lexicon (the paper's eleven)."""
         return sorted(p for p in self.predicates if p not in self.learned)
 
+    @property
+    def motion_classes(self) -> dict[str, str]:
+        """predicate -> its class of motion, for the predicates that have one (the learned ones)."""
+        return {name: spec.motion for name, spec in self.predicates.items() if spec.motion}
+
 
 def _spec(name: str, spec: dict) -> PredicateSpec:
     return PredicateSpec(

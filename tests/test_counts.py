@@ -39,6 +39,40 @@ def test_smoothed_estimates_by_hand():
     )
 
 
+def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
+    # "put away" put a book in a box once and never stated milk's place; "store", of the same class, put milk
+    # in the fridge twice
+    fillers = [
+        ("put away", "Theme", "milk", 1),
+        ("put away", "Theme", "book", 1),
+        ("put away", "Destination", "box", 1),
+        ("store", "Theme", "milk", 2),
+        ("store", "Destination", "fridge", 2),
+    ]
+    pairs = [
+        ("store", "Theme", "milk", "Destination", "fridge", 2),
+        ("store", "Destination", "fridge", "Theme", "milk", 2),
+        ("put away", "Theme", "book", "Destination", "box", 1),
+        ("put away", "Destination", "box", "Theme", "book", 1),
+    ]
+    m = FrameCountScorer(fillers, pairs, alpha=2.0, classes={"put away": "place", "store": "place"})
+    flat = FrameCountScorer(fillers, pairs, alpha=2.0)
+    own = m.p_filler("put away", "Destination", "fridge")
+    kind = (2 + 2 * own) / (2 + 2)  # the class's places given milk: store's fridge twice
+    assert m.p_given("put away", "Theme", "milk", "Destination", "fridge") == pytest.approx(kind)  # put away: none
+    assert flat.p_given("put away", "Theme", "milk", "Destination", "fridge") == pytest.approx(own)
+    # without the class, milk goes where put away put anything (the box); with it, into the fridge
+    frames = [("put away", {"Theme": "milk", "Destination": d}) for d in ("fridge", "box")]
+    fridge, box = m.score_frames(frames)
+    assert fridge > box
+    fridge, box = flat.score_frames(frames)
+    assert box > fridge
+    # a predicate of no class scores as without classes
+    plain = ("pour", {"Theme": "water", "Destination": "cup"})
+    with_classes = FrameCountScorer(FILLERS, PAIRS, classes={"put away": "place"})
+    assert with_classes.score_frame(plain) == FrameCountScorer(FILLERS, PAIRS).score_frame(plain)
+
+
 def test_a_verb_never_seen_with_a_filler_backs_off_to_what_fills_the_role():
     m = FrameCountScorer(FILLERS, PAIRS)
     # cut never had a Destination: a cup (a Destination of pour, 3 times) outscores water (only ever a Theme)

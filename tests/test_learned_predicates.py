@@ -422,6 +422,27 @@ def test_each_learned_verb_gets_the_class_of_motion_its_fillers_are_most_like(tm
     assert table.to_json()["predicates"]["whisk"]["spec"]["motion"] == "stir"
 
 
+def test_a_learned_verbs_pairs_back_off_to_what_its_class_does(tmp_path):
+    """'put away' never says where a cup goes; the verbs of its class (put, transfer) put cups in glasses,
+    while a bowl is where most things go: the class decides, as the count model reads the published table."""
+    frames = _kitchen()
+    frames += [("put", {"Theme": "cup", "in": "glass"}, False)] * 5
+    frames += [("transfer", {"Theme": "milk", "into": "glass"}, False)] * 20
+    frames += [("transfer", {"Theme": "cup", "in": "glass"}, False)] * 5
+    con = _store(tmp_path, frames)
+    srl = tmp_path / "srl"
+    srl.mkdir()
+    refresh_predicates(con, HAND, srl, "build-1")
+    con.close()
+    classes = load_lexicon(learned=srl / PREDICATES_FILE).motion_classes
+    assert classes["put away"] == classes["put"] == classes["transfer"] == "place" and "pour" not in classes
+    glass, bowl = (Frame.of("put away", {"Theme": "cup", "Destination": d}) for d in ("glass", "bowl"))
+    flat = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL)
+    assert flat.score_frame(bowl) > flat.score_frame(glass)
+    counts = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL, classes=classes)
+    assert counts.score_frame(glass) > counts.score_frame(bowl)
+
+
 def test_without_a_prototype_no_class_is_guessed(tmp_path):
     frames = [f for f in _kitchen() if f[0] != "put"]
     table = learn_predicates(_store(tmp_path, frames), HAND)

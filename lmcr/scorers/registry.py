@@ -110,7 +110,9 @@ def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
 def _frame_counts(res: MethodResources) -> Scorer:
     from lmcr.scorers.frame_counts import FrameCountScorer
 
-    counts = FrameCountScorer.from_store(store_path(res, "frame_counts"), res.sql_dir, res.corpus, mixture=res.mixture)
+    classes = load_lexicon(learned=res.predicates).motion_classes  # a learned verb's pairs back off to its class's
+    db = store_path(res, "frame_counts")
+    counts = FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes)
     return counts.score_frames
 
 
