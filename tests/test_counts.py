@@ -73,6 +73,32 @@ def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
     assert with_classes.score_frame(plain) == FrameCountScorer(FILLERS, PAIRS).score_frame(plain)
 
 
+def test_a_phrasal_verbs_pairs_back_off_to_its_base_verbs_first():
+    # "warm up" stated its place only for soup (the pot); "warm" warms milk in the microwave; the class
+    # (placing verbs, which put milk in the fridge) comes after the base verb
+    fillers = [
+        ("warm up", "Theme", "soup", 2),
+        ("warm up", "Destination", "pot", 2),
+        ("warm", "Theme", "milk", 3),
+        ("warm", "Destination", "microwave", 3),
+        ("store", "Theme", "milk", 30),
+        ("store", "Destination", "fridge", 30),
+    ]
+    pairs = [
+        ("warm up", "Theme", "soup", "Destination", "pot", 2),
+        ("warm", "Theme", "milk", "Destination", "microwave", 3),
+        ("store", "Theme", "milk", "Destination", "fridge", 30),
+    ]
+    m = FrameCountScorer(fillers, pairs, alpha=2.0, classes={"warm up": "place", "store": "place"})
+    assert m.base == {"warm up": "warm"}
+    own = m.p_filler("warm up", "Destination", "microwave")
+    kind = (0 + 2 * own) / (30 + 2)  # the class's places given milk: the fridge 30 times, no microwave
+    base = (3 + 2 * kind) / (3 + 2)  # warm warmed milk in the microwave 3 times
+    assert m.p_given("warm up", "Theme", "milk", "Destination", "microwave") == pytest.approx((0 + 2 * base) / 2)
+    scores = m.score_frames([("warm up", {"Theme": "milk", "Destination": d}) for d in ("microwave", "fridge", "pot")])
+    assert scores[0] == max(scores)
+
+
 def test_a_verb_never_seen_with_a_filler_backs_off_to_what_fills_the_role():
     m = FrameCountScorer(FILLERS, PAIRS)
     # cut never had a Destination: a cup (a Destination of pour, 3 times) outscores water (only ever a Theme)

@@ -423,20 +423,21 @@ def test_each_learned_verb_gets_the_class_of_motion_its_fillers_are_most_like(tm
 
 
 def test_a_learned_verbs_pairs_back_off_to_what_its_class_does(tmp_path):
-    """'put away' never says where a cup goes; the verbs of its class (put, transfer) put cups in glasses,
-    while a bowl is where most things go: the class decides, as the count model reads the published table."""
+    """'stash' never says where a cup goes and stashes most things in bowls; the verbs of its class (put,
+    transfer) put cups in glasses: the class decides, as the count model reads the published table."""
     frames = _kitchen()
     frames += [("put", {"Theme": "cup", "in": "glass"}, False)] * 5
     frames += [("transfer", {"Theme": "milk", "into": "glass"}, False)] * 20
     frames += [("transfer", {"Theme": "cup", "in": "glass"}, False)] * 5
+    frames += [("stash", {"Theme": "milk", "in": "bowl"}, False)] * 20 + [("stash", {"Theme": "cup"}, False)] * 5
     con = _store(tmp_path, frames)
     srl = tmp_path / "srl"
     srl.mkdir()
     refresh_predicates(con, HAND, srl, "build-1")
     con.close()
     classes = load_lexicon(learned=srl / PREDICATES_FILE).motion_classes
-    assert classes["put away"] == classes["put"] == classes["transfer"] == "place" and "pour" not in classes
-    glass, bowl = (Frame.of("put away", {"Theme": "cup", "Destination": d}) for d in ("glass", "bowl"))
+    assert classes["stash"] == classes["put"] == classes["transfer"] == "place" and "pour" not in classes
+    glass, bowl = (Frame.of("stash", {"Theme": "cup", "Destination": d}) for d in ("glass", "bowl"))
     flat = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL)
     assert flat.score_frame(bowl) > flat.score_frame(glass)
     counts = FrameCountScorer.from_store(tmp_path / "lmcr.duckdb", SQL, classes=classes)
