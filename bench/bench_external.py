@@ -6,8 +6,10 @@ Usage: python bench/bench_external.py [--sets DIR] [--data-dir DIR] [--method M]
 calibration `lmcr evaluate` wrote there, as for `lmcr complete`. Per set: right predicate (named with
 its particle: `put away`) and missing role, top guess among `expected_any`, questions asked (help rate),
 how often the prediction set holds a right object and its mean size (KnowNo's success and help), the
-share with no completion and why, and the latency of one completion (p50, p90). The measures are
-defined in lmcr/evaluate/external.py. --out-jsonl writes one line per item: its set, the completion
+share with no completion and why, and the latency of one completion (p50, p90). Then, per set, the
+learned verbs' prediction sets had they been calibrated (`lmcr evaluate --requests`) on the other three
+sets' requests: how often they hold a right object, and their mean size. The measures are defined in
+lmcr/evaluate/external.py. --out-jsonl writes one line per item: its set, the completion
 line (`prediction_set` included, or its error) and its outcome.
 
 --peer [GGUF] adds the peer's rows (lmcr/evaluate/peer.py): the same items put zero-shot to a small
@@ -24,7 +26,7 @@ from pathlib import Path
 from record import add_json_option, run_or_exit, write_results
 
 from lmcr.evaluate import peer
-from lmcr.evaluate.external import read_sets, run_set, summarize
+from lmcr.evaluate.external import cross_calibrated, read_sets, run_set, summarize
 from lmcr.files import check_output_file
 from lmcr.jsonl import InputError, write_jsonl_atomic
 from lmcr.scorers.registry import COMPLETION_METHOD
@@ -41,6 +43,12 @@ COLUMNS = (
     ("p50 ms", "p50 ms", "{:.1f}"),
     ("p90 ms", "p90 ms", "{:.1f}"),
 )
+CROSS_COLUMNS = (
+    ("set holds", "set holds a right object", "{:.3f}"),
+    ("set size", "mean set size", "{:.2f}"),
+    ("temperature", "temperature", "{:.3g}"),
+    ("threshold", "set threshold", "{:.4f}"),
+)
 
 
 def sets_folder(given: Path | None) -> Path:
@@ -53,14 +61,14 @@ def sets_folder(given: Path | None) -> Path:
     return Path(shared) / "eval" / "external"
 
 
-def table(summaries: dict[str, dict]) -> str:
+def table(summaries: dict[str, dict], columns: tuple = COLUMNS) -> str:
     """The sets' figures, one row per set."""
 
     def cell(value, form: str) -> str:
         return "-" if value is None else form.format(value)
 
-    rows = [["set", *(head for head, _, _ in COLUMNS)]]
-    rows += [[name, *(cell(s[key], form) for _, key, form in COLUMNS)] for name, s in summaries.items()]
+    rows = [["set", *(head for head, _, _ in columns)]]
+    rows += [[name, *(cell(s[key], form) for _, key, form in columns)] for name, s in summaries.items()]
     widths = [max(len(row[k]) for row in rows) for k in range(len(rows[0]))]
     return "\n".join(
         "  ".join(c.rjust(w) if k else c.ljust(w) for k, (c, w) in enumerate(zip(row, widths))) for row in rows
@@ -116,19 +124,30 @@ def product_rows(ws: Workspace, method: str, sets: dict, lines: list) -> dict:
     scorer, config = ws.completion_scorer(method)
     parser = ws.parser()
     print(f"{method}; {config.source}")
-    summaries = {}
+    summaries, completed = {}, {}
     for name, items in sets.items():
         done = run_set(parser, scorer, config, items)
         summaries[name] = summarize(items, [outcome for _, outcome in done])
+        completed[name] = [line for line, _ in done]
         lines += [{"set": name, **line, "outcome": outcome_fields(outcome)} for line, outcome in done]
     print(table(summaries))
     for name, summary in summaries.items():
         reasons = ", ".join(f"{reason} {count}" for reason, count in summary["error reasons"].items())
         print(f"{name}: errors: {reasons or 'none'}")
-    figures = {"method": method, "calibration": config.source}
+    figures = {"method": method, "calibration": config.source, "learned verbs' calibration": learned_source(config)}
     for name, summary in summaries.items():
         figures |= flat(name, summary)
+    cross = cross_calibrated(sets, completed, parser.lex.learned)
+    print("the learned verbs' prediction sets calibrated on the other sets' requests (lmcr evaluate --requests):")
+    print(table(cross, CROSS_COLUMNS))
+    for name, row in cross.items():
+        figures |= {f"cross-calibrated: {name}: {k}": v for k, v in row.items()}
     return figures
+
+
+def learned_source(config) -> str:
+    """Where the learned verbs' temperature and threshold came from."""
+    return config.learned_source or "as the eleven's (no `lmcr evaluate --requests` calibration)"
 
 
 def peer_table(ws: Workspace, gguf: str | None, sets: dict, lines: list) -> dict:

@@ -51,9 +51,36 @@ class CompletionConfig:
     # against scoring the frame alone (README, Completion).
     context: bool = True
     source: str = "default"  # where the numbers came from
+    # The learned verbs' own temperature and threshold, calibrated on household requests (`lmcr evaluate
+    # --requests`): the dev ratings are recipe steps of the eleven, whose calibration holds the right object
+    # of a household request a quarter of the time. None: the eleven's serve for them too.
+    learned_temperature: float | None = None
+    learned_set_threshold: float | None = None
+    learned_source: str = ""
 
     def to_json(self) -> dict:
         return asdict(self)
+
+    def calibrated_for(self, learned: bool) -> CompletionConfig:
+        """The temperature and threshold that hold for a predicate: a learned one's own where they were
+        calibrated, else this config's."""
+        if not learned or self.learned_temperature is None or self.learned_set_threshold is None:
+            return self
+        return replace(
+            self,
+            temperature=self.learned_temperature,
+            set_threshold=self.learned_set_threshold,
+            source=self.learned_source,
+        )
+
+    def with_learned(self, learned: CompletionConfig) -> CompletionConfig:
+        """This config with `learned`'s temperature and threshold as the learned verbs' own."""
+        return replace(
+            self,
+            learned_temperature=learned.temperature,
+            learned_set_threshold=learned.set_threshold,
+            learned_source=learned.source,
+        )
 
 
 @dataclass(frozen=True)
@@ -220,6 +247,7 @@ def complete(
     if not missing:
         return replace(read, frame=Frame.of(frame.predicate, roles), instances=_instances(roles, ids_of))
     spec = parser.lex.predicates[frame.predicate]
+    config = config.calibrated_for(frame.predicate in parser.lex.learned)
     pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)
@@ -369,7 +397,9 @@ def _instances(roles: dict[str, str | None], ids_of: dict[str, list[str]]) -> di
     return {role: ids_of.get(value, []) if value else [] for role, value in roles.items()}
 
 
-def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str = "") -> CompletionConfig:
+def calibrate(
+    positive_first: list[list[float]], alpha: float = 0.1, source: str = "", what: str = "dev scenarios"
+) -> CompletionConfig:
     """Temperature and prediction-set threshold from dev scenarios, each a list of scores with the
     right (positive) candidate first.
 
@@ -392,7 +422,7 @@ def calibrate(positive_first: list[list[float]], alpha: float = 0.1, source: str
     return CompletionConfig(
         temperature=temperature,
         set_threshold=max(1 - q, 1e-6),
-        source=source or f"calibrated on {n} dev scenarios (alpha={alpha:g}, NLL {nll(temperature):.3f})",
+        source=source or f"calibrated on {n} {what} (alpha={alpha:g}, NLL {nll(temperature):.3f})",
     )
 
 
@@ -422,10 +452,19 @@ def calibration_file(method: str, res, calibration_dir: Path) -> tuple[Path, str
     return calibration_dir / f"{method}-{res.corpus}-{tag}.json", fingerprint
 
 
+def requests_calibration_file(path: Path) -> Path:
+    """Where the learned verbs' calibration on household requests lives beside a method's (`calibration_file`)."""
+    return path.with_name(f"{path.stem}-requests{path.suffix}")
+
+
 def completion_scorer(method: str, res, calibration_dir: Path) -> tuple[Scorer, CompletionConfig]:
     """The scorer of `method` and the completion settings `lmcr evaluate` calibrated for exactly what it
-    is built from (its fingerprint), or uncalibrated defaults when there are none."""
+    is built from (its fingerprint), with the learned verbs' own when it calibrated them on requests too;
+    uncalibrated defaults when there are none."""
     scorer = make_scorer(method, res)
     path, fingerprint = calibration_file(method, res, calibration_dir)
     config = load_config(path, fingerprint) if fingerprint else None
-    return scorer, config or CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")
+    if config is None:
+        return scorer, CompletionConfig(source="uncalibrated defaults (run `lmcr evaluate`)")
+    learned = load_config(requests_calibration_file(path), fingerprint)
+    return scorer, config.with_learned(learned) if learned else config

@@ -445,6 +445,20 @@ def test_default_methods_that_cannot_be_built_are_skipped_with_a_note(tmp_path, 
     assert json.loads((tmp_path / "report" / "figures.json").read_text())["table1"].keys() == {"random"}
 
 
+def test_requests_to_calibrate_on_are_read_before_the_evaluation(tmp_path, sample_dir):
+    """A bad requests file is refused in one line naming file and line, before any report is written;
+    --requests asks for a calibration, so --no-calibrate beside it is refused too."""
+    bad = tmp_path / "requests.jsonl"
+    bad.write_text('{"id": 1, "instruction": "put the milk away", "objects": ["milk"]}\n')
+    result = evaluate_sample(
+        tmp_path, sample_dir, str(tmp_path / "report"), "--methods", "random", "--requests", str(bad)
+    )
+    assert f"{bad}:1" in one_line_error(result) and not (tmp_path / "report").exists()
+    args = ("--methods", "random", "--requests", str(bad), "--no-calibrate")
+    result = evaluate_sample(tmp_path, sample_dir, str(tmp_path / "report"), *args)
+    assert "--no-calibrate" in one_line_error(result) and not (tmp_path / "report").exists()
+
+
 # 6. the evaluation's cached result is JSON
 
 

@@ -213,6 +213,31 @@ def test_a_scorer_is_one_registry_entry(monkeypatch):
     assert methods.scorer_fingerprint("verb_length+random", res) is None  # random is never calibrated
 
 
+def test_the_learned_verbs_calibration_is_read_beside_the_methods_and_only_with_it(monkeypatch, tmp_path):
+    """`lmcr evaluate --requests` saves the learned verbs' calibration beside the method's, under its
+    fingerprint: completion reads both; without the method's own, or under another fingerprint, neither."""
+    from lmcr.complete import calibration_file, completion_scorer, requests_calibration_file
+    from lmcr.scorers import registry as methods
+    from lmcr.scorers.resources import MethodResources
+
+    spec = methods.ScorerSpec(lambda res: lambda frames: [0.0] * len(frames), lambda res: "const-v1")
+    monkeypatch.setitem(methods.SCORERS, "const", spec)
+    res = MethodResources(checkpoints=tmp_path / "none")
+    path, fingerprint = calibration_file("const", res, tmp_path)
+    learned = CompletionConfig(temperature=9.0, set_threshold=0.1, source="requests")
+    save_config(learned, requests_calibration_file(path), fingerprint)
+    assert completion_scorer("const", res, tmp_path)[1].learned_temperature is None  # uncalibrated defaults
+    save_config(CompletionConfig(temperature=2.0, set_threshold=0.5, source="ratings"), path, fingerprint)
+    config = completion_scorer("const", res, tmp_path)[1]
+    assert (config.temperature, config.calibrated_for(True).temperature, config.learned_source) == (
+        2.0,
+        9.0,
+        "requests",
+    )
+    save_config(learned, requests_calibration_file(path), "another scorer")
+    assert completion_scorer("const", res, tmp_path)[1].calibrated_for(True).temperature == 2.0
+
+
 def test_a_modifier_the_parser_kept_does_not_hide_a_detected_object(parser):
     """Without learned compounds the parser keeps "leftover pizza" whole; the robot sees a pizza."""
     assert parse_instruction(parser, "heat the leftover pizza").roles["Theme"] == "leftover pizza"

@@ -13,10 +13,12 @@ import pytest
 from lmcr.checkout import REPO_ROOT
 from lmcr.evaluate.external import (
     ExternalItem,
+    cross_calibrated,
     error_reason,
     percentile,
     read_items,
     read_sets,
+    right_first,
     right_predicate,
     score,
     summarize,
@@ -124,6 +126,41 @@ def test_missing_roles_left_open_by_a_pronoun():
         "put away", {}, ["Theme", "Destination"], [{"Theme": "storage box", "Destination": "coffee table"}], 1
     )
     assert not score(PUT_AWAY, line).right_role
+
+
+def test_right_first_puts_the_best_right_candidate_first_and_leaves_the_other_right_ones_out():
+    ranked = [{"Destination": "storage box"}, {"Destination": "coffee table"}, {"Destination": "sofa"}]
+    line = completion("put away", {"Theme": "orange"}, ["Destination"], ranked, 1)  # scores 0, -1, -2
+    assert right_first(PUT_AWAY, line) == [-1, 0, -2]
+    two = ExternalItem(**{**PUT_AWAY.__dict__, "expected_any": ("coffee table", "sofa")})
+    assert right_first(two, line) == [-1, 0]
+    # nothing to calibrate on: a wrong predicate, no right candidate, an error
+    assert right_first(PUT_AWAY, completion("season", {"Theme": "orange"}, ["Destination"], ranked, 1)) is None
+    assert right_first(PUT_AWAY, completion("put away", {"Theme": "orange"}, ["Destination"], ranked[:1], 1)) is None
+    assert right_first(PUT_AWAY, {"error": "no known predicate"}) is None
+
+
+def test_each_sets_prediction_sets_are_calibrated_on_the_other_sets():
+    """A set whose right object is always second, calibrated on one where it is always first, keeps a set of
+    one that never holds it; the other way round, the sets widen and hold it. A line of the eleven keeps
+    its own set, and a set with nothing to calibrate on has no figures."""
+    first = [{"Destination": "coffee table"}, {"Destination": "storage box"}]
+    second = first[::-1]
+    items = {"easy": [PUT_AWAY] * 10, "hard": [PUT_AWAY] * 10}
+    easy = completion("put away", {"Theme": "orange"}, ["Destination"], first, 1)
+    easy["candidates"][1]["score"] = -0.5  # closer than the hard set's, whose calibration then holds both
+    lines = {
+        "easy": [easy] * 10,
+        "hard": [completion("put away", {"Theme": "orange"}, ["Destination"], second, 1)] * 10,
+    }
+    rows = cross_calibrated(items, lines, frozenset({"put away"}))
+    assert rows["hard"]["set holds a right object"] == 0.0 and rows["hard"]["mean set size"] == 1.0
+    assert rows["easy"]["set holds a right object"] == 1.0 and rows["easy"]["mean set size"] == 2.0
+    eleven = cross_calibrated(items, lines, frozenset())
+    assert eleven["easy"]["set holds a right object"] is None and eleven["easy"]["mean set size"] is None
+    pour = completion("pour", {"Theme": "water"}, ["Destination"], [{"Destination": "coffee table"}], 0)
+    mixed = cross_calibrated({**items, "eleven": [PUT_AWAY]}, {**lines, "eleven": [pour]}, frozenset({"put away"}))
+    assert mixed["eleven"]["mean set size"] == 0.0  # its own (empty) set
 
 
 def test_an_error_is_right_at_nothing_and_its_reason_is_counted():

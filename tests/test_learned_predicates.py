@@ -253,6 +253,41 @@ def test_a_learned_verb_is_completed_and_asked_about_like_the_eleven(learned_par
 
 
 @pytest.mark.model
+def test_a_learned_verb_uses_its_own_calibration_where_requests_calibrated_one(learned_parser):
+    """The eleven's threshold puts the likelier of two close objects alone in the set; the learned verbs'
+    own (calibrated on household requests) keeps both, and the eleven keep theirs."""
+    from lmcr.complete import CompletionConfig, complete
+
+    close = _prefer("fridge", "bowl")  # scores 0 and -1
+    eleven = CompletionConfig(temperature=1.0, set_threshold=0.6)
+    both = eleven.with_learned(CompletionConfig(temperature=10.0, set_threshold=0.3, source="requests"))
+    assert both.calibrated_for(True).set_threshold == 0.3 and both.calibrated_for(False) == both
+    objects = ["milk", "bowl", "fridge"]
+    assert complete(learned_parser, close, "put the milk away", objects, eleven).prediction_set == ("fridge",)
+    assert complete(learned_parser, close, "put the milk away", objects, both).prediction_set == ("fridge", "bowl")
+    pour = complete(learned_parser, _prefer("bowl", "fridge"), "pour the milk", objects, both)
+    assert pour.prediction_set == ("bowl",)  # one of the eleven: its own threshold
+
+
+@pytest.mark.model
+def test_requests_calibrate_the_learned_verbs_and_leave_the_eleven_out(learned_parser):
+    from lmcr.complete import CompletionConfig, CompletionError
+    from lmcr.evaluate.external import ExternalItem, calibrate_requests
+
+    def item(instruction: str, verb: str, right: str) -> ExternalItem:
+        objects = ("milk", "bowl", "fridge")
+        return ExternalItem(instruction, instruction, objects, verb, "Destination", ("Destination",), (right,))
+
+    away = [item("put the milk away", "put away", "fridge")] * 9 + [item("put the milk away", "put away", "bowl")]
+    pour = item("pour the milk", "pour", "bowl")
+    cal = calibrate_requests(learned_parser, _prefer("fridge", "bowl"), CompletionConfig(), [*away, pour])
+    assert cal.source.startswith("calibrated on 10 of 11 household requests (alpha=0.1")  # pour left out
+    assert 0 < cal.set_threshold < 1  # one right object in ten is the second: the set must widen for it
+    with pytest.raises(CompletionError, match="none of 1 requests"):
+        calibrate_requests(learned_parser, _prefer("fridge", "bowl"), CompletionConfig(), [pour])
+
+
+@pytest.mark.model
 def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parser):
     from lmcr.complete import CompletionConfig, complete
 

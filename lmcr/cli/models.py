@@ -147,6 +147,11 @@ def evaluate(
     paper: Path | None = typer.Option(
         None, help="The paper's LaTeX source: its Table I beside ours (default $LMCR_PAPER; none: no paper columns)."
     ),
+    requests: Path | None = typer.Option(
+        None,
+        help="Household requests (a JSONL file in the external sets' format, or a folder of them) to calibrate "
+        "the learned verbs' completion on, beside the ratings' calibration.",
+    ),
 ) -> None:
     """The paper's evaluation on rated frames: Table I, Fig. 4 A-D, with a report."""
     from lmcr.evaluate.run import run_evaluation
@@ -155,6 +160,9 @@ def evaluate(
     ws = Workspace.from_env()
     res = ws.resources(checkpoint, "all", vectors, conceptnet, seed)
     check_output_dir(out)  # before the work: a user's folder is refused at once, not after the evaluation
+    if requests is not None and not calibrate:
+        fail("--requests calibrates completion: it cannot be given with --no-calibrate")
+    items = _requests(requests) if requests is not None else None  # a bad file fails before the evaluation
     rated = _rated_frames(ratings, ws)
     # what the user named must build; the defaults may be skipped (a setting not trained, no ConceptNet)
     default_methods, default_settings = list(EVALUATED), [s.label for s in ALL_SETTINGS]
@@ -176,7 +184,41 @@ def evaluate(
     )
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
+    if items is not None:
+        _calibrate_learned(ws, res, [m for m in chosen_methods if m in results.table1], items)
     console.print(f"report: {out / 'report.html'}")
+
+
+def _requests(path: Path) -> list:
+    from lmcr.evaluate.external import read_requests
+
+    return read_requests(path)
+
+
+def _calibrate_learned(ws: Workspace, res, methods: list[str], items: list) -> None:
+    """Calibrate the learned verbs' completion on the requests for each method the ratings calibrated, and
+    save it beside that calibration, under the same fingerprint."""
+    from lmcr.complete import CompletionError, calibration_file, load_config, requests_calibration_file, save_config
+    from lmcr.evaluate.external import calibrate_requests
+    from lmcr.scorers.registry import make_scorer
+
+    parser = ws.parser()
+    for method in methods:
+        path, fingerprint = calibration_file(method, res, ws.calibration)
+        config = load_config(path, fingerprint) if fingerprint else None
+        if config is None:
+            continue  # not calibrated on the ratings: there is nothing to put it beside
+        try:
+            learned = calibrate_requests(parser, make_scorer(method, res), config, items)
+        except CompletionError as exc:  # the ratings' calibration stands: the learned verbs keep using it
+            console.print(f"{method} learned verbs not calibrated: {exc}", highlight=False)
+            continue
+        save_config(learned, requests_calibration_file(path), fingerprint)
+        console.print(
+            f"{method} learned verbs: temperature {learned.temperature:.3g}, prediction-set threshold "
+            f"p >= {learned.set_threshold:.3f} ({learned.source})",
+            highlight=False,
+        )
 
 
 def _rated_frames(ratings: Path, ws: Workspace) -> list:

@@ -34,7 +34,7 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from lmcr.complete import CompletionConfig, CompletionError, complete
+from lmcr.complete import CompletionConfig, CompletionError, calibrate, complete, softmax
 from lmcr.errors import one_line
 from lmcr.jsonl import InputError, check_text, read_jsonl
 from lmcr.lexicon import normalize_name as normalize
@@ -111,6 +111,14 @@ def read_sets(folder: Path) -> dict[str, list[ExternalItem]]:
     if not files:
         raise InputError(f"{folder}: no request sets (*.jsonl)")
     return {path.stem: read_items(path) for path in files}
+
+
+def read_requests(path: Path) -> list[ExternalItem]:
+    """The items of one set's file, or of every set of a folder (`read_sets`), in order."""
+    path = Path(path)
+    if path.is_dir():
+        return [item for items in read_sets(path).values() for item in items]
+    return read_items(path)
 
 
 def right_predicate(read: str | None, verb: str) -> bool:
@@ -194,6 +202,87 @@ def complete_line(
         return complete(parser, scorer, instruction, objects, config).to_json()
     except (NoPredicateError, CompletionError, InputError) as exc:  # what `lmcr complete` reports per line
         return {"error": one_line(exc)}
+
+
+def right_first(item: ExternalItem, line: dict) -> list[float] | None:
+    """A completion line's candidate scores with its best right candidate first and the other right ones
+    left out (what `complete.calibrate` reads): a right candidate fills the item's `missing` role with an
+    object of `expected_any`. None for an error, a wrong predicate or no right candidate: no threshold
+    puts in a set what is not among the candidates. (Two open roles list the best `max_listed` pairs
+    only; the rest hold next to no probability.)"""
+    if line.get("error") is not None or not right_predicate(line["frame"]["predicate"], item.verb):
+        return None
+    candidates = line["candidates"]
+    right = [normalize(c["objects"].get(item.missing) or "") in item.expected_any for c in candidates]
+    if not any(right):
+        return None
+    best = max(c["score"] for c, is_right in zip(candidates, right) if is_right)
+    return [best, *(c["score"] for c, is_right in zip(candidates, right) if not is_right)]
+
+
+def calibrate_requests(
+    parser: FrameParser, scorer: Scorer, config: CompletionConfig, items: list[ExternalItem], alpha: float = 0.1
+) -> CompletionConfig:
+    """The learned verbs' temperature and prediction-set threshold, calibrated on household requests as
+    `complete.calibrate` calibrates the eleven's on the dev scenarios: each item completed as `lmcr
+    complete` does, and read by `right_first`. Items whose predicate is one of the eleven, or whose
+    completion holds no right candidate, are left out; CompletionError when none is left."""
+    lists = []
+    for item in items:
+        line = complete_line(parser, scorer, config, item.instruction, list(item.objects))
+        if line.get("error") is None and line["frame"]["predicate"] in parser.lex.learned:
+            found = right_first(item, line)
+            lists += [found] if found else []
+    if not lists:
+        raise CompletionError(f"none of {len(items)} requests was completed with a right candidate to calibrate on")
+    return calibrate(lists, alpha, what=f"of {len(items)} household requests")
+
+
+def cross_calibrated(
+    items_by_set: dict[str, list[ExternalItem]], lines_by_set: dict[str, list[dict]], learned: frozenset[str]
+) -> dict[str, dict]:
+    """Each set's prediction sets had the learned verbs been calibrated (`calibrate_requests`) on the
+    other sets' completion lines, so that no set is calibrated on its own items (on its own when it is the
+    only set): how often the set holds a right object and its mean size (`score`'s), with the temperature
+    and threshold used. A line of one of the eleven keeps its own set."""
+
+    def lists(name: str) -> list[list[float]]:
+        pairs = zip(items_by_set[name], lines_by_set[name])
+        return [found for item, line in pairs if _learned(line, learned) and (found := right_first(item, line))]
+
+    calibration = {name: lists(name) for name in items_by_set}
+    rows = {}
+    for name, items in items_by_set.items():
+        others = [x for other, found in calibration.items() if other != name for x in found] or calibration[name]
+        if not others:  # no learned verb completed with a right candidate anywhere: nothing to calibrate on
+            rows[name] = dict.fromkeys(("set holds a right object", "mean set size", "temperature", "set threshold"))
+            continue
+        config = calibrate(others, what="requests of the other sets")
+        outcomes = [score(item, _reset(line, config, learned)) for item, line in zip(items, lines_by_set[name])]
+        completed = [o for o in outcomes if o.error is None]
+        rows[name] = {
+            "set holds a right object": round(sum(o.covered for o in outcomes) / len(outcomes), 3),
+            "mean set size": round(sum(o.set_size for o in completed) / len(completed), 2) if completed else None,
+            "temperature": round(config.temperature, 3),
+            "set threshold": round(config.set_threshold, 4),
+        }
+    return rows
+
+
+def _learned(line: dict, learned: frozenset[str]) -> bool:
+    return line.get("error") is None and line["frame"]["predicate"] in learned
+
+
+def _reset(line: dict, config: CompletionConfig, learned: frozenset[str]) -> dict:
+    """A learned verb's completion line with the prediction set `config` gives its candidates (the best
+    ones, as `complete` forms it); any other line as it is."""
+    if not _learned(line, learned):
+        return line
+    probs = softmax([c["score"] for c in line["candidates"]], config.temperature)
+    return {
+        **line,
+        "prediction_set": [c["object"] for c, p in zip(line["candidates"], probs) if p >= config.set_threshold],
+    }
 
 
 def run_set(
