@@ -579,6 +579,42 @@ def test_a_learned_tool_verb_is_completed_with_the_tool_and_done_with_its_class_
     assert out["reply"] == f"I {verb} the {layout[0][0]} with the {tool}."
 
 
+@pytest.mark.parametrize(
+    "motion, tool, theme, why",
+    [
+        ("cut", "spoon", "bread", "the spoon has no blade"),
+        ("cut", "knife", "bowl", "the bowl is no food a blade cuts"),
+        ("cut", "knife", "cake", "the knife's blade cannot saw through the cake, 0.18 m across"),
+        ("stir", "bowl", "soup", "the bowl is no tool to stir with"),
+        ("cover", "lid", "bread", "the bread is no open container to cover"),
+        ("wipe", "sponge", "bread", "the sponge does not lie flat on the bread with room to move"),
+        ("wipe", "sponge", "cutting board", None),
+    ],
+)
+def test_why_a_tool_cannot_do_its_class_motion_is_said_in_the_frames_words(motion, tool, theme, why):
+    found = tasks.unfit_tool(Frame.of("x", {"Theme": theme, "Instrument": tool}), motion)
+    assert (found.format(tool=tool, theme=theme) if found else None) == why
+    assert (tasks.task_for(Frame.of("x", {"Theme": theme, "Instrument": tool}), motion) is None) == (why is not None)
+    assert tasks.unfit_tool(Frame.of("x", {"Theme": theme, "Destination": tool}), motion) is None  # no tool: no reason
+
+
+def test_a_tool_that_cannot_do_it_is_refused_with_the_reason(sim, tmp_path, learned_parser):
+    """ "cut the cake": the knife is the only tool, and its blade cannot saw through a cake that wide: the
+    robot says so, in one line and in its reply, instead of that it knows no motion for cutting."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import NoMotionError, execute
+    from lmcr.robot.reply import error_outcome, say
+
+    scene = make_scene([("cake", [0.1, -0.15]), ("knife", [-0.1, 0.25])])
+    with pytest.raises(NoMotionError) as refused:
+        execute("cut the cake", scene, learned_parser, _prefers("knife"), CompletionConfig(), tmp_path)
+    why = "the knife's blade cannot saw through the cake, 0.18 m across"
+    assert str(refused.value) == f"the simulated Baxter cannot cut the cake with the knife: {why}"
+    assert (
+        say(error_outcome(refused.value), learned_parser.lex) == f"Sorry, I can't cut the cake with the knife: {why}."
+    )
+
+
 def _prefers(label: str):
     """A model-free scorer: the frames that name `label` score 1, the others 0."""
     return lambda frames, context="": [1.0 if label in f.role_map.values() else 0.0 for f in frames]

@@ -29,7 +29,7 @@ from lmcr.robot.plan import Infeasible, Plan, Planner
 from lmcr.robot.render import Recorder
 from lmcr.robot.reply import say
 from lmcr.robot.scene import X_LIMIT, Scene, SceneObject, free_spots, load_scene, scene_from_json
-from lmcr.robot.tasks import COOK, MOTIONS, SERVE, TASKS, TOOL_MOTIONS, Task, scoops, task_for
+from lmcr.robot.tasks import COOK, MOTIONS, SERVE, TASKS, TOOL_MOTIONS, Task, scoops, task_for, unfit_tool
 from lmcr.robot.world import build_world
 from lmcr.srl.instruction import NoPredicateError
 
@@ -45,15 +45,20 @@ LEARNED_MOTIONS = sorted({*MOTIONS, *TOOL_MOTIONS, SERVE.motion, *(task.motion f
 
 class NoMotionError(NoPredicateError):
     """A predicate the robot understands (learned from the corpora) but has no motion for with the objects
-    it sees: none yet for the verb's class, or none that the candidates fit (no tool on the table)."""
+    it sees: none yet for the verb's class, or none that the candidates fit (no tool on the table). `unfit`:
+    (what it was asked to do, why the tool cannot) when its class has a tool motion the chosen tool cannot
+    do ("cut the cake with the knife", "the knife's blade cannot saw through the cake, 0.18 m across")."""
 
-    def __init__(self, predicate: str):
+    def __init__(self, predicate: str, unfit: tuple[str, str] | None = None):
         can, learned = ", ".join(sorted(TASKS)), ", ".join(LEARNED_MOTIONS[:-1]) + " or " + LEARNED_MOTIONS[-1]
         super().__init__(
-            f"the simulated Baxter has no motion for {predicate!r} with the objects it sees (it can {can}; and "
-            f"{learned} for a verb learned as one of those, its tool on the table)"
+            f"the simulated Baxter cannot {unfit[0]}: {unfit[1]}"
+            if unfit
+            else f"the simulated Baxter has no motion for {predicate!r} with the objects it sees (it can {can}; "
+            f"and {learned} for a verb learned as one of those, its tool on the table)"
         )
         self.predicate = predicate
+        self.unfit = unfit
 
 
 def _with_tasks(
@@ -68,8 +73,18 @@ def _with_tasks(
         (frame, candidate, task_for(_as_built(frame, shapes), _verb_motion(frame, lex))) for frame, candidate in options
     ]
     if all(task is None for _, _, task in found):
-        raise NoMotionError(completion.frame.predicate)
+        raise NoMotionError(completion.frame.predicate, _unfit(options[0][0], shapes, lex))
     return found
+
+
+def _unfit(frame: Frame, shapes: dict[str, str], lex: Lexicon) -> tuple[str, str] | None:
+    """(what the frame asks, why its tool cannot do it: `tasks.unfit_tool` on what its objects are built
+    as), in the frame's own words; None when that is not why."""
+    why = unfit_tool(_as_built(frame, shapes), _verb_motion(frame, lex))
+    if why is None:
+        return None
+    tool, theme = frame.role_map["Instrument"], frame.role_map["Theme"]
+    return f"{frame.predicate} the {theme} with the {tool}", why.format(tool=tool, theme=theme)
 
 
 def _as_built(frame: Frame, shapes: dict[str, str]) -> Frame:

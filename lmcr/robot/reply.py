@@ -111,7 +111,8 @@ def say(outcome: Mapping, lexicon: Lexicon | None = None) -> str:
     `lmcr robot`'s JSON: `frame` ({"predicate", "roles"} or a Frame), `feasible`, `success`, `checks`,
     `reason`, `out_of_reach`, `blocker`, `chosen_object`, `suggestion`, `question`, `left`, and for an
     error `error` with `error_kind` ("unknown_predicate", "incomplete" with the parsed `frame`, "absent"
-    with the `absent` label; see `error_outcome`)."""
+    with the `absent` label, "unfit" with what it was asked, `doing`, and why its tool cannot, `reason`;
+    see `error_outcome`)."""
     lexicon = lexicon or load_lexicon()
     if outcome.get("error"):
         return _error(outcome, lexicon)
@@ -139,6 +140,8 @@ def error_outcome(exc: Exception) -> dict:
         out.update(error_kind="absent", absent=exc.absent)
     elif getattr(exc, "frame", None):  # a frame the objects on the table cannot complete
         out.update(error_kind="incomplete", frame=exc.frame)
+    elif getattr(exc, "unfit", None):  # a tool that cannot do what the verb's class does with it
+        out.update(error_kind="unfit", doing=exc.unfit[0], reason=exc.unfit[1])
     elif any(c.__name__ == "NoPredicateError" for c in type(exc).__mro__):  # by name: no spaCy to import
         out["error_kind"] = "unknown_predicate"
         if getattr(exc, "predicate", None):  # understood, but no motion for it
@@ -158,6 +161,8 @@ def _error(outcome: Mapping, lexicon: Lexicon) -> str:
         return _cannot_do(outcome.get("predicate"), lexicon)
     if kind == "absent":
         return f"I see no {outcome['absent']} on the table."  # "no" suits a cup and milk alike
+    if kind == "unfit":
+        return f"Sorry, I can't {outcome['doing']}: {outcome['reason']}."
     if kind == "incomplete" and _parts(outcome["frame"])[0] in lexicon.predicates:
         return f"I can't {phrase(outcome['frame'], lexicon)} here."
     return f"Sorry, I can't do that: {outcome['error']}."

@@ -556,11 +556,21 @@ def surface(target: SceneObject, box: tuple) -> tuple[float, float, float, float
 def fits_on(tool: str, label: str) -> bool:
     """Whether a wiping tool lies flat on the surface with room to move (within a container's walls, which
     must be lower than the tool: the hand holding it stays above the rim)."""
-    if not has_shape(tool) or not has_shape(label) or depth(label) >= height(tool):
-        return False
+    return why_not_wipe(tool, label) is None
+
+
+def why_not_wipe(tool: str, label: str) -> str | None:
+    """Why the `tool` cannot wipe the `label` (`fits_on`), as a template of {tool} and {theme}; None when
+    it can."""
+    if not has_shape(tool) or not has_shape(label):
+        return "the robot has no model of the {tool} or the {theme} to wipe with"
+    if depth(label) >= height(tool):
+        return "the {theme} is deeper inside than the {tool} is tall: the hand holding it would hit its walls"
     (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
     inset = WALL + WIPE_CLEAR if _walled(label) else WIPE_CLEAR
-    return min(tx, ty) <= min(sx, sy) - inset and max(tx, ty) <= max(sx, sy) - inset
+    if min(tx, ty) > min(sx, sy) - inset or max(tx, ty) > max(sx, sy) - inset:
+        return "the {tool} does not lie flat on the {theme} with room to move"
+    return None
 
 
 def program_wipe(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -624,10 +634,20 @@ def working_end_down(g: Geometry, v: Variant) -> Variant:
 def stirs(tool: str, label: str) -> bool:
     """Whether the `tool` stirs in the `label`: a tool that is no vessel, its end narrower than the inside
     of a kitchen container (a spoon in the soup; not a microwave in the butter, nor a spoon in a bin)."""
-    if not has_shape(tool) or label not in CONTAINERS or tool in CONTAINERS or label in household():
-        return False
+    return why_not_stir(tool, label) is None
+
+
+def why_not_stir(tool: str, label: str) -> str | None:
+    """Why the `tool` cannot stir in the `label` (`stirs`), as a template of {tool} and {theme}; None when
+    it can."""
+    if not has_shape(tool) or tool in CONTAINERS:
+        return "the {tool} is no tool to stir with"
+    if label not in CONTAINERS or label in household():
+        return "the {theme} is not in a kitchen container to stir it in"
     (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
-    return min(tx, ty) + STIR_CLEAR <= min(sx, sy) - WALL
+    if min(tx, ty) + STIR_CLEAR > min(sx, sy) - WALL:
+        return "the {tool}'s end does not fit inside the {theme}"
+    return None
 
 
 def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -660,11 +680,21 @@ def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 def cuts(tool: str, label: str) -> bool:
     """Whether the `tool` cuts the `label` through: a blade, and food whose short side it spans while it saws
     (drawn SAW back and forth across the food's middle, the handle kept off the food)."""
+    return why_not_cut(tool, label) is None
+
+
+def why_not_cut(tool: str, label: str) -> str | None:
+    """Why the `tool` cannot cut the `label` through (`cuts`), as a template of {tool} and {theme}; None
+    when it can."""
     found = TOOLS.get(tool)
-    if label not in FOOD or found is None or found.blade is None:
-        return False
+    if found is None or found.blade is None:
+        return "the {tool} has no blade"
+    if label not in FOOD:
+        return "the {theme} is no food a blade cuts"
     half_x, half_y, _ = outline(label)
-    return min(half_x, half_y) + SAW <= found.blade_reach - HANDLE_OFF + 1e-9
+    if min(half_x, half_y) + SAW > found.blade_reach - HANDLE_OFF + 1e-9:
+        return f"the {{tool}}'s blade cannot saw through the {{theme}}, {2 * min(half_x, half_y):.2f} m across"
+    return None
 
 
 def program_cut(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -702,10 +732,20 @@ def program_cut(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 def covers(tool: str, label: str) -> bool:
     """Whether the `tool` covers the `label`: a container with an opening, and a tool that lies over all of
     it (a lid, foil; a plate on a bowl)."""
-    if tool == label or not has_shape(tool) or not has_shape(label) or not _walled(label):
-        return False
+    return why_not_cover(tool, label) is None
+
+
+def why_not_cover(tool: str, label: str) -> str | None:
+    """Why the `tool` cannot cover the `label` (`covers`), as a template of {tool} and {theme}; None when
+    it can."""
+    if tool == label or not has_shape(tool):
+        return "the {tool} is nothing to cover it with"
+    if not has_shape(label) or not _walled(label):
+        return "the {theme} is no open container to cover"
     (tx, ty, _), (sx, sy, _) = outline(tool), outline(label)
-    return tx >= sx and ty >= sy
+    if tx < sx or ty < sy:
+        return "the {tool} is smaller than the {theme}'s opening"
+    return None
 
 
 def program_cover(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -1016,7 +1056,8 @@ TOOL_MOTIONS = {
 # content into the Destination
 SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="serve", source_role="Theme", wide=True)
 # whether a tool can do its class's motion to the Theme at all (its shape): others are tried in the world
-TOOL_FITS = {"wipe": fits_on, "cut": cuts, "cover": covers, "stir": stirs}
+# why a tool motion's tool cannot act on its Theme (None when it can): a template of {tool} and {theme}
+TOOL_UNFIT = {"wipe": why_not_wipe, "cut": why_not_cut, "cover": why_not_cover, "stir": why_not_stir}
 # a verb of the cook class puts the Theme in or on what cooks it, as the paper's heat does: the Instrument
 # ("reheat the soup in the microwave") or, when the verb takes none, the Destination ("bake the bread in
 # the oven"); by the role it is put at
@@ -1048,14 +1089,23 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
     if verb_motion == "cook":
         return _cook_task(roles)
     if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
-        fits = TOOL_FITS[verb_motion](roles["Instrument"], roles["Theme"])
-        return TOOL_MOTIONS[verb_motion] if fits else None
+        return TOOL_MOTIONS[verb_motion] if unfit_tool(frame, verb_motion) is None else None
     if not {"Theme", "Destination"} <= set(roles):
         return None
     found = household().get(roles["Destination"])
     if found is not None:
         return MOTIONS[found.motion]
     return MOTIONS["place"] if verb_motion == "place" else None
+
+
+def unfit_tool(frame: Frame, verb_motion: str | None) -> str | None:
+    """Why the tool of a frame of a learned verb cannot do its class's tool motion on the Theme (a template
+    of {tool} and {theme}: "the {tool} has no blade"); None when it can, or when the verb's class has no
+    tool motion or the frame no tool."""
+    roles = frame.role_map
+    if verb_motion not in TOOL_UNFIT or not {"Theme", "Instrument"} <= set(roles):
+        return None
+    return TOOL_UNFIT[verb_motion](roles["Instrument"], roles["Theme"])
 
 
 def cooks(label: str) -> bool:
