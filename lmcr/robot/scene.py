@@ -297,14 +297,24 @@ def _held(holding: object, where: str) -> tuple[str | None, str | None]:
     if holding is None:
         return None, None
     label, like = (holding.get("label"), holding.get("like")) if isinstance(holding, dict) else (holding, None)
-    known = {*load_lexicon().objects, *TOOLS}
-    if not isinstance(label, str) or (label not in known and like is None) or id_problem(label):
+    wrong = _unbuildable(label, like, {*load_lexicon().objects, *TOOLS})
+    if wrong == "label":
         raise InputError(f"{where}: 'holding' must be a known object label, not {label!r:.60}")
-    if like is not None and (not isinstance(like, str) or like not in known):
+    if wrong == "like":
         raise InputError(
             f"{where}: 'holding' ({label}): 'like' must be a known object the hand can hold, not {like!r:.60}"
         )
     return label, like
+
+
+def _unbuildable(label: object, like: object, vocabulary: set[str]) -> str | None:
+    """Which of an object's fields keeps it from being built: "like" when it is given but names no known
+    object, "label" when the label is no usable name or neither it nor a like is known; None when it can be."""
+    if like is not None and (not isinstance(like, str) or like not in vocabulary):
+        return "like"
+    if not isinstance(label, str) or (label not in vocabulary and like is None) or id_problem(label):
+        return "label"
+    return None
 
 
 def _check_like(labels: list, likes: list, vocabulary: set[str], where: str) -> None:
@@ -312,11 +322,12 @@ def _check_like(labels: list, likes: list, vocabulary: set[str], where: str) -> 
     (a frame names labels, and each names one shape)."""
     built: dict[str, str | None] = {}
     for k, (label, like) in enumerate(zip(labels, likes)):
-        if like is not None and (not isinstance(like, str) or like not in vocabulary):
+        wrong = _unbuildable(label, like, vocabulary)
+        if wrong == "like":
             raise InputError(
                 f"{where}: object {k} ({label!r:.60}): 'like' must be a known object label, not {like!r:.60}"
             )
-        if not isinstance(label, str) or (label not in vocabulary and like is None) or id_problem(label):
+        if wrong == "label":
             raise InputError(
                 f"{where}: object {k}: unknown label {label!r:.60} (give 'like', the known object it is built as)"
             )
