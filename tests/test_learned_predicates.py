@@ -196,6 +196,40 @@ def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, ins
 
 @pytest.mark.model
 @pytest.mark.parametrize(
+    "instruction, predicate, roles",
+    [
+        ("stir in the sugar", "stir in", {"Theme": "sugar", "Destination": None}),  # the sugar is stirred in
+        ("stir in the bowl", "stir", {"Theme": None, "Destination": "bowl"}),  # the bowl is where
+        ("stir in the flour", "stir", {"Theme": None, "Destination": "flour"}),  # unseen: the phrase stands
+        ("whisk in the sugar", "whisk", {"Theme": "sugar", "Destination": None}),  # "whisk in" not learned
+        ("stir the milk in the bowl", "stir", {"Theme": "milk", "Destination": "bowl"}),  # an object: no question
+    ],
+)
+def test_a_learned_verbs_preposition_is_a_particle_when_the_corpus_takes_its_noun_for_a_theme(
+    tmp_path, instruction, predicate, roles
+):
+    from collections import Counter
+
+    from lmcr.srl.instruction import parse_instruction
+    from lmcr.srl.parser import FrameParser, load_nlp
+    from lmcr.srl.priors import RolePriors
+
+    frames = _kitchen()
+    frames += [("stir", {"Theme": "milk", "in": "bowl"}, False)] * 25 + [("stir in", {"Theme": "sugar"}, False)] * 25
+    frames += [("whisk", {"Theme": "egg", "in": "bowl"}, False)] * 25
+    con = _store(tmp_path, frames)
+    publish_predicates(con, learn_predicates(con, HAND), tmp_path / PREDICATES_FILE, "b")
+    con.close()
+    pooled = Counter({("sugar", "Theme"): 9, ("sugar", "Destination"): 1, ("bowl", "Destination"): 9})
+    lex = load_lexicon(learned=tmp_path / PREDICATES_FILE)
+    assert {"stir", "stir in", "whisk"} <= lex.learned and "whisk in" not in lex.predicates
+    parser = FrameParser(load_nlp(), lex, priors=RolePriors(Counter(), pooled))
+    frame = parse_instruction(parser, instruction)
+    assert (frame.predicate, frame.roles) == (predicate, roles)
+
+
+@pytest.mark.model
+@pytest.mark.parametrize(
     "instruction", ["put the teddy bear away", "put the bay leaves away", "put the granite cutting board away"]
 )
 def test_a_particle_after_an_object_the_parser_misread_still_names_the_phrasal_verb(learned_parser, instruction):

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from spacy.tokens import Doc, Span, Token
 
@@ -25,6 +25,8 @@ PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
 # Adverbs that complete a phrasal verb where the parser calls them adverbs ("put the milk away"); the
 # parser's own particles (dep prt) count whatever the word. English's closed class, not a verb list.
 ADVERB_PARTICLES = frozenset({"away", "back", "aside", "out", "up", "down", "off"})
+# Prepositions English also uses as particles ("stir in the sugar", "put on the lid"); "into" never is.
+PREP_PARTICLES = frozenset({"in", "on", "over", "off", "through", "around", "along", "about"})
 # Where only a noun can stand: a word tagged as a verb there is a noun the tagger misread.
 NOUN_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "attr", "appos"})
 # Tags of a noun phrase's words (POS: the possessive 's), and those a particle is tagged with; tags, since
@@ -47,6 +49,10 @@ class FrameMention:
     ambiguous_object: str | None = None
     # Said to the robot: an imperative or "can you ...", not "I drank it" or "the one was eaten".
     addressed: bool = True
+    # "stir in the sugar": the same words read as a learned phrasal verb and its object ("stir in", Theme
+    # sugar) instead of the verb and a phrase ("stir", Destination sugar); the corpus decides which
+    # (`RolePriors.resolve`), and without its counts the phrase stands.
+    particle_reading: FrameMention | None = None
 
     def missing(self) -> list[str]:
         return [role for role, value in self.roles.items() if value is None]
@@ -57,16 +63,8 @@ class FrameMention:
     def shifted(self, offset: int) -> FrameMention:
         """The same frame with character offsets moved (for text that was re-parsed with a prefix)."""
         spans = {r: (s + offset, e + offset) for r, (s, e) in self.spans.items()}
-        return FrameMention(
-            self.predicate,
-            self.roles,
-            self.known,
-            self.start + offset,
-            self.end + offset,
-            spans,
-            self.ambiguous_object,
-            self.addressed,
-        )
+        reading = self.particle_reading.shifted(offset) if self.particle_reading else None
+        return replace(self, start=self.start + offset, end=self.end + offset, spans=spans, particle_reading=reading)
 
 
 @dataclass
@@ -350,5 +348,22 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
             else _generic_frame(token, name, args, lex, compounds)
         )
         frame.addressed = _addressed(token)
+        if (reading := _particle_reading(token, lemma, name, args, lex)) is not None:
+            frame.particle_reading = replace(_known_frame(token, *reading, lex, compounds), addressed=frame.addressed)
         frames.append(frame)
     return sorted(frames, key=lambda f: f.start)
+
+
+def _particle_reading(verb: Token, lemma: str, name: str, args: _Args, lex: Lexicon) -> tuple | None:
+    """The predicate and arguments a learned verb with no object may be read as when its first phrase
+    follows it at once, its preposition a particle and its noun the object ("stir in the sugar": "stir in",
+    the sugar its object, as "pour in the milk"; "whisk in the eggs": whisk, the phrasal verb not learned);
+    None for any other verb."""
+    if name not in lex.learned or args.objects or not args.preps:
+        return None
+    prep, obj = args.preps[0]
+    if obj.head.i != verb.i + 1 or prep not in PREP_PARTICLES:
+        return None
+    phrasal = lex.predicates.get(f"{lemma} {prep}")
+    spec = phrasal if phrasal is not None and phrasal.name in lex.learned else lex.predicates[name]
+    return spec, _Args([obj], args.preps[1:], [*args.particles, prep])

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 from collections import Counter
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from lmcr.files import atomic_path, read_resource
@@ -46,7 +46,11 @@ class RolePriors:
         return None
 
     def resolve(self, frame: FrameMention) -> FrameMention:
-        """Swap a default-assigned lone object into the other role when the corpus prefers that role."""
+        """Swap a default-assigned lone object into the other role when the corpus prefers that role; read a
+        learned verb's phrase as a phrasal verb's object when the corpus prefers its noun as a Theme ("stir
+        in the sugar": the sugar is what is stirred in, not where)."""
+        if frame.particle_reading is not None:
+            return self._particle(frame)
         role = frame.ambiguous_object
         if role is None:
             return frame
@@ -58,7 +62,19 @@ class RolePriors:
         roles = {role: None, other: value} if list(frame.roles)[0] == role else {other: value, role: None}
         roles = {r: roles[r] for r in frame.roles}
         spans = {other: frame.spans[role]} if role in frame.spans else {}
-        return FrameMention(frame.predicate, roles, frame.known, frame.start, frame.end, spans, other)
+        return replace(frame, roles=roles, spans=spans, ambiguous_object=other)
+
+    def _particle(self, frame: FrameMention) -> FrameMention:
+        """The phrasal reading of `frame` when its object is likelier a Theme than what the phrase made it
+        in the other reading (the phrasal verb is no alternating verb of the eleven: the pooled counts
+        decide); else the frame."""
+        reading = frame.particle_reading
+        theme = reading.roles.get("Theme")
+        phrase_role = next((r for r, v in frame.roles.items() if v == theme and r != "Theme"), None)
+        if theme is None or phrase_role is None:
+            return replace(frame, particle_reading=None)
+        p = self.probability(reading.predicate, theme, "Theme", phrase_role)
+        return replace(reading if p is not None and p > 0.5 else frame, particle_reading=None)
 
     def save(self, path: Path) -> None:
         """Write as JSON under a temporary name, then rename."""
