@@ -115,6 +115,16 @@ def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions
     return chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
 
 
+@task(name="calibrate-learned-verbs")
+def calibrate_learned_task(requests: str, methods: list[str], res: MethodResources, ws: Workspace) -> dict:
+    """The learned verbs' completion calibrated on household requests (`lmcr evaluate --requests`) for
+    each method the ratings calibrated: method -> what was done."""
+    from lmcr.evaluate.external import calibrate_learned_verbs, read_requests
+
+    items = read_requests(Path(requests))
+    return calibrate_learned_verbs(ws, res, methods, items, log=get_run_logger().info)
+
+
 @flow(name="evaluate")
 def evaluate_flow(
     ratings: str | None = None,
@@ -130,6 +140,7 @@ def evaluate_flow(
     paper: str | None = None,
     mixture: bool = True,
     instructions: str | None = None,
+    requests: str | None = None,
 ) -> dict:
     """Evaluate on `ratings` (default: the store's ingested ratings) and write the report to `out`
     (default `$LMCR_DATA_DIR/report`); `corpus` is the LM setting of the Table I methods. With `mixture`
@@ -137,7 +148,9 @@ def evaluate_flow(
     (and on `instructions`, a JSONL of instructions in scenes, when given), so the default completion is
     evaluated and calibrated under it. `methods` and `settings` default to every method (EVALUATED) and LM
     setting (any spelling `Setting.parse` reads); a default that cannot be built (a setting not trained) is
-    skipped with a note, while one given explicitly must build."""
+    skipped with a note, while one given explicitly must build. With `requests` (household requests in the
+    external sets' format, a file or a folder), the learned verbs' completion is calibrated on them too,
+    and the result says so under `learned_verbs`."""
     optional = [*(EVALUATED if methods is None else ()), *(SETTINGS if settings is None else ())]
     methods = list(EVALUATED) if methods is None else methods
     settings = list(SETTINGS) if settings is None else [Setting.parse(s).label for s in settings]
@@ -152,6 +165,9 @@ def evaluate_flow(
             methods, optional = [*methods, f"{COMPLETION_METHOD}@plain"], [*optional, f"{COMPLETION_METHOD}@plain"]
     report = Path(out or ws.report)
     results = evaluate_task(ratings or str(ws.db), str(report), methods, settings, res, per_verb, seed, ws, optional)
+    if requests:
+        done = [m for m in methods if m in results["table1"]]
+        results = {**results, "learned_verbs": calibrate_learned_task(requests, done, res, ws)}
     create_table_artifact(
         key="table-i",
         description="Table I overall accuracy (lambda=1, k=6)",

@@ -3,6 +3,8 @@ process-pool task runner."""
 
 from __future__ import annotations
 
+import json
+
 import duckdb
 import pytest
 
@@ -72,6 +74,14 @@ def evaluate_on_trained(tmp_path):
         for i, obj in enumerate(objects)
     ]
     write_results(tmp_path / "ratings.csv", rows)
+    requests = tmp_path / "requests.jsonl"
+    request = {
+        "id": 1,
+        "instruction": "put the milk away",
+        "objects": ["milk", "bowl", "cup"],
+        "missing": "Destination",
+    }
+    requests.write_text(json.dumps({**request, "expected_any": ["bowl"], "verb": "put away"}) + "\n")
     results = evaluate_flow(
         ratings=str(tmp_path / "ratings.csv"),
         out=str(tmp_path / "report"),
@@ -80,7 +90,11 @@ def evaluate_on_trained(tmp_path):
         corpus="youcook2",
         per_verb=5,
         data_dir=str(tmp_path),
+        requests=str(requests),
     )
+    # each method the ratings calibrated is calibrated on the requests too, or says why not
+    assert set(results["learned_verbs"]) == {"sentence_lm", "frame_lm", "sentence_lm+frame_counts"}
+    assert all(done.startswith("learned verbs") for done in results["learned_verbs"].values())
     assert set(results["table1"]) == {
         "sentence_lm",
         "frame_lm",
@@ -90,7 +104,8 @@ def evaluate_on_trained(tmp_path):
     }
     assert (tmp_path / "report" / "report.html").exists() and (tmp_path / "report" / "fig4d.png").exists()
     # one file per method, named by its fingerprint too; none for the random baseline
-    calibrated = sorted(p.name.rsplit("-", 1)[0] for p in (tmp_path / "calibration").glob("*.json"))
+    files = [p for p in (tmp_path / "calibration").glob("*.json") if not p.stem.endswith("-requests")]
+    calibrated = sorted(p.name.rsplit("-", 1)[0] for p in files)
     assert calibrated == ["frame_lm-youcook2", "sentence_lm+frame_counts-youcook2", "sentence_lm-youcook2"]
 
 

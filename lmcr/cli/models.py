@@ -185,7 +185,10 @@ def evaluate(
     rows = [{"method": m, "overall": f"{acc.get('all', float('nan')):.3f}"} for m, acc in results.table1.items()]
     print_rows(f"Table I overall accuracy (lambda={results.config.lam:g}, k={results.config.k})", rows)
     if items is not None:
-        _calibrate_learned(ws, res, [m for m in chosen_methods if m in results.table1], items)
+        from lmcr.evaluate.external import calibrate_learned_verbs
+
+        methods_run = [m for m in chosen_methods if m in results.table1]
+        calibrate_learned_verbs(ws, res, methods_run, items, log=lambda m: console.print(m, highlight=False))
     console.print(f"report: {out / 'report.html'}")
 
 
@@ -193,32 +196,6 @@ def _requests(path: Path) -> list:
     from lmcr.evaluate.external import read_requests
 
     return read_requests(path)
-
-
-def _calibrate_learned(ws: Workspace, res, methods: list[str], items: list) -> None:
-    """Calibrate the learned verbs' completion on the requests for each method the ratings calibrated, and
-    save it beside that calibration, under the same fingerprint."""
-    from lmcr.complete import CompletionError, calibration_file, load_config, requests_calibration_file, save_config
-    from lmcr.evaluate.external import calibrate_requests
-    from lmcr.scorers.registry import make_scorer
-
-    parser = ws.parser()
-    for method in methods:
-        path, fingerprint = calibration_file(method, res, ws.calibration)
-        config = load_config(path, fingerprint) if fingerprint else None
-        if config is None:
-            continue  # not calibrated on the ratings: there is nothing to put it beside
-        try:
-            learned = calibrate_requests(parser, make_scorer(method, res), config, items)
-        except CompletionError as exc:  # the ratings' calibration stands: the learned verbs keep using it
-            console.print(f"{method} learned verbs not calibrated: {exc}", highlight=False)
-            continue
-        save_config(learned, requests_calibration_file(path), fingerprint)
-        console.print(
-            f"{method} learned verbs: temperature {learned.temperature:.3g}, prediction-set threshold "
-            f"p >= {learned.set_threshold:.3f} ({learned.source})",
-            highlight=False,
-        )
 
 
 def _rated_frames(ratings: Path, ws: Workspace) -> list:

@@ -30,7 +30,7 @@ import math
 import re
 import time
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -236,6 +236,35 @@ def calibrate_requests(
     if not lists:
         raise CompletionError(f"none of {len(items)} requests was completed with a right candidate to calibrate on")
     return calibrate(lists, alpha, what=f"of {len(items)} household requests")
+
+
+def calibrate_learned_verbs(
+    ws, res, methods: list[str], items: list[ExternalItem], log: Callable[[str], None] = print
+) -> dict[str, str]:
+    """Calibrate the learned verbs' completion on the requests (`calibrate_requests`) for each method the
+    ratings calibrated in the workspace `ws` (`lmcr evaluate`), and save it beside that calibration under
+    the same fingerprint (`complete.requests_calibration_file`); method -> what was done, as logged."""
+    from lmcr.complete import calibration_file, load_config, requests_calibration_file, save_config
+    from lmcr.scorers.registry import make_scorer
+
+    parser, done = ws.parser(), {}
+    for method in methods:
+        path, fingerprint = calibration_file(method, res, ws.calibration)
+        config = load_config(path, fingerprint) if fingerprint else None
+        if config is None:
+            continue  # not calibrated on the ratings: there is nothing to put it beside
+        try:
+            learned = calibrate_requests(parser, make_scorer(method, res), config, items)
+        except CompletionError as exc:  # the ratings' calibration stands: the learned verbs keep using it
+            done[method] = f"learned verbs not calibrated: {one_line(exc)}"
+        else:
+            save_config(learned, requests_calibration_file(path), fingerprint)
+            done[method] = (
+                f"learned verbs: temperature {learned.temperature:.3g}, prediction-set threshold "
+                f"p >= {learned.set_threshold:.3f} ({learned.source})"
+            )
+        log(f"{method} {done[method]}")
+    return done
 
 
 def cross_calibrated(
