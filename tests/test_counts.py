@@ -20,6 +20,14 @@ FILLERS = [
 PAIRS = [("pour", "Theme", "water", "Destination", "cup", 3), ("pour", "Destination", "cup", "Theme", "water", 3)]
 
 
+def counted(frames: list[tuple[str, dict[str, str], int]]) -> tuple[list, list]:
+    """The filler rows and the pair rows (both orders) of frames (predicate, roles, how often), as the
+    store's count queries give them."""
+    fillers = [(v, role, value, n) for v, roles, n in frames for role, value in roles.items()]
+    pairs = [(v, r, a, m, o, n) for v, roles, n in frames for r, a in roles.items() for m, o in roles.items() if r != m]
+    return fillers, pairs
+
+
 def test_smoothed_estimates_by_hand():
     m = FrameCountScorer(FILLERS, PAIRS, alpha=2.0)
     assert m.n == 10 and m.types == 3
@@ -42,19 +50,13 @@ def test_smoothed_estimates_by_hand():
 def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
     # "put away" put a book in a box once and never stated milk's place; "store", of the same class, put milk
     # in the fridge twice
-    fillers = [
-        ("put away", "Theme", "milk", 1),
-        ("put away", "Theme", "book", 1),
-        ("put away", "Destination", "box", 1),
-        ("store", "Theme", "milk", 2),
-        ("store", "Destination", "fridge", 2),
-    ]
-    pairs = [
-        ("store", "Theme", "milk", "Destination", "fridge", 2),
-        ("store", "Destination", "fridge", "Theme", "milk", 2),
-        ("put away", "Theme", "book", "Destination", "box", 1),
-        ("put away", "Destination", "box", "Theme", "book", 1),
-    ]
+    fillers, pairs = counted(
+        [
+            ("put away", {"Theme": "milk"}, 1),
+            ("put away", {"Theme": "book", "Destination": "box"}, 1),
+            ("store", {"Theme": "milk", "Destination": "fridge"}, 2),
+        ]
+    )
     m = FrameCountScorer(fillers, pairs, alpha=2.0, classes={"put away": "place", "store": "place"})
     flat = FrameCountScorer(fillers, pairs, alpha=2.0)
     own = m.p_filler("put away", "Destination", "fridge")
@@ -76,19 +78,13 @@ def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
 def test_a_phrasal_verbs_pairs_back_off_to_its_base_verbs_first():
     # "warm up" stated its place only for soup (the pot); "warm" warms milk in the microwave; the class
     # (placing verbs, which put milk in the fridge) comes after the base verb
-    fillers = [
-        ("warm up", "Theme", "soup", 2),
-        ("warm up", "Destination", "pot", 2),
-        ("warm", "Theme", "milk", 3),
-        ("warm", "Destination", "microwave", 3),
-        ("store", "Theme", "milk", 30),
-        ("store", "Destination", "fridge", 30),
-    ]
-    pairs = [
-        ("warm up", "Theme", "soup", "Destination", "pot", 2),
-        ("warm", "Theme", "milk", "Destination", "microwave", 3),
-        ("store", "Theme", "milk", "Destination", "fridge", 30),
-    ]
+    fillers, pairs = counted(
+        [
+            ("warm up", {"Theme": "soup", "Destination": "pot"}, 2),
+            ("warm", {"Theme": "milk", "Destination": "microwave"}, 3),
+            ("store", {"Theme": "milk", "Destination": "fridge"}, 30),
+        ]
+    )
     m = FrameCountScorer(fillers, pairs, alpha=2.0, classes={"warm up": "place", "store": "place"})
     assert m.base == {"warm up": "warm"}
     own = m.p_filler("warm up", "Destination", "microwave")

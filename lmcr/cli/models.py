@@ -162,7 +162,11 @@ def evaluate(
     check_output_dir(out)  # before the work: a user's folder is refused at once, not after the evaluation
     if requests is not None and not calibrate:
         fail("--requests calibrates completion: it cannot be given with --no-calibrate")
-    items = _requests(requests) if requests is not None else None  # a bad file fails before the evaluation
+    items = None
+    if requests is not None:  # a bad file fails before the evaluation
+        from lmcr.evaluate.external import read_requests
+
+        items = read_requests(requests)
     rated = _rated_frames(ratings, ws)
     # what the user named must build; the defaults may be skipped (a setting not trained, no ConceptNet)
     default_methods, default_settings = list(EVALUATED), [s.label for s in ALL_SETTINGS]
@@ -190,12 +194,6 @@ def evaluate(
         methods_run = [m for m in chosen_methods if m in results.table1]
         calibrate_learned_verbs(ws, res, methods_run, items, log=lambda m: console.print(m, highlight=False))
     console.print(f"report: {out / 'report.html'}")
-
-
-def _requests(path: Path) -> list:
-    from lmcr.evaluate.external import read_requests
-
-    return read_requests(path)
 
 
 def _rated_frames(ratings: Path, ws: Workspace) -> list:

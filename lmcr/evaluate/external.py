@@ -227,12 +227,8 @@ def calibrate_requests(
     `complete.calibrate` calibrates the eleven's on the dev scenarios: each item completed as `lmcr
     complete` does, and read by `right_first`. Items whose predicate is one of the eleven, or whose
     completion holds no right candidate, are left out; CompletionError when none is left."""
-    lists = []
-    for item in items:
-        line = complete_line(parser, scorer, config, item.instruction, list(item.objects))
-        if line.get("error") is None and line["frame"]["predicate"] in parser.lex.learned:
-            found = right_first(item, line)
-            lists += [found] if found else []
+    lines = [complete_line(parser, scorer, config, item.instruction, list(item.objects)) for item in items]
+    lists = learned_right_first(items, lines, parser.lex.learned)
     if not lists:
         raise CompletionError(f"none of {len(items)} requests was completed with a right candidate to calibrate on")
     return calibrate(lists, alpha, what=f"of {len(items)} household requests")
@@ -275,11 +271,7 @@ def cross_calibrated(
     only set): how often the set holds a right object and its mean size (`score`'s), with the temperature
     and threshold used. A line of one of the eleven keeps its own set."""
 
-    def lists(name: str) -> list[list[float]]:
-        pairs = zip(items_by_set[name], lines_by_set[name])
-        return [found for item, line in pairs if _learned(line, learned) and (found := right_first(item, line))]
-
-    calibration = {name: lists(name) for name in items_by_set}
+    calibration = {name: learned_right_first(items_by_set[name], lines_by_set[name], learned) for name in items_by_set}
     rows = {}
     for name, items in items_by_set.items():
         others = [x for other, found in calibration.items() if other != name for x in found] or calibration[name]
@@ -296,6 +288,12 @@ def cross_calibrated(
             "set threshold": round(config.set_threshold, 4),
         }
     return rows
+
+
+def learned_right_first(items: list[ExternalItem], lines: list[dict], learned: frozenset[str]) -> list[list[float]]:
+    """`right_first` of each completion line of a learned predicate that has a right candidate: what the
+    learned verbs are calibrated on."""
+    return [found for item, line in zip(items, lines) if _learned(line, learned) and (found := right_first(item, line))]
 
 
 def _learned(line: dict, learned: frozenset[str]) -> bool:
