@@ -3,8 +3,9 @@
 Usage: python bench/bench_executor.py [--placements 20] [--distractors 4] [--seed 0] [--predicates pour,fill,place]
        [--urdf PATH] [--holding] [--videos DIR] [--json PATH]
 For each of the 11 predicates, and for a learned verb of each motion that puts a Theme at a Destination
-(place: put away on a shelf, in a drawer that is opened and shut, or in a chest fridge whose lid is
-lifted open and lowered shut; dispose: throw out into a bin; hand
+(place: put away on a shelf, in a drawer that is opened and shut, in a chest fridge whose lid is lifted
+open and lowered shut, in a dish drawer pulled open and pushed shut, or in a cupboard whose door is swung
+open, the object carried in through its front, and swung shut; dispose: throw out into a bin; hand
 over: hand to a person), and of each class that works with a tool (stir the soup with a spoon, wipe the
 cutting board with a sponge, cut the bread with a knife, cover the pot with a lid; serve: scoop the soup
 into a bowl with the ladle on the table; cook: reheat the soup in the microwave, bake the bread in the
@@ -59,6 +60,8 @@ TASKS = {
     "place": ("put the apple away", "apple", "shelf", "Destination"),
     "place in a drawer": ("put the apple away", "apple", "drawer", "Destination"),
     "place in the fridge": ("put the milk away", "milk", "fridge", "Destination"),
+    "place in the dishwasher": ("put the plate away", "plate", "dishwasher", "Destination"),
+    "place in the cupboard": ("put the cup away", "cup", "cabinet", "Destination"),
     "place on the stove": ("put the pot", "pot", "stove", "Destination"),
     "dispose": ("throw out the banana", "banana", "trash can", "Destination"),
     "hand over": ("hand me the knife", "knife", "person", "Destination"),
@@ -81,6 +84,8 @@ LEARNED = {
     "place",
     "place in a drawer",
     "place in the fridge",
+    "place in the dishwasher",
+    "place in the cupboard",
     "place on the stove",
     "dispose",
     "hand over",

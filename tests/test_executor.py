@@ -553,7 +553,7 @@ def test_round_food_does_not_roll_away_under_what_lands_on_it(sim, tmp_path):
 def test_objects_lower_than_a_side_grip_are_poured_from_a_top_grasp(label, side_grasps):
     """A side grasp holds an object 7.5 cm up at least (the hand clears the table): an ice cube or an egg
     has no body there, and a planned side grasp of one closed the fingers above it."""
-    variants = tasks.variants(SceneObject(label, (0.1, 0.1)), pours=True, opening=0.1)
+    variants = tasks.variants(SceneObject(label, (0.1, 0.1)), side_first=True, opening=0.1)
     assert any(v.side for v in variants) is side_grasps
     assert any(not v.side for v in variants)
 

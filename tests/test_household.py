@@ -66,6 +66,7 @@ OPENING |= {"headroom": 0.165}
         ({**URDF, "opening": {**OPENING, "opens": -1.6}}, "'opens' must be a number"),
         ({**URDF, "opening": {**OPENING, "shut": "almost"}}, "'shut' must be a number"),
         ({**URDF, "opening": {k: v for k, v in OPENING.items() if k != "handle"}}, "handle"),
+        ({**URDF, "opening": {**OPENING, "entry": "side"}}, "'entry' must be one of top, front, not 'side'"),
     ],
 )
 def test_a_bad_receptacle_is_one_line_naming_the_file_and_label(tmp_path, entry, reason):
@@ -122,12 +123,24 @@ def test_scenes_take_the_receptacles_but_the_hand_never_holds_one():
         (Frame.of("put away", {"Theme": "apple", "Destination": "shelf"}), "place", "place"),
         (Frame.of("bring", {"Theme": "sponge", "Destination": "person"}), "stir", "hand over"),
         (Frame.of("put away", {"Theme": "apple", "Destination": "drawer"}), None, "place"),
+        (Frame.of("put away", {"Theme": "plate", "Destination": "dishwasher"}), "place", "place"),
+        (Frame.of("put away", {"Theme": "cup", "Destination": "cabinet"}), "place", "place"),
         # a kitchen container takes what a verb of the place class puts there
         (Frame.of("put", {"Theme": "apple", "Destination": "bowl"}), "place", "place"),
     ],
 )
 def test_a_learned_verb_moves_as_its_destination_asks(frame, verb_motion, motion):
     assert tasks.task_for(frame, verb_motion).motion == motion
+
+
+def test_a_cupboard_is_entered_through_its_front_and_the_others_from_above():
+    through_front = {label for label, r in household().items() if r.opening and r.opening.entry == "front"}
+    assert through_front == {"cabinet"} and household()["drawer"].opening.entry == "top"
+    into = {
+        label: tasks.task_for(Frame.of("put away", {"Theme": "cup", "Destination": label})) for label in household()
+    }
+    assert into["cabinet"] is tasks.PUT_IN and into["cabinet"].sideways
+    assert all(task is not tasks.PUT_IN and not task.sideways for label, task in into.items() if label != "cabinet")
 
 
 def test_the_paper_predicates_keep_their_programs_and_other_classes_have_none():
@@ -321,24 +334,28 @@ def test_a_tool_wipes_only_a_surface_it_lies_on_with_the_hand_above_the_rim(tool
     assert tasks.task_for(Frame.of("wipe", {"Theme": "counter", "Instrument": tool}), "wipe") is None
 
 
-def test_a_drawer_is_pulled_open_filled_and_pushed_shut_with_the_object_inside_it(sim, tmp_path):
-    """The drawer slides on its joint: shut at the start, pulled 14 cm open by its handle, the apple put in,
-    pushed shut; the apple then lies inside the cabinet, under its top, where the drawer took it."""
+@pytest.mark.parametrize("theme, receptacle", [("apple", "drawer"), ("plate", "dishwasher")])
+def test_a_drawer_is_pulled_open_filled_and_pushed_shut_with_the_object_inside_it(sim, tmp_path, theme, receptacle):
+    """A drawer (or a dish drawer's tub) slides on its joint: shut at the start, pulled open by its handle
+    (14 cm; the dish drawer 24 cm, room for a dinner plate), the object put in, pushed shut; the object then
+    lies inside the cabinet, under its top, where the drawer took it."""
     from lmcr.robot.household import household
 
     out = _run(
         tmp_path,
-        [("apple", [-0.1, 0.25]), ("drawer", [0.05, -0.2])],
-        Frame.of("put away", {"Theme": "apple", "Destination": "drawer"}),
+        [(theme, [-0.2, 0.4]), (receptacle, [0.05, -0.2])],
+        Frame.of("put away", {"Theme": theme, "Destination": receptacle}),
     )
     names = [w["name"] for w in out["waypoints"]]
-    assert names.index("pull the drawer open") < names.index("lower into drawer") < names.index("push the drawer shut")
-    drawer, apple = out["target"], out["held"]
-    assert abs(p.getJointState(drawer.body, drawer.joint)[0]) < household()["drawer"].opening.shut
+    assert names.index(f"pull the {receptacle} open") < names.index(f"lower into {receptacle}")
+    assert names.index(f"lower into {receptacle}") < names.index(f"push the {receptacle} shut")
+    assert out["success"] and out["checks"]["in_target"] and out["checks"]["shut"], out["checks"]
+    drawer, held = out["target"], out["held"]
+    assert abs(p.getJointState(drawer.body, drawer.joint)[0]) < household()[receptacle].opening.shut
     cabinet_lo, cabinet_hi = p.getAABB(drawer.body)  # the cabinet (the body's base)
-    pos = p.getBasePositionAndOrientation(apple.body)[0]
+    pos = p.getBasePositionAndOrientation(held.body)[0]
     assert cabinet_lo[0] <= pos[0] <= cabinet_hi[0] and cabinet_lo[1] <= pos[1] <= cabinet_hi[1]
-    assert p.getAABB(apple.body)[1][2] < cabinet_hi[2] and household()["drawer"].opening.opens == 0.14
+    assert p.getAABB(held.body)[1][2] < cabinet_hi[2]
 
 
 def test_a_chest_fridge_lid_is_lifted_open_the_milk_put_in_and_the_lid_lowered_shut(sim, tmp_path):
@@ -365,8 +382,58 @@ def test_a_chest_fridge_lid_is_lifted_open_the_milk_put_in_and_the_lid_lowered_s
     assert not tasks.check_in_target(milk, fridge, None)["ok"]
 
 
-@pytest.mark.parametrize("tall, receptacle", [("milk", "drawer"), ("blender", "fridge")])
-def test_what_is_too_tall_to_shut_a_receptacle_over_is_refused_before_moving(sim, tmp_path, tall, receptacle):
+def test_where_things_go_in_a_receptacle_is_in_its_urdf_frame_not_at_its_centre_of_mass(sim, tmp_path):
+    """pybullet gives a root link's pose at its centre of mass (the fridge's 9 cm up, the cupboard's in the
+    middle of its box); the floor's middle is in the URDF's frame, on the table top."""
+    from lmcr.robot.scene import TABLE_TOP
+
+    scene = make_scene([("fridge", [0.2, -0.3]), ("cabinet", [0.0, 0.25])])
+    build_world(scene, tmp_path)
+    for obj in scene.objects:
+        middle = household()[obj.label].opening.middle
+        expected = [*np.add(world_xy(obj.xy), middle[:2]), TABLE_TOP + middle[2]]
+        assert tasks.opening_point(obj, "middle") == pytest.approx(expected, abs=1e-6)
+
+
+@pytest.mark.parametrize("theme", ["apple", "glass"])
+def test_a_cupboard_door_is_swung_open_the_object_carried_in_through_its_front_and_the_door_swung_shut(
+    sim, tmp_path, theme
+):
+    """The door turns out about its vertical hinge, held by its handle's bar (which turns in the hold), the
+    object is carried in level through the front onto the floor and let go, the door swung back: the object
+    stands in the box behind the shut door; the success check looks at the world, so a door left open fails it."""
+    out = _run(
+        tmp_path,
+        [(theme, [-0.2, 0.42]), ("cabinet", [0.05, -0.2])],
+        Frame.of("put away", {"Theme": theme, "Destination": "cabinet"}),
+    )
+    names = [w["name"] for w in out["waypoints"]]
+    opened = [n for n in names if n.startswith("swing the cabinet open")]
+    assert len(opened) == 11 and names.index(opened[-1]) < names.index("into the cabinet")  # 100 degrees in 10
+    assert (
+        names.index("into the cabinet")
+        < names.index("out of the cabinet")
+        < names.index("swing the cabinet shut (11/11)")
+    )
+    assert out["success"] and out["checks"]["in_target"] and out["checks"]["shut"], out["checks"]
+    cabinet, held = out["target"], out["held"]
+    box_lo, box_hi = p.getAABB(cabinet.body, -1)
+    lo, hi = p.getAABB(held.body)
+    assert box_lo[0] < lo[0] and hi[0] < box_hi[0] and box_lo[1] < lo[1] and hi[1] < box_hi[1]
+    assert hi[2] < box_hi[2] and lo[2] < box_lo[2] + 0.03  # on the floor, under the top, behind the door
+    p.resetJointState(cabinet.body, cabinet.joint, -household()["cabinet"].opening.opens)
+    assert not tasks.check_in_target(held, cabinet, None)["ok"]
+
+
+@pytest.mark.parametrize(
+    "tall, receptacle, room",
+    [
+        ("milk", "drawer", "to shut the drawer over it"),
+        ("blender", "fridge", "to shut the fridge over it"),
+        ("blender", "dishwasher", "to shut the dishwasher over it"),
+    ],
+)
+def test_what_is_too_tall_to_shut_a_receptacle_over_is_refused_before_moving(sim, tmp_path, tall, receptacle, room):
     from lmcr.robot.plan import Infeasible, Planner
 
     scene = make_scene([(tall, [-0.1, 0.25]), (receptacle, [0.05, -0.2])])
@@ -374,8 +441,22 @@ def test_what_is_too_tall_to_shut_a_receptacle_over_is_refused_before_moving(sim
     task = tasks.task_for(Frame.of("put away", {"Theme": tall, "Destination": receptacle}))
     refused = planner.plan_shut_receptacle(task, scene.find(tall), scene.find(receptacle), holding=False)
     assert isinstance(refused, Infeasible)
-    assert refused.reason == f"the {tall} is too tall to shut the {receptacle} over it"
+    assert refused.reason == f"the {tall} is too tall {room}"
     assert p.getJointState(scene.find(receptacle).body, scene.find(receptacle).joint)[0] == 0.0
+
+
+def test_what_a_cupboard_has_no_room_for_is_refused_before_its_door_is_opened(sim, tmp_path, monkeypatch):
+    from dataclasses import replace
+
+    from lmcr.robot.plan import Infeasible, Planner
+
+    low = household()["cabinet"]  # a cupboard 5 cm high inside
+    monkeypatch.setitem(household(), "cabinet", replace(low, opening=replace(low.opening, headroom=0.05)))
+    scene = make_scene([("cup", [-0.2, 0.42]), ("cabinet", [0.05, -0.2])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = tasks.task_for(Frame.of("put away", {"Theme": "cup", "Destination": "cabinet"}))
+    refused = planner.plan_shut_receptacle(task, scene.find("cup"), scene.find("cabinet"), holding=False)
+    assert isinstance(refused, Infeasible) and refused.reason == "the cup is too tall to stand in the cabinet"
 
 
 def test_the_person_holds_what_was_handed_over_and_not_what_was_not(sim, tmp_path):

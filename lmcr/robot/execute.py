@@ -272,7 +272,7 @@ def _instances(scene: Scene, frame: Frame, task: Task, role: str, seen: set[str]
 
 def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, SceneObject]) -> Plan | Infeasible:
     """The plan for a task with its objects (role -> object), or why there is none: the hand emptied first
-    when it holds something else; a drawer or a fridge opened, filled and shut by one arm; else directly.
+    when it holds something else; a drawer, a fridge or a cupboard opened, filled and shut by one arm; else directly.
     Where that is refused, something is set down elsewhere first (`_set_aside`)."""
     task = task.with_source(objects)
     held, target = objects[task.held_role], objects[task.target_role]

@@ -1,12 +1,12 @@
 """The household's receptacles, the person and the tools, described in data (`household.json`), not code:
-bins, boxes, a shelf, a stove, a drawer, a fridge, a hand held out over the table; a knife, a lid, a ladle,
-a whisk, foil. Each receptacle is its shape (an open box, or boxes put together, or a URDF body with
-joints), its mass (0: fixed in place), the surface things are put on (inside it below the rim, or on its
-top) and the motion that puts a Theme there (place, dispose, hand over). The scene takes them as objects
-like the kitchen's containers; the world builds them from their parts; a learned verb's frame with a
-Theme and a Destination is carried out with the Destination's motion (`tasks.task_for`). A tool is its
-shape, its mass, where the hand holds it (`grip`) and, for a knife, its blade's edge, for a ladle, its
-bowl.
+bins, boxes, a shelf, a stove, a drawer, a fridge, a dish drawer, a cupboard, a hand held out over the
+table; a knife, a lid, a ladle, a whisk, foil. Each receptacle is its shape (an open box, or boxes put
+together, or a URDF body with joints), its mass (0: fixed in place), the surface things are put on
+(inside it below the rim, or on its top) and the motion that puts a Theme there (place, dispose, hand
+over). The scene takes them as objects like the kitchen's containers; the world builds them from their
+parts; a learned verb's frame with a Theme and a Destination is carried out with the Destination's
+motion (`tasks.task_for`). A tool is its shape, its mass, where the hand holds it (`grip`) and, for a
+knife, its blade's edge, for a ladle, its bowl.
 
 A light module (json only): the scene's validation reads the vocabulary without loading the simulator."""
 
@@ -23,6 +23,7 @@ from lmcr.errors import LMCRError
 HOUSEHOLD_FILE = Path(__file__).with_name("household.json")
 MOTIONS = ("place", "dispose", "hand over")  # the motions that put a Theme at a Destination
 SURFACES = ("inside", "top")
+ENTRIES = ("top", "front")  # how things go into an opened receptacle: lowered from above, or in through its front
 CENTRED = 0.001  # metres: how far off the origin the middle of a body's parts may lie
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]  # half extents, centre
@@ -35,11 +36,13 @@ class HouseholdError(LMCRError, ValueError):
 @dataclass(frozen=True)
 class Opening:
     """How a shut receptacle is opened, filled and shut again: a drawer slides out on a prismatic `joint`, a
-    chest fridge's lid turns up on a revolute one. The hand holds the `handle` (the bar's middle, in the
-    frame of the link the joint moves) and moves it along the joint's travel, `opens` (metres or radians:
-    the joint stands at -opens when open), and back; things go to the `middle` of the floor of the `link`
-    they are put in (its frame; the URDF's root link for a box that stays put), at most `headroom` tall (what
-    shuts passes over them). Within `shut` of its closed end (joint units) it counts as shut."""
+    chest fridge's lid turns up on a revolute one, a cupboard's door swings out on one. The hand holds the
+    `handle` (the bar's middle, in the frame of the link the joint moves) and moves it along the joint's
+    travel, `opens` (metres or radians: the joint stands at -opens when open), and back; things go to the
+    `middle` of the floor of the `link` they are put in (its frame; the URDF's root link for a box that
+    stays put), at most `headroom` tall (what shuts passes over them, or what the box has room for), by its
+    `entry`: lowered from the `top`, or carried in through the `front` (a cupboard's). Within `shut` of its
+    closed end (joint units) it counts as shut."""
 
     link: str
     joint: str
@@ -48,6 +51,7 @@ class Opening:
     middle: tuple[float, float, float]
     headroom: float
     shut: float = 0.01
+    entry: str = "top"
 
     def joint_at(self, open_: bool) -> float:
         """The joint's value with the receptacle open (-opens) or shut (0)."""
@@ -288,7 +292,8 @@ def _opening(entry: object, where: str) -> Opening:
     middle = _numbers(entry.get("middle"), 3, f"{where}: middle")
     opens, headroom = _number(entry, "opens", where), _number(entry, "headroom", where)
     shut = _number(entry, "shut", where, default=Opening.shut)
-    return Opening(entry["link"], entry["joint"], opens, handle, middle, headroom, shut)
+    way_in = _choice({"entry": Opening.entry, **entry}, "entry", ENTRIES, where)
+    return Opening(entry["link"], entry["joint"], opens, handle, middle, headroom, shut, way_in)
 
 
 @cache

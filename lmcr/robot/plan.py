@@ -221,7 +221,7 @@ class Planner:
     def plan_as_it_stands(
         self, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str = "home"
     ) -> Plan | Infeasible:
-        """The task planned with nothing set down first: into a shut receptacle (a drawer, a fridge) through
+        """The task planned with nothing set down first: into a shut receptacle (a drawer, a fridge, a cupboard) through
         its opening (`plan_shut_receptacle`), else directly (`plan`), the arm from its `start`."""
         if target.joint >= 0:
             return self.plan_shut_receptacle(task, held, target, holding, start)
@@ -230,14 +230,16 @@ class Planner:
     def plan_shut_receptacle(
         self, task: Task, held: SceneObject, target: SceneObject, holding: bool, start: str = "home"
     ) -> Plan | Infeasible:
-        """Into a drawer or a chest fridge: open it, do the task with it open, shut it, all three with one
-        arm (the nearer first; the other parked), each part planned in the world the one before leaves (the
-        held object lying in it for the shutting), the arm from its `start` ("home" or "parked"). Refused
-        at once when the held object is too tall to shut the drawer or the lid over it. A spent budget ends
+        """Into a drawer, a chest fridge or a cupboard: open it, do the task with it open, shut it, all three
+        with one arm (the nearer first; the other parked), each part planned in the world the one before
+        leaves (the held object lying in it for the shutting), the arm from its `start` ("home" or
+        "parked"). Refused at once when the held object is too tall to shut the drawer or the lid over it,
+        or to stand in the cupboard. A spent budget ends
         the search."""
         found = household()[target.shape].opening
         if height(held.shape) > found.headroom:
-            return Infeasible(f"{_named(held)} is too tall to shut {_named(target)} over it", 0, False, _named(target))
+            room = f"to stand in {_named(target)}" if found.entry == "front" else f"to shut {_named(target)} over it"
+            return Infeasible(f"{_named(held)} is too tall {room}", 0, False, _named(target))
         best = Infeasible("nothing was tried", -1)
         for side in _nearer_first(target, SIDES):
             if self.spent():
@@ -587,7 +589,9 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
         found = variants(held, turns=task.turns, wide=task.wide)
         found = [v for v in found if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
     else:
-        found = variants(held, task.pours, opening, task.turns, task.wide)
+        found = variants(held, task.pours or task.sideways, opening, task.turns, task.wide)
+    if task.sideways:  # in through a front: a hand leaning forward trails behind the object, under the box's top
+        found = sorted(found, key=lambda v: -v.pitch)
     return [v for v in found if v.turn == 0.0] if task.square else found
 
 

@@ -65,8 +65,21 @@ HANDLE_BAR = 0.015  # a drawer's or a lid's handle bar, this thick
 # the hand leaning forward this far (radians) all the while: held straight down, the bar of an open lid on
 # the far side of the table is out of reach (its hold lets the bar turn, so the hand need not turn with it)
 CHORD, LID_LEAN = math.radians(10), 0.3
+# what opening and shutting is called, by how the joint moves: a drawer slides, a lid turns up, a door out
+OPENING_WORDS = {
+    ("slide", True): "pull {} open",
+    ("slide", False): "push {} shut",
+    ("lid", True): "lift {} open",
+    ("lid", False): "lower {} shut",
+    ("door", True): "swing {} open",
+    ("door", False): "swing {} shut",
+}
 HANDLE_APPROACH = 0.1  # the hand comes onto a handle, and leaves it, along its own axis from this far
 PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this far above the table
+# an object put in through a cupboard's front is let go with its underside this far over the floor (over
+# the 1 cm every motion keeps from what it does not touch), after coming up to the opening with its near
+# side this far before the front
+FRONT_LIFT, FRONT_CLEAR = 0.015, 0.03
 CUT_STROKES, SAW = 3, 0.015  # a cut saws down through the food in this many strokes, the blade this far back and forth
 CUT_ABOVE, CUT_CLEAR = 0.03, 0.004  # the edge starts this far above the food; it ends this far above the board
 CUT_THROUGH = 0.006  # the food is cut through when the edge came this near its underside
@@ -252,10 +265,21 @@ def opening_point(target: SceneObject, which: str) -> np.ndarray:
     """A shut receptacle's `handle` (on the link its joint moves) or the `middle` of the floor things are put
     on (on the link that holds them) in the world, where it now stands (open or shut; household.json)."""
     link = target.joint if which == "handle" else target.link  # pybullet numbers a joint's child link as it
-    pos, orn = p.getLinkState(target.body, link)[4:6] if link >= 0 else p.getBasePositionAndOrientation(target.body)
+    pos, orn = link_frame(target.body, link)
     return np.asarray(
         p.multiplyTransforms(pos, orn, getattr(household()[target.shape].opening, which), (0, 0, 0, 1))[0]
     )
+
+
+def link_frame(body: int, link: int) -> tuple[tuple, tuple]:
+    """A link's frame as its URDF describes it, in the world (-1: the root link). pybullet gives a root
+    link's pose at its centre of mass, which its URDF's inertial origin sets off the link's frame (a
+    cupboard's mass is in the middle of its box, above the floor things are put on)."""
+    if link >= 0:
+        return p.getLinkState(body, link)[4:6]
+    pos, orn = p.getBasePositionAndOrientation(body)
+    inertial_pos, inertial_orn = p.getDynamicsInfo(body, -1)[3:5]
+    return p.multiplyTransforms(pos, orn, *p.invertTransform(inertial_pos, inertial_orn))
 
 
 def hinged(target: SceneObject) -> bool:
@@ -264,9 +288,9 @@ def hinged(target: SceneObject) -> bool:
 
 
 def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
-    """Open a drawer or a lid (or shut it) by its handle: the gripper comes onto the bar along its own axis,
-    holds it, moves it along the joint's whole travel (straight along a slide; round a hinge in chords of
-    CHORD, leaning LID_LEAN forward, the bar turning in the hold), lets go and draws back straight."""
+    """Open a drawer, a lid or a door (or shut it) by its handle: the gripper comes onto the bar along its
+    own axis, holds it, moves it along the joint's whole travel (straight along a slide; round a hinge in
+    chords of CHORD, leaning LID_LEAN forward, the bar turning in the hold), lets go and draws back straight."""
     found = household()[target.shape].opening
     turns = hinged(target)
     start, end = p.getJointState(target.body, target.joint)[0], found.joint_at(opening)
@@ -278,8 +302,8 @@ def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
     axis = np.array([math.sin(lean), 0.0, -math.cos(lean)])  # the way the fingers point
     grip = opening_point(target, "handle") - axis * (HANDLE_BAR / 2 + GRIP_GAP)
     path = _moved_with(target, grip, [start + (end - start) * k / pieces for k in range(1, pieces + 1)])
-    way = {(False, True): "pull {} open", (False, False): "push {} shut", (True, True): "lift {} open"}
-    name = way.get((turns, opening), "lower {} shut").format(f"the {target.name}")
+    kind = ("door" if _upright_axis(target) else "lid") if turns else "slide"
+    name = OPENING_WORDS[kind, opening].format(f"the {target.name}")
     return [
         move(f"above the {target.name}'s handle", grip - axis * HANDLE_APPROACH, orn),
         move(f"on the {target.name}'s handle", grip, orn, touches="target"),
@@ -292,6 +316,13 @@ def opening_steps(target: SceneObject, opening: bool) -> list[Step]:
         # straight off the bar: a joint-space move with the target ignored swept a hand through an open lid
         Step("move", "up from the handle", (path[-1] - axis * HANDLE_APPROACH,), orn, "target", straight=True),
     ]
+
+
+def _upright_axis(target: SceneObject) -> bool:
+    """Whether the target's hinge turns about the vertical (a door's), not about a level axis (a lid's)."""
+    axis = p.getJointInfo(target.body, target.joint)[13]
+    orn = p.getLinkState(target.body, target.joint)[5]
+    return abs(p.multiplyTransforms([0, 0, 0], orn, axis, [0, 0, 0, 1])[0][2]) > 0.9
 
 
 def _moved_with(target: SceneObject, point: np.ndarray, values: list[float]) -> list[np.ndarray]:
@@ -346,13 +377,14 @@ def gripper_over(point_in_hand: np.ndarray, orientation) -> float:
 
 
 def variants(
-    held: SceneObject, pours: bool = False, opening: float = 0.0, turns: bool = False, wide: bool = False
+    held: SceneObject, side_first: bool = False, opening: float = 0.0, turns: bool = False, wide: bool = False
 ) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
-    forward, each tilting either way when the task `turns` it; for pouring, side grasps first where the
-    object fits between the fingers, `opening` wide less a centimetre (the hand then stays high while it
-    pours), headed from the robot towards the object. A `wide` task's hand also turns by WIDE_TURNS."""
+    forward, each tilting either way when the task `turns` it; `side_first` (pouring, putting in through a
+    front), side grasps first where the object fits between the fingers, `opening` wide less a centimetre
+    (the hand then stays high while it pours, level behind it as it goes in), headed from the robot towards
+    the object. A `wide` task's hand also turns by WIDE_TURNS."""
     half_x, half_y, round_ = outline(held.shape)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if round_:  # a square box held across its corners would not fit between fingers set for its sides
@@ -374,7 +406,11 @@ def variants(
         for sign in signs
     ]
     narrow = [replace(v, narrow=True) for v in top]  # last: where no grasp with open fingers is clear
-    if not pours or 2 * footprint(held.shape) > opening - 0.01 or side_grip_height(held.shape) >= height(held.shape):
+    if (
+        not side_first
+        or 2 * footprint(held.shape) > opening - 0.01
+        or side_grip_height(held.shape) >= height(held.shape)
+    ):
         return (
             top + narrow
         )  # a side grasp needs the body between the fingers: lower than its grip, it is held by the top
@@ -475,6 +511,26 @@ def _lower_into(g: Geometry, v: Variant) -> Step:
     # into a container it passes the walls clear (a bottle wider than a glass's opening would end on its rim)
     walled = _walled(g.target.shape)
     return move(f"lower {'into' if walled else 'onto'} {g.target.name}", lower, orn, touches="target", into=walled)
+
+
+def program_put_in(g: Geometry, v: Variant, holding: bool) -> list[Step]:
+    """Put the held object into an opened cupboard through its front (a receptacle whose `entry` is
+    "front"): carried to stand before the opening at the height it will stand at inside, moved straight in
+    along the way the box faces to the middle of its floor, let go, the hand drawn straight back out and
+    up. Every motion keeps clear of the box, its open door and what stands in it."""
+    orn, name = v.at_target(), g.target.name
+    floor = opening_point(g.target, "middle")
+    inside_ = gripper_for(g.centre(v), orn, floor + [0, 0, FRONT_LIFT + height(g.held.shape) / 2])
+    front = g.target_box[0][0]  # the box's near side (its root link's box: the door is a link of its own)
+    before = inside_ - [floor[0] - (front - FRONT_CLEAR - footprint(g.held.shape)), 0.0, 0.0]
+    return [
+        *pick(g, v, holding),
+        move(f"before the {name}", before, orn),
+        Step("move", f"into the {name}", (inside_,), orn, straight=True),
+        Step("release", "let go"),
+        Step("move", f"out of the {name}", (before,), orn, straight=True),
+        above(before, "retreat", orn),
+    ]
 
 
 def program_hand_over(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -1015,6 +1071,7 @@ class Task:
     motion: str = ""  # the class of motion it is (a learned verb's), else the predicate's own program
     square: bool = False  # the held object stays square to the table (the program turns it, if at all)
     wide: bool = False  # the hand may also turn by WIDE_TURNS while carrying (a tool with a long handle)
+    sideways: bool = False  # side grasps are tried first where the object fits (as for pouring), not poured
     source_role: str = ""  # the role of a third object the motion works with (serve: what it scoops from)
     # ... that object, once the instruction's objects are known (`with_source`)
     source: SceneObject | None = field(default=None, compare=False)
@@ -1045,6 +1102,9 @@ MOTIONS = {
     "dispose": Task("Theme", "Destination", program_place, check_in_bin, motion="dispose"),
     "hand over": Task("Theme", "Destination", program_hand_over, check_handed_over, motion="hand over"),
 }
+# placing into a receptacle entered through its front (a cupboard): held from the side first where the
+# object fits between the fingers (the hand then goes in level behind it, not above it)
+PUT_IN = Task("Theme", "Destination", program_put_in, check_in_target, motion="place", sideways=True)
 # the motions of a learned verb's class that work with a tool (the Instrument) on the Theme
 TOOL_MOTIONS = {
     "stir": Task("Instrument", "Theme", program_stir, check_stir, turns=True, motion="stir"),
@@ -1094,7 +1154,8 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
         return None
     found = household().get(roles["Destination"])
     if found is not None:
-        return MOTIONS[found.motion]
+        in_front = found.motion == "place" and found.opening is not None and found.opening.entry == "front"
+        return PUT_IN if in_front else MOTIONS[found.motion]
     return MOTIONS["place"] if verb_motion == "place" else None
 
 
