@@ -445,6 +445,50 @@ def test_what_is_too_tall_to_shut_a_receptacle_over_is_refused_before_moving(sim
     assert p.getJointState(scene.find(receptacle).body, scene.find(receptacle).joint)[0] == 0.0
 
 
+def test_where_the_open_door_stands_in_the_way_back_to_its_start_the_arm_goes_on_from_the_handle(sim, tmp_path):
+    """A cupboard at the right arm's end of the table: its door, swung open, stands where that arm's start
+    is, so the arm goes on from above the handle to the cup; the cup ends in the shut cupboard."""
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.plan import Plan, Planner
+
+    scene = make_scene([("cup", [0.2, 0.0]), ("cabinet", [0.0, -0.3])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = tasks.task_for(Frame.of("put away", {"Theme": "cup", "Destination": "cabinet"}))
+    cup, cabinet = scene.find("cup"), scene.find("cabinet")
+    plan = planner.plan_shut_receptacle(task, cup, cabinet, holding=False)
+    assert isinstance(plan, Plan) and plan.arm.side == "right"
+    assert [s.step.name for s in plan.opens.segments][-1] == "up from the handle"  # not back to its start
+    assert np.allclose(plan.segments[0].path[0], plan.opens.segments[-1].path[-1])  # on from there
+    out = run_plan(plan, cup, cabinet, [], planner)
+    assert out["success"] and out["checks"]["in_target"] and out["checks"]["shut"], out["checks"]
+
+
+def test_a_grasp_whose_hand_cannot_stand_in_the_cupboard_is_refused_before_its_motions_are_planned(sim, tmp_path):
+    """The pose inside a cupboard decides a grasp, and is checked first: with the door shut, a hand leaning
+    forward trails out through it (refused at that step, naming the cabinet), while an upright one stands
+    wholly inside the box (left to the planning of its motions, which must pass the door). The check
+    solves at most the step's two poses a grasp and leaves the cup where it stood."""
+    from lmcr.robot.collision import Clearance
+    from lmcr.robot.plan import Carried, Planner, _hemmed_in, _variants
+
+    scene = make_scene([("cup", [-0.2, 0.42]), ("cabinet", [0.05, -0.2])])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    cup, cabinet = scene.find("cup"), scene.find("cabinet")
+    arm, standing = planner.arms["right"], p.getBasePositionAndOrientation(cup.body)
+    clearance, g = Clearance(arm, planner._obstacles(cup)), tasks.Geometry.measure(cup, cabinet)
+    grasps = [v for v in _variants(cup, tasks.PUT_IN, False, arm.opening) if v.turn == 0 and not v.narrow]
+    solved, found = arm.ik_calls, {}
+    for v in grasps:
+        steps = tasks.program_put_in(g, v, False)
+        found[v] = _hemmed_in(arm, clearance, steps, cup, cabinet, Carried(cup.body, *g.in_hand(v)))
+        into = next(i for i, step in enumerate(steps) if step.decides)
+        assert steps[into].name == "into the cabinet" and len(steps[into].positions) == 2
+    assert arm.ik_calls - solved <= 2 * len(grasps) and p.getBasePositionAndOrientation(cup.body) == standing
+    leaning = [r for v, r in found.items() if v.pitch == tasks.FRONT_LEAN]
+    assert leaning and all(r is not None and r.progress == into and r.blocker == "the cabinet" for r in leaning)
+    assert all(r is None for v, r in found.items() if v.pitch == 0.0 and not v.side)
+
+
 def test_what_a_cupboard_has_no_room_for_is_refused_before_its_door_is_opened(sim, tmp_path, monkeypatch):
     from dataclasses import replace
 

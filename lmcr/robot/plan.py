@@ -25,8 +25,10 @@ from lmcr.robot.household import household
 from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, height, world_xy
 from lmcr.robot.tasks import (
+    FRONT_LEAN,
     GRIP_GAP,
     OPENING,
+    PITCHES,
     Geometry,
     Step,
     Task,
@@ -123,11 +125,12 @@ class Planner:
         target: SceneObject,
         holding: bool,
         arms: tuple[str, ...] = SIDES,
-        start: str = "home",
+        start: str | np.ndarray = "home",
     ) -> Plan | Infeasible:
         """The first feasible plan over the `arms` (the nearer one first) and the task's variants, or the
         reason of the attempt that got furthest. The arm starts at its `start` configuration ("home",
-        or "parked": then it first moves home), the other one parked. A spent budget ends the search."""
+        "parked": then it first moves home, or joints: where opening a door left it), the other one parked.
+        A spent budget ends the search."""
         sides = _nearer_first(held if not holding else target, arms)
         best = Infeasible("nothing was tried", -1)
         for side in sides:
@@ -136,7 +139,8 @@ class Planner:
             try:
                 other.set_config(other.parked)
                 other.shape_fingers(other.finger_open, now=True)
-                arm.set_config(getattr(arm, start))
+                begin = getattr(arm, start) if isinstance(start, str) else start
+                arm.set_config(begin)
                 if holding:
                     _put_in_hand(arm, held)
                 g = Geometry.measure(held, target, task.source)
@@ -155,16 +159,15 @@ class Planner:
                     arm.shape_fingers(approach_fingers(arm, variant, held.shape), now=True)
                     carried = Carried(held.body, *g.in_hand(variant)) if holding else None
                     steps = [
-                        *([Step("home", "to its start")] if start != "home" else []),
+                        *([Step("home", "to its start")] if isinstance(start, str) and start != "home" else []),
                         *task.program(g, variant, holding),
                     ]
-                    result = self._plan_variant(arm, clearance, steps, held, target, carried, getattr(arm, start))
+                    result = _hemmed_in(arm, clearance, steps, held, target, Carried(held.body, *g.in_hand(variant)))
+                    result = result or self._plan_variant(arm, clearance, steps, held, target, carried, begin)
                     _restore(held, standing)  # the checks of carried motions left it in the hand
                     found = g
                     if isinstance(result, list) and not holding:
-                        result, found = self._as_grasped(
-                            arm, other, getattr(arm, start), result, steps, task, g, variant
-                        )
+                        result, found = self._as_grasped(arm, other, begin, result, steps, task, g, variant)
                         _restore(held, standing)
                     if isinstance(result, list):
                         return Plan(arm, other, variant, result, carried, found, task)
@@ -260,8 +263,10 @@ class Planner:
             return opening
         saved = _save(held)
         p.resetJointState(target.body, target.joint, household()[target.shape].opening.joint_at(True))
+        # on from its start, or from above the handle when the open door stood in the way back there
+        resume = "home" if opening.segments[-1].step.kind == "home" else opening.segments[-1].path[-1]
         try:
-            rest = self.plan(task, held, target, holding, arms=(side,), start="home")
+            rest = self.plan(task, held, target, holding, arms=(side,), start=resume)
             if isinstance(rest, Infeasible):
                 return replace(rest, progress=rest.progress + len(opening.segments))
             bottom = opening_point(target, "middle") + [0, 0, 0.002]  # as it will lie in it, upright
@@ -287,10 +292,11 @@ class Planner:
         start: np.ndarray,
         moving: SceneObject | None = None,
     ) -> Plan | Infeasible:
-        """The drawer or lid opened (then the arm back at its start) or shut, from joints `start`; `moving`:
-        what lies in it (a drawer carries it along, no obstacle). What follows the motion along the joint is
-        planned with the drawer or lid where that motion leaves it (an open lid stands in the way home);
-        the joint is left as it was."""
+        """The drawer, lid or door opened (then the arm back at its start, or, where the open door leaves it
+        no clear way there, up from the handle) or shut, from joints `start`; `moving`: what lies in it (a
+        drawer carries it along, no obstacle). What follows the motion along the joint is planned with the
+        drawer, lid or door where that motion leaves it (an open lid stands in the way home); the joint is
+        left as it was."""
         away = opening and not np.array_equal(start, arm.home)  # parked: it comes to its start first
         steps = [
             *([Step("home", "to its start")] if away else []),
@@ -309,6 +315,8 @@ class Planner:
         p.resetJointState(target.body, target.joint, household()[target.shape].opening.joint_at(opening))
         try:
             rest = self._plan_variant(arm, clearance, steps[moved:], target, target, None, found[-1].path[-1])
+            if isinstance(rest, Infeasible) and opening and rest.progress == len(steps) - moved - 1:
+                rest = self._plan_variant(arm, clearance, steps[moved:-1], target, target, None, found[-1].path[-1])
         finally:
             p.resetJointState(target.body, target.joint, was)
         if isinstance(rest, Infeasible):
@@ -477,6 +485,42 @@ class Planner:
         return segments
 
 
+def _hemmed_in(
+    arm: Arm, clearance: Clearance, steps: list[Step], held: SceneObject, target: SceneObject, carried: Carried
+) -> Infeasible | None:
+    """Why a step that `decides` the variant cannot be reached clear, the object held as planned (IK from
+    the arm's start; the arm and the object are left where they were): planning the motions up to it
+    first cost seconds a variant, in a search that tries dozens. None when every such step can."""
+    saved, standing = arm.config(), _save(held)
+    try:
+        for i, step in enumerate(steps):
+            if step.decides:
+                reached, hit = _reached_clear(arm, clearance, step, carried, target)
+                if not reached or hit:
+                    why = f"'{step.name}' would put the {arm.side} arm against {hit}" if hit else ""
+                    return Infeasible(why or _cannot_reach(arm, step, 0.0), i, not hit, hit)
+        return None
+    finally:
+        arm.set_config(saved)
+        _restore(held, standing)
+
+
+def _reached_clear(
+    arm: Arm, clearance: Clearance, step: Step, carried: Carried, target: SceneObject
+) -> tuple[bool, str]:
+    """Whether any of a step's positions is reached, and what the last reached one hit ("" when one is
+    reached clear)."""
+    ignore = frozenset({target.body} if step.touches == "target" else ())
+    reached, hit = False, ""
+    for position in step.positions:
+        goal, err_pos, err_rot = arm.solve(position, step.orientation, [arm.home])
+        if err_pos <= IK_POSITION and err_rot <= IK_ROTATION:
+            reached, hit = True, clearance.clash(goal, carried, ignore) or ""
+            if not hit:
+                return True, ""
+    return reached, hit
+
+
 def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
     """Why a step is out of reach: the arm and how far short of it the gripper stays (metres)."""
     return f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)"
@@ -591,7 +635,8 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
     else:
         found = variants(held, task.pours or task.sideways, opening, task.turns, task.wide)
     if task.sideways:  # in through a front: a hand leaning forward trails behind the object, under the box's top
-        found = sorted(found, key=lambda v: -v.pitch)
+        leaning = [replace(v, pitch=FRONT_LEAN) for v in found if v.pitch == max(PITCHES)]
+        found = sorted(leaning + found, key=lambda v: -v.pitch)
     return [v for v in found if v.turn == 0.0] if task.square else found
 
 

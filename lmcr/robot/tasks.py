@@ -47,6 +47,8 @@ SHAKE_HEIGHT = 0.18  # a shaker's opening above the target: flat targets (pizza,
 SIDE_GRIP, SIDE_GRIP_MIN = 0.6, 0.075  # side grasps hold 60 % up the object, at least 7.5 cm above the table
 SIDE_APPROACH = 0.12  # a side grasp starts this far back along the gripper's axis
 PITCHES = (0.0, 0.5)  # the gripper upright, or leaning forward to reach the far side of the table
+# ... or further, into a cupboard through its front: the hand then trails low behind what it holds, under the top
+FRONT_LEAN = 0.9
 TURNS = (0.0, 0.8, -0.8)  # radians the hand may turn about the vertical while carrying
 # ... and further for a tool held by a long handle (a ladle): where the handle points decides whether the
 # arm can tip its bowl over the target
@@ -80,6 +82,7 @@ PUT_DOWN_HEIGHT = 0.005  # an object put down is let go with its underside this 
 # the 1 cm every motion keeps from what it does not touch), after coming up to the opening with its near
 # side this far before the front
 FRONT_LIFT, FRONT_CLEAR = 0.015, 0.03
+FRONT_DOOR = 0.02  # ... and stood at least this far behind the front, for the door to shut clear of it
 CUT_STROKES, SAW = 3, 0.015  # a cut saws down through the food in this many strokes, the blade this far back and forth
 CUT_ABOVE, CUT_CLEAR = 0.03, 0.004  # the edge starts this far above the food; it ends this far above the board
 CUT_THROUGH = 0.006  # the food is cut through when the edge came this near its underside
@@ -114,6 +117,9 @@ class Step:
     # (what is in it), the object must pass the walls clear
     into: bool = False
     straight: bool = False  # the gripper moves along the straight line (pulling a drawer on its slide)
+    # a pose so hemmed in (the hand inside a cupboard) that it decides the variant: it is checked, reach and
+    # clearance with the object held as planned, before any motion to it is planned
+    decides: bool = False
 
     @property
     def moves(self) -> bool:
@@ -518,15 +524,18 @@ def program_put_in(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     "front"): carried to stand before the opening at the height it will stand at inside, moved straight in
     along the way the box faces to the middle of its floor, let go, the hand drawn straight back out and
     up. Every motion keeps clear of the box, its open door and what stands in it."""
-    orn, name = v.at_target(), g.target.name
+    orn, name, half = v.at_target(), g.target.name, footprint(g.held.shape)
     floor = opening_point(g.target, "middle")
     inside_ = gripper_for(g.centre(v), orn, floor + [0, 0, FRONT_LIFT + height(g.held.shape) / 2])
     front = g.target_box[0][0]  # the box's near side (its root link's box: the door is a link of its own)
-    before = inside_ - [floor[0] - (front - FRONT_CLEAR - footprint(g.held.shape)), 0.0, 0.0]
+    before = inside_ - [floor[0] - (front - FRONT_CLEAR - half), 0.0, 0.0]
+    # the middle of the floor, else as near the front as leaves the door room to shut (the far end of the
+    # arm's reach)
+    nearest = max(0.0, floor[0] - (front + FRONT_DOOR + half))
     return [
         *pick(g, v, holding),
         move(f"before the {name}", before, orn),
-        Step("move", f"into the {name}", (inside_,), orn, straight=True),
+        Step("move", f"into the {name}", (inside_, inside_ - [nearest, 0.0, 0.0]), orn, straight=True, decides=True),
         Step("release", "let go"),
         Step("move", f"out of the {name}", (before,), orn, straight=True),
         above(before, "retreat", orn),
