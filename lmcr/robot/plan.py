@@ -12,6 +12,7 @@ back into the others' state. Joint-space paths are `joint_paths.py`, acting the 
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 
@@ -237,8 +238,7 @@ class Planner:
         with one arm (the nearer first; the other parked), each part planned in the world the one before
         leaves (the held object lying in it for the shutting), the arm from its `start` ("home" or
         "parked"). Refused at once when the held object is too tall to shut the drawer or the lid over it,
-        or to stand in the cupboard. A spent budget ends
-        the search."""
+        or to stand in the cupboard. A spent budget ends the search."""
         found = household()[target.shape].opening
         if height(held.shape) > found.headroom:
             room = f"to stand in {_named(target)}" if found.entry == "front" else f"to shut {_named(target)} over it"
@@ -495,10 +495,11 @@ def _hemmed_in(
     try:
         for i, step in enumerate(steps):
             if step.decides:
-                reached, hit = _reached_clear(arm, clearance, step, carried, target)
-                if not reached or hit:
-                    why = f"'{step.name}' would put the {arm.side} arm against {hit}" if hit else ""
-                    return Infeasible(why or _cannot_reach(arm, step, 0.0), i, not hit, hit)
+                short, hit = _reached_clear(arm, clearance, step, carried, target)
+                if short > IK_POSITION:
+                    return Infeasible(_cannot_reach(arm, step, short), i, True)
+                if hit:
+                    return Infeasible(f"'{step.name}' would put the {arm.side} arm against {hit}", i, False, hit)
         return None
     finally:
         arm.set_config(saved)
@@ -507,18 +508,20 @@ def _hemmed_in(
 
 def _reached_clear(
     arm: Arm, clearance: Clearance, step: Step, carried: Carried, target: SceneObject
-) -> tuple[bool, str]:
-    """Whether any of a step's positions is reached, and what the last reached one hit ("" when one is
-    reached clear)."""
+) -> tuple[float, str]:
+    """How far short of the nearest of a step's positions the gripper stays (0 when one is reached), and
+    what the last one reached hits ("" when one is reached clear)."""
     ignore = frozenset({target.body} if step.touches == "target" else ())
-    reached, hit = False, ""
+    short, hit = math.inf, ""
     for position in step.positions:
         goal, err_pos, err_rot = arm.solve(position, step.orientation, [arm.home])
-        if err_pos <= IK_POSITION and err_rot <= IK_ROTATION:
-            reached, hit = True, clearance.clash(goal, carried, ignore) or ""
-            if not hit:
-                return True, ""
-    return reached, hit
+        if err_pos > IK_POSITION or err_rot > IK_ROTATION:
+            short = min(short, err_pos)
+            continue
+        short, hit = 0.0, clearance.clash(goal, carried, ignore) or ""
+        if not hit:
+            return 0.0, ""
+    return short, hit
 
 
 def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
