@@ -158,12 +158,13 @@ class Planner:
                     _restore(held, standing)
                     # the fingers as they will be on the way: collision checks see them so
                     arm.shape_fingers(approach_fingers(arm, variant, held.shape), now=True)
-                    carried = Carried(held.body, *g.in_hand(variant)) if holding else None
+                    planned = Carried(held.body, *g.in_hand(variant))  # held as this grasp will hold it
+                    carried = planned if holding else None
                     steps = [
                         *([Step("home", "to its start")] if isinstance(start, str) and start != "home" else []),
                         *task.program(g, variant, holding),
                     ]
-                    result = _hemmed_in(arm, clearance, steps, held, target, Carried(held.body, *g.in_hand(variant)))
+                    result = _hemmed_in(arm, clearance, steps, held, target, planned)
                     result = result or self._plan_variant(arm, clearance, steps, held, target, carried, begin)
                     _restore(held, standing)  # the checks of carried motions left it in the hand
                     found = g
@@ -491,15 +492,17 @@ def _hemmed_in(
     """Why a step that `decides` the variant cannot be reached clear, the object held as planned (IK from
     the arm's start; the arm and the object are left where they were): planning the motions up to it
     first cost seconds a variant, in a search that tries dozens. None when every such step can."""
+    deciding = [(i, step) for i, step in enumerate(steps) if step.decides]
+    if not deciding:  # most programs: nothing to check, nothing to save and restore
+        return None
     saved, standing = arm.config(), _save(held)
     try:
-        for i, step in enumerate(steps):
-            if step.decides:
-                short, hit = _reached_clear(arm, clearance, step, carried, target)
-                if short > IK_POSITION:
-                    return Infeasible(_cannot_reach(arm, step, short), i, True)
-                if hit:
-                    return Infeasible(f"'{step.name}' would put the {arm.side} arm against {hit}", i, False, hit)
+        for i, step in deciding:
+            short, hit = _reached_clear(arm, clearance, step, carried, target)
+            if short > IK_POSITION:
+                return Infeasible(_cannot_reach(arm, step, short), i, True)
+            if hit:
+                return Infeasible(f"'{step.name}' would put the {arm.side} arm against {hit}", i, False, hit)
         return None
     finally:
         arm.set_config(saved)
