@@ -210,6 +210,19 @@ def test_learned_compounds_decide_adjective_tagged_modifiers():
     assert frames("heat/VB/ROOT/0 hot/JJ/amod/2 oil/NN/dobj/0", learned)[0][1]["Theme"] == "oil"
 
 
+def test_a_noun_said_as_a_modifier_in_the_singular_joins_by_its_plurals_head_rate():
+    # "the vegetable stock": vegetable seldom heads a phrase, vegetables often ("add the vegetables.")
+    doc = "pour/VB/ROOT/0 the/DT/det/3 vegetable/JJ/amod/3 stock/NN/dobj/0 into/IN/prep/0 pot/NN/pobj/4"
+    learned = Compounds(head_rates={"vegetables": 0.40, "berries": 0.5, "tomatoes": 0.48, "others": 0.6})
+    assert frames(doc)[0][1]["Theme"] == "stock"
+    assert frames(doc, learned)[0][1]["Theme"] == "vegetable stock"
+    assert learned.joins("berry", "sauce") and learned.joins("tomato", "sauce")  # -ies and -es plurals
+    assert not learned.joins("other", "bowl")  # "the others" heads phrases; "other" is a function word
+    assert not learned.joins("large", "bowl") and not Compounds(
+        predicative=frozenset({"vegetable"}), head_rates={"vegetables": 0.4}
+    ).joins("vegetable", "stock")
+
+
 def test_lone_object_of_alternating_verb_is_resolved_by_priors():
     [frame] = extract_frames(make_doc("rub/VB/ROOT/0 the/DT/det/2 steak/NN/dobj/0"), LEX)
     assert frame.ambiguous_object == "Theme" and frame.roles == {"Theme": "steak", "Destination": None}

@@ -4,7 +4,9 @@ The small tagger calls many noun modifiers adjectives ("olive/JJ oil", "cinnamon
 some adjectives proper nouns ("leftover/NNP rice"), so the tag cannot tell "olive oil" (a name) from
 "hot oil" (oil that is hot). Corpus statistics can:
 - head rate: how often the word itself heads a noun phrase ("add the cinnamon," "with the tart.")
-  among its uses after a determiner; nouns do this often, adjectives almost never;
+  among its uses after a determiner; nouns do this often, adjectives almost never. A noun said mostly as
+  a modifier in the singular ("the vegetable stock", "a mushroom risotto") heads its phrases in the
+  plural ("add the vegetables."), so a word whose plural has a noun's head rate is a noun too;
 - unit strength of the bigram: fixed phrases ("olive oil", "black pepper", "sesame oil", "frying
   pan") stick together far more than chance (NPMI), or the modifier mostly comes with this head;
 - predicative use: adjectives of state ("hot", "warm", "softened") follow "until", "is", "very"...
@@ -22,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import duckdb
+from spacy.lang.en.stop_words import STOP_WORDS
 
 from lmcr.files import atomic_path, read_resource
 
@@ -126,6 +129,8 @@ class Compounds:
         return (
             modifier in self.proper
             or self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
+            or any(self.head_rates.get(form, 0.0) >= HEAD_RATE_MIN for form in _number_forms(modifier))
+            and modifier not in STOP_WORDS  # "the other bowl": "others" heads phrases, "other" names nothing
             or f"{modifier} {head}" in self.strong_bigrams
         )
 
@@ -161,6 +166,13 @@ class Compounds:
             _words(data.get("proper", [])),
             None if singular is None else {_word(w): int(n) for w, n in singular.items()},
         )
+
+
+def _number_forms(word: str) -> tuple[str, ...]:
+    """The plurals English spelling can give a word (vegetable -> vegetables, tomato -> tomatoes, berry
+    -> berries): where its head rate may be read too (`Compounds.joins`)."""
+    forms = (f"{word}s", f"{word}es")
+    return (*forms, f"{word[:-1]}ies") if word.endswith("y") else forms
 
 
 def _word(value: object) -> str:
