@@ -26,10 +26,8 @@ from lmcr.robot.household import household
 from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
 from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, height, world_xy
 from lmcr.robot.tasks import (
-    FRONT_LEAN,
     GRIP_GAP,
     OPENING,
-    PITCHES,
     Geometry,
     Step,
     Task,
@@ -636,13 +634,10 @@ def _variants(held: SceneObject, task: Task, holding: bool, opening: float) -> l
     """The ways to try: all grasps, or, for an object already in the hand, the top grasp it was handed
     over in, by its middle (tilting either way); carried unturned when the task keeps it `square`."""
     if holding:
-        found = variants(held, turns=task.turns, wide=task.wide)
+        found = variants(held, turns=task.turns, wide=task.wide, front=task.sideways)
         found = [v for v in found if v.yaw == 0.0 and not v.side and v.shift == (0.0, 0.0)]
     else:
-        found = variants(held, task.pours or task.sideways, opening, task.turns, task.wide)
-    if task.sideways:  # in through a front: a hand leaning forward trails behind the object, under the box's top
-        leaning = [replace(v, pitch=FRONT_LEAN) for v in found if v.pitch == max(PITCHES)]
-        found = sorted(leaning + found, key=lambda v: -v.pitch)
+        found = variants(held, task.pours or task.sideways, opening, task.turns, task.wide, task.sideways)
     return [v for v in found if v.turn == 0.0] if task.square else found
 
 

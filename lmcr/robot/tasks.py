@@ -383,14 +383,29 @@ def gripper_over(point_in_hand: np.ndarray, orientation) -> float:
 
 
 def variants(
-    held: SceneObject, side_first: bool = False, opening: float = 0.0, turns: bool = False, wide: bool = False
+    held: SceneObject,
+    side_first: bool = False,
+    opening: float = 0.0,
+    turns: bool = False,
+    wide: bool = False,
+    front: bool = False,
 ) -> list[Variant]:
     """The grasps that suit the held object's shape (fingers across a long object; a round one also from
     the diagonals, after the others at each lean: between two neighbours only a diagonal may fit), upright or leaning
     forward, each tilting either way when the task `turns` it; `side_first` (pouring, putting in through a
     front), side grasps first where the object fits between the fingers, `opening` wide less a centimetre
     (the hand then stays high while it pours, level behind it as it goes in), headed from the robot towards
-    the object. A `wide` task's hand also turns by WIDE_TURNS."""
+    the object. A `wide` task's hand also turns by WIDE_TURNS. A task that puts the object in through a
+    `front` first tries each leaning grasp leaning further (FRONT_LEAN): the hand then trails behind the
+    object, under the box's top; the grasps then go most leaning first."""
+    found = _grasps(held, side_first, opening, turns, wide)
+    if not front:
+        return found
+    leaning = [replace(v, pitch=FRONT_LEAN) for v in found if v.pitch == max(PITCHES)]
+    return sorted(leaning + found, key=lambda v: -v.pitch)
+
+
+def _grasps(held: SceneObject, side_first: bool, opening: float, turns: bool, wide: bool) -> list[Variant]:
     half_x, half_y, round_ = outline(held.shape)
     yaws, shifts = [0.0, math.pi / 2, -math.pi / 2], [(0.0, 0.0)]
     if round_:  # a square box held across its corners would not fit between fingers set for its sides
