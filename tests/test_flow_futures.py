@@ -61,6 +61,8 @@ def test_a_signal_that_a_library_wraps_still_ends_the_run_as_an_interrupt(monkey
     KeyboardInterrupt (the pipeline's one line and exit status 130), not the wrapping error's traceback;
     the process's own handlers are restored after."""
     monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")  # no server of its own
+    # a run at a terminal: Ctrl-C is live even where these tests run as a background job (which ignores it)
+    live = signal.signal(how, signal.default_int_handler if how == signal.SIGINT else signal.SIG_DFL)
     worker = multiprocessing.get_context("spawn").Process(target=time.sleep, args=(60,))
     worker.start()
     before = signal.getsignal(how)
@@ -71,8 +73,27 @@ def test_a_signal_that_a_library_wraps_still_ends_the_run_as_an_interrupt(monkey
         assert not worker.is_alive() and worker.exitcode is not None and worker.exitcode < 0
         assert signal.getsignal(how) is before
     finally:
+        signal.signal(how, live)
         if worker.is_alive():
             worker.kill()
+
+
+def test_an_ignored_ctrl_c_stays_ignored_through_the_run(monkeypatch):
+    """A run started as a background job (SIGINT ignored, as the shell leaves it) does not take Ctrl-C
+    up: the signal is still ignored during the run, which ends as its body does, and after."""
+    monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        assert run_with_server(_ignored_interrupt) == "ran on"
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def _ignored_interrupt() -> str:
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.5)  # a handler would have run by now
+    return "ran on" if signal.getsignal(signal.SIGINT) is signal.SIG_IGN else "taken up"
 
 
 def test_an_error_without_a_signal_is_left_as_it_is(monkeypatch):
