@@ -210,7 +210,8 @@ def complete(
     frame, doc = read_instruction(parser, instruction)
     labels = [" ".join(o.split()).lower() for o in objects]
     kept = [k for k, o in enumerate(objects) if o and o.strip()]
-    ids_of = ids_by_label([labels[k] for k in kept], [(ids or assign_ids(labels))[k] for k in kept])
+    every_id = ids or assign_ids(labels)  # once: per object it made a completion quadratic in the objects
+    ids_of = ids_by_label([labels[k] for k in kept], [every_id[k] for k in kept])
     detected = list(ids_of)
     pronouns = parser.lex.object_pronouns
     # "I'd love some wine, could you pour it?": the wine; "bring me the soap": to the person who asks
