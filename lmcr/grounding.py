@@ -11,6 +11,7 @@ import re
 from lmcr.srl.context import antecedents, predicate_token, served_in
 from lmcr.srl.mentions import FrameMention
 from lmcr.srl.parser import FrameParser
+from lmcr.text import plural_forms
 
 
 def grounded(value: str, known: set[str]) -> str | None:
@@ -99,7 +100,7 @@ def same_noun(word: str, other: str) -> bool:
     if word == other:
         return True
     one, two = sorted((word, other), key=len)
-    return two in (one + "s", one + "es") or (one.endswith("y") and two == one[:-1] + "ies")
+    return two in plural_forms(one)
 
 
 def named_by_head(value: str, detected: list[str]) -> str | None:

@@ -120,3 +120,10 @@ def split_sentences(text: str) -> list[str]:
 def count_words(text: str) -> int:
     """Whitespace-delimited word count, the unit of every words/s figure."""
     return len(text.split())
+
+
+def plural_forms(word: str) -> tuple[str, ...]:
+    """The plurals English spelling can give a singular noun: carrot -> carrots, dish -> dishes, patty
+    -> patties (which of them is a word is for the caller's counts to say)."""
+    forms = (f"{word}s", f"{word}es")
+    return (*forms, f"{word[:-1]}ies") if word.endswith("y") else forms

@@ -27,6 +27,7 @@ import duckdb
 from spacy.lang.en.stop_words import STOP_WORDS
 
 from lmcr.files import atomic_path, read_resource
+from lmcr.text import plural_forms
 
 HEAD_RATE_MIN = 0.10  # nouns measured 0.10-0.49, adjectives/participles 0.00-0.08 (closing note)
 NPMI_MIN = 0.65  # "black pepper" 0.75, "olive oil" 0.84; "salted water" 0.61, "melted butter" 0.52
@@ -129,8 +130,11 @@ class Compounds:
         return (
             modifier in self.proper
             or self.head_rates.get(modifier, 0.0) >= HEAD_RATE_MIN
-            or any(self.head_rates.get(form, 0.0) >= HEAD_RATE_MIN for form in _number_forms(modifier))
-            and modifier not in STOP_WORDS  # "the other bowl": "others" heads phrases, "other" names nothing
+            # "the other bowl": "others" heads phrases, "other" names nothing
+            or (
+                modifier not in STOP_WORDS
+                and any(self.head_rates.get(f, 0.0) >= HEAD_RATE_MIN for f in plural_forms(modifier))
+            )
             or f"{modifier} {head}" in self.strong_bigrams
         )
 
@@ -166,13 +170,6 @@ class Compounds:
             _words(data.get("proper", [])),
             None if singular is None else {_word(w): int(n) for w, n in singular.items()},
         )
-
-
-def _number_forms(word: str) -> tuple[str, ...]:
-    """The plurals English spelling can give a word (vegetable -> vegetables, tomato -> tomatoes, berry
-    -> berries): where its head rate may be read too (`Compounds.joins`)."""
-    forms = (f"{word}s", f"{word}es")
-    return (*forms, f"{word[:-1]}ies") if word.endswith("y") else forms
 
 
 def _word(value: object) -> str:
