@@ -7,6 +7,11 @@ from pathlib import Path
 
 import pytest
 
+# The planning search of every test (and of the commands it starts) stops at its IK count alone: a wall
+# clock would end it earlier on a busy machine, and a test would find another plan or none. The tests of
+# the clock give their own budget.
+os.environ.setdefault("LMCR_PLAN_SECONDS", "3600")
+
 from lmcr.checkout import REPO_ROOT
 from lmcr.store import connect
 from lmcr.workspace import Workspace

@@ -73,3 +73,40 @@ def test_budgets_out_of_range_are_one_line(tmp_path, sample_scene, option, value
     result = _execute(tmp_path, INSTRUCTION, "--scene", sample_scene, option, value)
     lines = result.output.strip().splitlines()
     assert result.exit_code == 1 and len(lines) == 1 and option in lines[0], result.output
+
+
+def test_the_default_clock_of_the_planning_search_comes_from_the_environment(tmp_path, sample_scene, prefers_cup):
+    """$LMCR_PLAN_SECONDS sets `--plan-seconds`' default: here so short that the clock ends the search."""
+    result = runner.invoke(
+        app,
+        ["execute", INSTRUCTION, "--scene", sample_scene, "--json"],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data"), "LMCR_DEBUG": "", "LMCR_PLAN_SECONDS": "0.01"},
+    )
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout.strip().splitlines()[-1])
+    assert out["budget_exhausted"] and not out["feasible"] and "search stopped after" in out["reason"]
+
+
+@pytest.mark.parametrize("value", ["x", "0", "nan", "1e9"])
+def test_a_clock_budget_in_the_environment_that_is_no_budget_is_one_line(tmp_path, sample_scene, value, monkeypatch):
+    from lmcr.robot.budget import Budget, BudgetError
+
+    monkeypatch.setenv("LMCR_PLAN_SECONDS", value)
+    with pytest.raises(BudgetError, match=r"^\$LMCR_PLAN_SECONDS="):
+        Budget()
+    result = runner.invoke(
+        app,
+        ["execute", INSTRUCTION, "--scene", sample_scene],
+        env={"LMCR_DATA_DIR": str(tmp_path / "data"), "LMCR_DEBUG": "", "LMCR_PLAN_SECONDS": value},
+    )
+    lines = result.output.strip().splitlines()
+    assert result.exit_code == 1 and len(lines) == 1 and "LMCR_PLAN_SECONDS" in lines[0], result.output
+
+
+def test_the_library_reads_the_clock_budget_when_none_is_given(monkeypatch):
+    from lmcr.robot.budget import PLAN_SECONDS, Budget
+
+    monkeypatch.setenv("LMCR_PLAN_SECONDS", "7.5")
+    assert Budget().seconds == 7.5 and Budget(seconds=3).seconds == 3
+    monkeypatch.delenv("LMCR_PLAN_SECONDS")
+    assert Budget().seconds == PLAN_SECONDS == 25.0

@@ -9,7 +9,7 @@ from pathlib import Path
 import typer
 
 from lmcr.cli.common import SPACY_MODEL_HELP, CorpusSetting, app, console, fail, note, one_or_batch, write_batch
-from lmcr.robot.budget import IK_CALLS, IK_CALLS_RANGE, PLAN_SECONDS, PLAN_SECONDS_RANGE, Budget
+from lmcr.robot.budget import IK_CALLS, IK_CALLS_RANGE, PLAN_SECONDS, PLAN_SECONDS_ENV, PLAN_SECONDS_RANGE, Budget
 from lmcr.scorers.registry import COMPLETION_METHOD, METHODS
 from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.workspace import Workspace
@@ -27,7 +27,9 @@ IK_BUDGET_HELP = "Planning search's budget of inverse-kinematics solves per inst
 
 
 def plan_seconds_option():
-    return typer.Option(PLAN_SECONDS, "--plan-seconds", **PLAN_SECONDS_RANGE, help=PLAN_SECONDS_HELP)
+    return typer.Option(
+        PLAN_SECONDS, "--plan-seconds", envvar=PLAN_SECONDS_ENV, **PLAN_SECONDS_RANGE, help=PLAN_SECONDS_HELP
+    )
 
 
 def ik_budget_option():

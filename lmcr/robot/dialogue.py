@@ -78,7 +78,7 @@ def converse(
     config: CompletionConfig,
     cache_dir: Path,
     say: Callable[[str], None],
-    budget: Budget = Budget(),
+    budget: Budget | None = None,
 ) -> list[dict]:
     """Run the conversation until the turns run out; each instruction's outcome is one dict (executed
     result, left, or error) with what the robot said about it (`reply`); each instruction's planning search

@@ -127,7 +127,7 @@ def execute(
     recorder: Recorder | None = None,
     answer: dict[str, str] | None = None,
     urdf: Path | None = None,
-    budget: Budget = Budget(),
+    budget: Budget | None = None,
 ) -> dict:
     """The CLI contract's result: frame, chosen object (`chosen_object` its label, `chosen_id` which of the
     objects with that label; `role_ids` the object of every role), waypoint errors, per-verb checks,
@@ -136,7 +136,7 @@ def execute(
     moves and the result asks (`question`, `suggestion`). A `recorder` takes a picture at the start, at
     every waypoint and at the end. `answer` (role -> object) is what a person answered: it fills those
     roles instead. `urdf`: the official Baxter description to use instead of ours. The planning search
-    stops when its `budget` is spent: the refusal then says so (`budget_exhausted`)."""
+    stops when its `budget` (default `Budget()`) is spent: the refusal then says so (`budget_exhausted`)."""
     started = time.perf_counter()
     _connect()
     robot = build_world(scene, cache_dir, urdf)
@@ -145,7 +145,7 @@ def execute(
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config, [d.id for d in seen], held)
     options = _with_tasks(completion, _options(completion, answer), parser.lex, scene.shapes())[:MAX_TRIED]
     completed = time.perf_counter()
-    planner = Planner(robot, scene, scene.table, budget)
+    planner = Planner(robot, scene, scene.table, budget or Budget())
     tried = _search(planner, scene, options, {d.id for d in seen})
     planned = time.perf_counter()
     # the language model's choice, as the first of its objects the robot can act on (else the nearest)

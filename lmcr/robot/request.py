@@ -4,7 +4,7 @@ the pictures saved; or a batch of instructions and scenes. The models are loaded
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from lmcr.complete import CompletionConfig
@@ -29,7 +29,7 @@ class Executor:
     config: CompletionConfig
     cache_dir: Path
     urdf: Path | None = None
-    budget: Budget = Budget()
+    budget: Budget = field(default_factory=Budget)
 
     def run(self, instruction: str, scene: Scene, recorder: Recorder | None = None) -> dict:
         """One instruction executed in `scene`: the CLI contract's result (see `execute`)."""
