@@ -75,6 +75,33 @@ def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
     assert with_classes.score_frame(plain) == FrameCountScorer(FILLERS, PAIRS).score_frame(plain)
 
 
+def test_a_learned_verbs_own_fillers_against_its_class_by_hand():
+    # "chill" put things in the refrigerator 6 times and never chilled an apple; "store", of the same class,
+    # put apples in cups 8 times: the class's pairs choose the cup, the verb's own fillers the refrigerator
+    fillers, pairs = counted(
+        [
+            ("chill", {"Theme": "dough", "Destination": "refrigerator"}, 6),
+            ("store", {"Theme": "apple", "Destination": "cup"}, 8),
+            ("store", {"Theme": "jam", "Destination": "refrigerator"}, 1),
+        ]
+    )
+    m = FrameCountScorer(fillers, pairs, alpha=2.0, classes={"chill": "place", "store": "place"})
+    frames = [("chill", {"Theme": "apple", "Destination": d}) for d in ("refrigerator", "cup")]
+    fridge, cup = m.score_frames(frames)
+    assert cup > fridge  # the class level outvotes chill's own places
+    in_role = m.p_in_role("Destination", "refrigerator")
+    of_class = (7 + 2 * in_role) / (15 + 2)  # the class's 15 places: the refrigerator 7 times
+    own = (6 + 2 * of_class) / (6 + 2)  # chill's 6, all the refrigerator
+    apple_class = m.p_class_filler("place", "Theme", "apple")
+    apple_own = (0 + 2 * apple_class) / (6 + 2)  # chill never chilled an apple
+    fridge, cup = (m.verb_preference(f) for f in frames)
+    assert fridge == pytest.approx(math.log(own / of_class) + math.log(apple_own / apple_class))
+    assert fridge > cup  # within the Destination, the refrigerator now leads (the apple's term is both's)
+    # a verb of no class prefers nothing, nor a verb in a role it was never seen with (its class's, then)
+    assert m.verb_preference(("pour", {"Theme": "water", "Destination": "cup"})) == 0.0
+    assert m.verb_preference(("chill", {"Instrument": "spoon"})) == pytest.approx(0.0)
+
+
 def test_a_phrasal_verbs_pairs_back_off_to_its_base_verbs_first():
     # "warm up" stated its place only for soup (the pot); "warm" warms milk in the microwave; the class
     # (placing verbs, which put milk in the fridge) comes after the base verb

@@ -27,6 +27,20 @@ of every set (docs/guide/complete.md). Tried there and not kept: the class's fil
 P(o | v, m) and P(o | m) (IntroPlan lost most of its top guesses), and more smoothing mass at the class
 level (50, 500: fewer top guesses right on three sets).
 
+The class level can outvote the verb's own fillers: "chill" puts things in the refrigerator hundreds of
+times and never chills an apple, so P(o | chill, Theme = apple, Destination) is the placing verbs' (a
+cup, a bowl). The `verb_fillers` term (`verb_preference`) gives the verb its say within a role:
+
+    log P~(o | v, m) - log P(o | K, m),  P~(o | v, m) = (c(v, m=o) + alpha P(o | K, m)) / (c(v, m) + alpha)
+
+summed over the frame's fillers: how much likelier the verb itself fills role m with o than the verbs of
+its class do (0 for a verb seldom seen: P~ is then its class's; 0 for the eleven, which have no class).
+It is a ratio, not a probability, so it only orders the fillers of one role (`ScorerSpec.within_role`):
+as a factor of the pair level it moved which open role won (HuRIC's right role 0.973 to 0.904). On the
+external request sets it raised COAT's top guesses from 23 to 28 of 59 and left the other three sets'
+and every right role unchanged (docs/guide/complete.md); weights 0.5 and 2 gave 144 and 145 of 399, 1
+gave 145.
+
 alpha = 5: of the two values tried on the dev ratings (1 and 5), the better at lambda=1, k=6. Unlike the
 LMs this model sees only frames whose roles the SRL filled, and treats a filler as one symbol: it knows
 "sprinkle cheese on the pizza" was said five times, not how "cheese" relates to "parmesan".
@@ -98,7 +112,12 @@ class FrameCountScorer:
         self.in_role: Counter[tuple[str, str]] = Counter()  # (role, value), over every predicate
         self.role_n: Counter[str] = Counter()
         self.value: Counter[str] = Counter()
+        self.class_filler: Counter[tuple[str, str, str]] = Counter()  # (class, role, value): pooled
+        self.class_role_total: Counter[tuple[str, str]] = Counter()
         for v, role, value, n in fillers:
+            if v in self.classes:
+                self.class_filler[(self.classes[v], role, value)] += n
+                self.class_role_total[(self.classes[v], role)] += n
             self.filler[(v, role, value)] += n
             self.role_total[(v, role)] += n
             self.in_role[(role, value)] += n
@@ -128,13 +147,16 @@ class FrameCountScorer:
         alpha: float = ALPHA,
         mixture: Mixture = Mixture(),
         classes: dict[str, str] | None = None,
+        pairs: bool = True,
     ) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
-        corpus's frames count as often as the mixture weighs it. `classes`: as the constructor's."""
-        fillers, pairs = weighted_counts(db, sql_dir, ("frame_fillers", "frame_filler_pairs"), corpus, mixture)
+        corpus's frames count as often as the mixture weighs it. `classes`: as the constructor's. Without
+        `pairs`, the fillers alone are read (all `verb_preference` needs; a pair then scores as unseen)."""
+        queries = ("frame_fillers", "frame_filler_pairs") if pairs else ("frame_fillers",)
+        fillers, *pair_rows = weighted_counts(db, sql_dir, queries, corpus, mixture)
         if not fillers:
             raise MethodUnavailable(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
-        return cls(fillers, pairs, alpha, classes)
+        return cls(fillers, pair_rows[0] if pair_rows else [], alpha, classes)
 
     def p_value(self, value: str) -> float:
         return add_one(self.value[value], self.n, self.types)
@@ -148,6 +170,25 @@ class FrameCountScorer:
         return dirichlet(
             self.filler[(v, role, value)], self.role_total[(v, role)], self.p_in_role(role, value), self.alpha
         )
+
+    def p_class_filler(self, k: str, role: str, value: str) -> float:
+        """P(value | K, role): what the verbs of class K fill `role` with, backing off to P(value | role)."""
+        prior = self.p_in_role(role, value)
+        return dirichlet(self.class_filler[(k, role, value)], self.class_role_total[(k, role)], prior, self.alpha)
+
+    def verb_preference(self, frame: Frame) -> float:
+        """The summed log ratio of how likely the verb fills each role with its filler to how likely the
+        verbs of its class do (module docstring); 0 for a predicate without a class."""
+        v, roles = frame
+        k = self.classes.get(v)
+        if k is None:
+            return 0.0
+        total = 0.0
+        for role, value in roles.items():
+            of_class = self.p_class_filler(k, role, value)
+            own = dirichlet(self.filler[(v, role, value)], self.role_total[(v, role)], of_class, self.alpha)
+            total += math.log(own / of_class)
+        return total
 
     def p_given(self, v: str, given_role: str, given: str, role: str, value: str) -> float:
         """P(value | v, given_role = given, role), backing off through v's base verb and class when it has

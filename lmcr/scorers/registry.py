@@ -36,9 +36,11 @@ if TYPE_CHECKING:
 # What completes instructions by default: the sentence LM times the frame counts times what the verbs
 # most like the predicate do with the same fillers (lmcr/scorers/similar_verbs.py), less how common the fillers
 # are anyway (lmcr/scorers/rarity.py), plus what the instruction's purpose says of each filler
-# (lmcr/scorers/context_pmi.py; 0 without one, so on the rated frames). The household weight under which it runs is
+# (lmcr/scorers/context_pmi.py; 0 without one, so on the rated frames), and, within a role, how much
+# likelier a learned verb itself fills it with each object than the verbs of its class do
+# (`FrameCountScorer.verb_preference`; 0 for the eleven). The household weight under which it runs is
 # chosen on both dev sets (lmcr/evaluate/choose_mixture.py); its figures are in the README.
-COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi"
+COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi+verb_fillers"
 
 
 class Scorer(Protocol):
@@ -114,6 +116,15 @@ def _frame_counts(res: MethodResources) -> Scorer:
     db = store_path(res, "frame_counts")
     counts = FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes)
     return counts.score_frames
+
+
+def _verb_fillers(res: MethodResources) -> Scorer:
+    from lmcr.scorers.frame_counts import FrameCountScorer
+
+    classes = load_lexicon(learned=res.predicates).motion_classes
+    db = store_path(res, "verb_fillers")
+    counts = FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=False)
+    return lambda frames: [counts.verb_preference(frame) for frame in frames]
 
 
 def _frame_counts_fingerprint(res: MethodResources) -> str:
@@ -259,13 +270,16 @@ SCORERS: dict[str, ScorerSpec] = {
     "conceptnet_retrofit": ScorerSpec(_conceptnet_retrofit),
     "random": ScorerSpec(_random),
     "commonsense": ScorerSpec(_commonsense, _commonsense_fingerprint, within_role=True),  # a term, as rarity
+    # a term, as rarity; it orders the fillers of one role only
+    "verb_fillers": ScorerSpec(_verb_fillers, _frame_counts_fingerprint, within_role=True),
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
     "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
 
 
 METHODS = tuple(SCORERS)
-TERMS = ("rarity", "context_pmi", "commonsense")  # added to methods ('a+rarity'), not compared as methods of their own
+# added to methods ('a+rarity'), not compared as methods of their own
+TERMS = ("rarity", "context_pmi", "commonsense", "verb_fillers")
 # what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
 # its third expert
 EVALUATED = (
