@@ -7,7 +7,7 @@ import pytest
 
 pytest.importorskip("ompl")
 
-from lmcr.robot.joint_paths import RESOLUTION, joint_path, segment_clash  # noqa: E402
+from lmcr.robot.joint_paths import RESOLUTION, joint_path, segment_clash, smooth_path  # noqa: E402
 
 LIMITS = np.array([[-2.0, 2.0]] * 7)
 
@@ -35,6 +35,28 @@ def test_a_search_gives_the_same_path_whatever_was_planned_before():
     again = joint_path(_wall, q0, q1, LIMITS)
     assert np.array_equal(np.array(first), np.array(again))
     assert not np.array_equal(np.array(first), np.array(joint_path(_wall, q0, q1, LIMITS, seed=2)))
+
+
+def _length(path) -> float:
+    return sum(float(np.linalg.norm(b - a)) for a, b in zip(path, path[1:]))
+
+
+def test_a_path_found_unshortened_is_shortened_later_to_a_clear_path_no_longer_than_it():
+    """A search left unshortened (`smooth=False`) returns the path as found, clear; `smooth_path` then
+    shortens it, clear by the same check, the same way whatever was planned between."""
+    q0, q1 = np.zeros(7) + [-1, 0, 0, 0, 0, 0, 0], np.zeros(7) + [1, 0, 0, 0, 0, 0, 0]
+    for seed in range(1, 11):
+        raw = joint_path(_wall, q0, q1, LIMITS, seed=seed, smooth=False)
+        assert raw is not None and np.allclose(raw[0], q0) and np.allclose(raw[-1], q1)
+        assert all(segment_clash(_wall, a, b) is None for a, b in zip(raw, raw[1:]))
+        short = smooth_path(_wall, raw, LIMITS)
+        assert np.allclose(short[0], q0) and np.allclose(short[-1], q1)
+        assert all(segment_clash(_wall, a, b) is None for a, b in zip(short, short[1:]))
+        assert _length(short) <= _length(raw) + 1e-9 and any(q[1] >= 1.0 for q in short)
+        joint_path(_wall, q0 + 0.1, q1 - 0.1, LIMITS, seed=5)  # another search in between
+        assert np.array_equal(np.array(short), np.array(smooth_path(_wall, raw, LIMITS)))
+    straight = [q0 + [0, 2, 0, 0, 0, 0, 0], q1 + [0, 2, 0, 0, 0, 0, 0]]  # over the wall: nothing to shorten
+    assert smooth_path(_wall, straight, LIMITS) is straight
 
 
 def test_an_impossible_motion_stops_at_its_budget_of_checks():

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -23,7 +24,7 @@ from lmcr.robot.arm import IK_POSITION, IK_ROTATION, Arm, relative_pose, rotatio
 from lmcr.robot.budget import Budget
 from lmcr.robot.collision import Carried, Clearance
 from lmcr.robot.household import household
-from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash
+from lmcr.robot.joint_paths import PLAN_CHECKS, joint_path, segment_clash, smooth_path
 from lmcr.robot.scene import TABLE_TOP, Scene, SceneObject, height, world_xy
 from lmcr.robot.tasks import (
     GRIP_GAP,
@@ -412,6 +413,8 @@ class Planner:
             if short > IK_POSITION:
                 return Infeasible(_cannot_reach(arm, step, short), i, True)
         q, segments, released = start, [], False
+        searched: list[tuple[int, Callable]] = []  # segments a search found, each with its clearance check
+        standing = _save(held)
         for i, step in enumerate(steps):
             if self.spent():
                 return Infeasible(f"the {arm.side} arm's plan stopped before '{step.name}'", i)
@@ -433,9 +436,10 @@ class Planner:
 
             if step.kind in ("home", "park"):
                 to = arm.home if step.kind == "home" else arm.parked
-                path = joint_path(clash, q, to, arm.limits, budget=PLAN_CHECKS)
+                path = joint_path(clash, q, to, arm.limits, budget=PLAN_CHECKS, smooth=False)
                 if path is None:
                     return Infeasible(f"no clear way for the {arm.side} arm {step.name}", i)
+                searched.append((len(segments), clash))
                 segments.append(Segment(step, path, _gripper_at(arm, to)))
                 q = to
                 continue
@@ -458,7 +462,7 @@ class Planner:
                 path = (
                     _straight_line(arm, q, position, step.orientation)
                     if straight
-                    else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS)
+                    else joint_path(clash, q, goal, arm.limits, budget=0 if touched else PLAN_CHECKS, smooth=False)
                 )
                 if straight and path is None:
                     way = "straight down" if into else "straight"  # into a container, or along a slide, an arc or a row
@@ -479,9 +483,28 @@ class Planner:
                 break
             if found is None:
                 return Infeasible(why, i, reach, blocker)
+            if not straight:
+                searched.append((len(segments), clash))
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]
+        _smooth(arm, held, standing, segments, searched)
         return segments
+
+
+def _smooth(
+    arm: Arm, held: SceneObject, standing: tuple, segments: list[Segment], searched: list[tuple[int, Callable]]
+) -> None:
+    """The searched paths of a variant that holds, shortened (`smooth_path`) as each was checked: the held
+    object standing where it stood at the variant's start (a carried motion's check places it in the hand
+    itself); the arm and the object are left where they were."""
+    saved, left = arm.config(), _save(held)
+    _restore(held, standing)
+    try:
+        for k, clash in searched:
+            segments[k].path = smooth_path(clash, segments[k].path, arm.limits)
+    finally:
+        arm.set_config(saved)
+        _restore(held, left)
 
 
 def _hemmed_in(

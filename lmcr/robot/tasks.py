@@ -117,7 +117,8 @@ class Step:
     # (what is in it), the object must pass the walls clear
     into: bool = False
     straight: bool = False  # the gripper moves along the straight line (pulling a drawer on its slide)
-    # a pose so hemmed in (the hand inside a cupboard) that it decides the variant: it is checked, reach and
+    # a pose so hemmed in (the hand inside a cupboard) or so turned (a stirring tool stood on its end over the
+    # pot, which most grasps of it cannot reach) that it decides the variant: it is checked, reach and
     # clearance with the object held as planned, before any motion to it is planned
     decides: bool = False
 
@@ -452,8 +453,12 @@ def above(xy, name: str, orientation=DOWN, touches: str = "") -> Step:
     )
 
 
-def move(name: str, position, orientation=DOWN, touches: str = "", probe: str = "", into: bool = False) -> Step:
-    return Step("move", name, (np.asarray(position, dtype=float),), orientation, touches, probe, into=into)
+def move(
+    name: str, position, orientation=DOWN, touches: str = "", probe: str = "", into: bool = False, decides: bool = False
+) -> Step:
+    return Step(
+        "move", name, (np.asarray(position, dtype=float),), orientation, touches, probe, into=into, decides=decides
+    )
 
 
 def pick(g: Geometry, v: Variant, holding: bool) -> list[Step]:
@@ -747,7 +752,7 @@ def program_stir(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     return [
         *pick(g, v, holding),
         over_target(g, v),
-        move(f"stand it up over {name}", gripper_for(tip, orn, t + [0, 0, 0.04]), orn),
+        move(f"stand it up over {name}", gripper_for(tip, orn, t + [0, 0, 0.04]), orn, decides=True),
         move(f"into {name}", gripper_for(tip, orn, [*at[-1][:2], at[-1][2]]), orn, "target", into=True),
         *[
             move(f"stir {k + 1}", gripper_for(tip, orn, point), orn, "target", f"stir {k + 1}")
