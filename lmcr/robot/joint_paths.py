@@ -50,7 +50,7 @@ def joint_path(
     def valid(state) -> bool:
         nonlocal checks
         checks += 1
-        return clash(np.array([state[k] for k in range(len(q0))])) is None
+        return clash(_config(state, len(q0))) is None
 
     space, si = _space_information(valid, limits)
     start, goal = space.allocState(), space.allocState()
@@ -91,9 +91,7 @@ def smooth_path(
     if len(path) <= 2:  # a straight segment: nothing to shorten
         return path
     ou.RNG.setSeed(seed)
-    space, si = _space_information(
-        lambda state: clash(np.array([state[k] for k in range(len(path[0]))])) is None, limits
-    )
+    space, si = _space_information(lambda state: clash(_config(state, len(path[0]))) is None, limits)
     geometric = og.PathGeometric(si)
     for q in path:
         state = space.allocState()
@@ -122,7 +120,12 @@ def _space_information(valid: Callable, limits: np.ndarray):
 
 
 def _states(geometric, n: int) -> list[np.ndarray]:
-    return [np.array([s[k] for k in range(n)]) for s in geometric.getStates()]
+    return [_config(s, n) for s in geometric.getStates()]
+
+
+def _config(state, n: int) -> np.ndarray:
+    """An OMPL state's n joint values."""
+    return np.array([state[k] for k in range(n)])
 
 
 def _clear(clash, path: list[np.ndarray]) -> bool:

@@ -479,11 +479,12 @@ class Planner:
                 if into and not _fits_through(arm, path, carried, target):
                     why, reach, blocker = f"{_named(held)} would not fit into {_named(target)}", False, _named(target)
                     continue
-                found = (path, path[-1], position)  # a straight line's end is its own (the goal's pose)
+                # a straight line's end is its own (the goal's pose); a searched path is shortened later
+                found = (path, path[-1], position, not straight)
                 break
             if found is None:
                 return Infeasible(why, i, reach, blocker)
-            if not straight:
+            if found[3]:
                 searched.append((len(segments), clash))
             segments.append(Segment(step, found[0], found[2]))
             q = found[1]

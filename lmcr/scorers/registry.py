@@ -109,21 +109,22 @@ def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     return fingerprint
 
 
-def _frame_counts(res: MethodResources) -> Scorer:
-    from lmcr.scorers.frame_counts import FrameCountScorer
-
-    classes = load_lexicon(learned=res.predicates).motion_classes  # a learned verb's pairs back off to its class's
-    db = store_path(res, "frame_counts")
-    counts = FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes)
-    return counts.score_frames
-
-
-def _verb_fillers(res: MethodResources) -> Scorer:
+def _frame_count_model(res: MethodResources, method: str, pairs: bool = True):
+    """The store's frame counts for `method`, each learned verb with its class of motion (its pairs back
+    off to its class's; `verb_fillers` sets it against its class); `pairs`: as `FrameCountScorer.from_store`."""
     from lmcr.scorers.frame_counts import FrameCountScorer
 
     classes = load_lexicon(learned=res.predicates).motion_classes
-    db = store_path(res, "verb_fillers")
-    counts = FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=False)
+    db = store_path(res, method)
+    return FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=pairs)
+
+
+def _frame_counts(res: MethodResources) -> Scorer:
+    return _frame_count_model(res, "frame_counts").score_frames
+
+
+def _verb_fillers(res: MethodResources) -> Scorer:
+    counts = _frame_count_model(res, "verb_fillers", pairs=False)
     return lambda frames: [counts.verb_preference(frame) for frame in frames]
 
 
