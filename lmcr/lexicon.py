@@ -120,6 +120,9 @@ class Lexicon:
     # too seldom to learn (verb -> frames): a request with one of those is refused by name
     learned: frozenset[str] = frozenset()
     refused: dict[str, int] = field(default_factory=dict)
+    # the frames the table needed to learn a verb: a refused verb with as many was refused for what its
+    # frames say (no role a request leaves open), one with fewer for having too few of them
+    min_frames: int = 0
 
     @property
     def hand_written(self) -> list[str]:
@@ -181,6 +184,7 @@ def _with_learned(path: str, table: str, modified_ns: int) -> Lexicon:
         predicates={**learned, **lex.predicates},
         learned=frozenset(learned),
         refused={name: int(n) for name, n in data.get("refused", {}).items()},
+        min_frames=int(data.get("settings", {}).get("min_frames", 0)),
     )
 
 

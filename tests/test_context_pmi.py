@@ -8,7 +8,7 @@ import math
 import pytest
 
 from lmcr.frame import Frame
-from lmcr.scorers.context_pmi import MIN_SENTENCES, WEIGHT, ContextCooccurrence
+from lmcr.scorers.context_pmi import ESTIMATE, MIN_SENTENCES, WEIGHT, ContextCooccurrence
 from lmcr.scorers.registry import make_scorer, scorer_fingerprint
 from lmcr.scorers.resources import MethodResources
 from lmcr.store import connect
@@ -69,10 +69,24 @@ def test_a_purpose_lifts_the_filler_named_with_it(store):
     frames = [Frame.of("season", {"Theme": "apple", "Instrument": spice}) for spice in ("salt", "cinnamon")]
     salt, cinnamon = counts.score(frames, "for the pie")
     assert cinnamon > salt
-    # N = 10; pie: 3 sentences; cinnamon: 2, both with pie; salt: 3, none with pie; the apple: 2, one with pie
-    assert cinnamon - salt == pytest.approx(WEIGHT * (math.log(3 * 11 / (4 * 3)) - math.log(1 * 11 / (4 * 4))))
+    # N = 10; pie: 3 sentences; cinnamon: 2, both with pie (0.6 expected); salt: 3, none with pie (0.9
+    # expected); the apple: 2, one with pie
+    assert cinnamon - salt == pytest.approx(WEIGHT * (math.log(3 / 1.6) - math.log(1 / 1.9)))
     assert counts.score(frames, "") == [0.0, 0.0]  # no context: as without the term
     assert counts.score(frames, "for the") == [0.0, 0.0]  # stop words say nothing
+
+
+def test_an_object_no_sentence_names_says_nothing_of_a_purpose(store):
+    """A filler outside the counted objects, or counted in no sentence, scores 0 for every word: no
+    evidence either way (the add-one estimate gave it log(N / n(w)), more than an object the corpora
+    name with the word). A pair expected in well under a sentence and not seen is about 0 too."""
+    counts = ContextCooccurrence.count(*store, OBJECTS, {"all": 1.0}, min_sentences=1)
+    assert counts.pmi("pie", "landfill bin") == 0.0 and counts.pmi("boil", "landfill bin") == 0.0
+    assert counts.pmi("pie", "cinnamon") > 0.0 > counts.pmi("pie", "salt")
+    assert counts.pmi("cherry", "black pepper") == pytest.approx(math.log(1 / 1.1))  # 1 and 1 in 10 sentences
+    frames = [Frame.of("season", {"Theme": "apple", "Instrument": spice}) for spice in ("cinnamon", "landfill bin")]
+    cinnamon, unknown = counts.score(frames, "for the pie")
+    assert cinnamon > unknown
 
 
 def test_words_of_the_filler_itself_do_not_count(store):
@@ -110,7 +124,7 @@ def test_context_pmi_is_a_context_reading_term_with_a_cache(store, tmp_path):
     assert json.loads(cache.read_text())["sentences"] == 10
     summed = make_scorer("random+context_pmi", res)(frames, "for my tea")
     assert summed == pytest.approx(make_scorer("random", res)(frames))
-    assert scorer_fingerprint("context_pmi", res).endswith(f"*{WEIGHT:g}/{MIN_SENTENCES}/sentences")
+    assert scorer_fingerprint("context_pmi", res).endswith(f"*{WEIGHT:g}/{MIN_SENTENCES}/sentences/{ESTIMATE}")
 
 
 def test_a_chosen_context_weight_scales_the_term_and_names_its_calibration(store, tmp_path, monkeypatch):
@@ -125,7 +139,9 @@ def test_a_chosen_context_weight_scales_the_term_and_names_its_calibration(store
     db, sql_dir = store
     res = MethodResources(checkpoints=db.parent, db=db, sql_dir=sql_dir, cache_dir=tmp_path / "cache")
     assert res.context_weight == WEIGHT
-    assert scorer_fingerprint("context_pmi", replace(res, context_weight=2.0)).endswith(f"*2/{MIN_SENTENCES}/sentences")
+    assert scorer_fingerprint("context_pmi", replace(res, context_weight=2.0)).endswith(
+        f"*2/{MIN_SENTENCES}/sentences/{ESTIMATE}"
+    )
     # `lmcr mixture` saves the weight it chose; every scorer the workspace builds reads it
     monkeypatch.setenv("LMCR_DATA_DIR", str(tmp_path))
     assert Workspace.from_env().resources().context_weight == WEIGHT

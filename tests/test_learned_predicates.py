@@ -229,6 +229,28 @@ def test_a_learned_verbs_preposition_is_a_particle_when_the_corpus_takes_its_nou
 
 
 @pytest.mark.model
+def test_a_refused_phrasal_verb_is_refused_by_name_not_read_as_its_verb(tmp_path):
+    """ "bake off" names only what it bakes in 3,000 frames (the base verb's rates, 50 frames' worth, do
+    not lift its Instrument to the minimum rate): refused, so "bake off the cake" is refused naming it,
+    never read as *bake* with an oven to choose. "bake up", refused for its 8 frames alone (under the 20 a
+    verb needs), still falls back to bake."""
+    from lmcr.srl.instruction import NoPredicateError, parse_instruction
+    from lmcr.srl.parser import FrameParser, load_nlp
+
+    frames = _kitchen() + [("bake off", {"Theme": "cake"}, False)] * 3000 + [("bake up", {"Theme": "cake"}, False)] * 8
+    con = _store(tmp_path, frames)
+    publish_predicates(con, learn_predicates(con, HAND), tmp_path / PREDICATES_FILE, "b")
+    con.close()
+    lex = load_lexicon(learned=tmp_path / PREDICATES_FILE)
+    assert "bake" in lex.learned and lex.refused == {"cut": 30, "bake off": 3000, "bake up": 8}
+    parser = FrameParser(load_nlp(), lex)
+    with pytest.raises(NoPredicateError, match=r"too little about 'bake off' .*\(3,000 frames\)"):
+        parse_instruction(parser, "bake off the cake")
+    assert parse_instruction(parser, "bake the cake").predicate == "bake"
+    assert parse_instruction(parser, "bake up the cake").predicate == "bake"  # refused for its 8 frames alone
+
+
+@pytest.mark.model
 @pytest.mark.parametrize(
     "instruction", ["put the teddy bear away", "put the bay leaves away", "put the granite cutting board away"]
 )

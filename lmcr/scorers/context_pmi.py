@@ -3,11 +3,17 @@
 sentences at large, and a bowl barely more.
 
     context_pmi(frame, context) = weight * sum over the context's words w and the frame's fillers o of
-                                  log [(n(w, o) + 1) (N + 1) / ((n(w) + 1) (n(o) + 1))]
+                                  log [(n(w, o) + 1) / (n(w) n(o) / N + 1)]
 
 n(w): sentences (recipe steps, titles, ingredient lines, narrations, program steps) with the word w;
 n(o): those that name the object o (its last word may take -s or -es); n(w, o): both; N: sentences (in
-`all`, each corpus's sentences count as often as the mixture weighs it). The context's words are its
+`all`, each corpus's sentences count as often as the mixture weighs it). n(w) n(o) / N is how many
+sentences would name both were the word and the object independent: the log compares what was seen
+with what was expected, each plus one sentence. A pair expected in under a sentence and never seen says
+nothing (about 0), where the add-one estimate log [(n(w, o) + 1) (N + 1) / ((n(w) + 1) (n(o) + 1))] read
+it as strong evidence for: an object named in no sentence (one outside the counted vocabulary, a "landfill
+bin") took log (N / n(w)), some 7 nats a word, over every object the corpora know ("I drank it already":
+the bins over the soda, docs/guide/complete.md). The context's words are its
 tokens that are not stop words (spaCy's list), in at least MIN_SENTENCES sentences, and not a word of the
 filler itself (a purpose that names the pasta says the pot is for it, not that the pasta is the pot). An
 instruction without context scores 0 for every candidate, as without the term, and so does every rated
@@ -37,6 +43,9 @@ from lmcr.store import named_query, read_connection
 WEIGHT = 1.0  # the unscaled term: what completion uses when no weight was chosen
 GRID = (0.5, 1.0, 2.0)  # the weights `lmcr mixture` chooses among
 MIN_SENTENCES = 20  # a word in fewer sentences says little and would only grow the table
+# the estimate (against the expected count, module docstring), in the calibration's fingerprint: scores of
+# another estimate were calibrated for other numbers
+ESTIMATE = "expected+1"
 
 
 class ContextCooccurrence:
@@ -122,11 +131,12 @@ class ContextCooccurrence:
         return list(seen)
 
     def pmi(self, word: str, obj: str) -> float:
-        """log of how much more often sentences with `word` name `obj` than sentences at large, smoothed."""
+        """log of how many more sentences name `word` and `obj` together than would by chance, each plus one
+        (0 for an object no sentence names)."""
         key = obj.lower()
         together = self.pair_sentences.get(key, {}).get(word, 0.0)
-        alone = (self.word_sentences[word] + 1) * (self.object_sentences.get(key, 0.0) + 1)
-        return math.log((together + 1) * (self.sentences + 1) / alone)
+        expected = self.word_sentences[word] * self.object_sentences.get(key, 0.0) / max(self.sentences, 1.0)
+        return math.log((together + 1) / (expected + 1))
 
     def score(self, frames: list[Frame], context: str = "", weight: float = WEIGHT) -> list[float]:
         """`weight` * the summed PMI of the context's words with each frame's fillers (0 without context)."""

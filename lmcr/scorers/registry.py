@@ -195,9 +195,9 @@ def _context_pmi(res: MethodResources) -> Scorer:
 
 
 def _context_pmi_fingerprint(res: MethodResources) -> str:
-    from lmcr.scorers.context_pmi import MIN_SENTENCES
+    from lmcr.scorers.context_pmi import ESTIMATE, MIN_SENTENCES
 
-    return f"{store_corpus_hash(res.db, 'sentence')}*{res.context_weight:g}/{MIN_SENTENCES}/sentences"
+    return f"{store_corpus_hash(res.db, 'sentence')}*{res.context_weight:g}/{MIN_SENTENCES}/sentences/{ESTIMATE}"
 
 
 def _cooccur(res: MethodResources) -> Scorer:
