@@ -184,13 +184,17 @@ def _with_learned(path: str, table: str, modified_ns: int) -> Lexicon:
         predicates={**learned, **lex.predicates},
         learned=frozenset(learned),
         refused={name: int(n) for name, n in data.get("refused", {}).items()},
-        min_frames=int(data.get("settings", {}).get("min_frames", 0)),
+        min_frames=data.get("settings", {}).get("min_frames", 0),
     )
 
 
 def _learned_table(value: object) -> dict:
     if not (isinstance(value, dict) and isinstance(value.get("predicates"), dict)):
         raise ValueError("not a learned predicate table: no 'predicates' object")
+    settings = value.get("settings", {})
+    min_frames = settings.get("min_frames", 0) if isinstance(settings, dict) else None
+    if not isinstance(min_frames, int) or isinstance(min_frames, bool) or min_frames < 0:
+        raise ValueError("its settings give no count of frames a verb needs ('min_frames')")
     for name, entry in value["predicates"].items():
         spec = entry.get("spec") if isinstance(entry, dict) else None
         if not (isinstance(spec, dict) and isinstance(spec.get("roles"), list) and len(spec["roles"]) == 2):

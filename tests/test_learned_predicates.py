@@ -149,6 +149,16 @@ def test_a_broken_table_is_one_line_naming_it(tmp_path):
         load_lexicon(learned=path)
 
 
+@pytest.mark.parametrize("settings", [[], {"min_frames": "many"}, {"min_frames": -1}, {"min_frames": True}])
+def test_a_table_whose_settings_give_no_frame_count_is_one_line_naming_it(tmp_path, settings):
+    from lmcr.errors import LMCRError
+
+    path = tmp_path / PREDICATES_FILE
+    path.write_text(json.dumps({"predicates": {}, "settings": settings}))
+    with pytest.raises(LMCRError, match=f"{path}: cannot read the learned predicate table.*'min_frames'"):
+        load_lexicon(learned=path)
+
+
 @pytest.fixture(scope="module")
 def learned_parser(tmp_path_factory):
     """The real parser with the table learned from `_kitchen` (put, put away, bake, dispose; cut refused)."""
