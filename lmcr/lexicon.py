@@ -211,12 +211,19 @@ def learned_table_path() -> Path:
     return data_dir_from_env() / SRL_SUBDIR / PREDICATES_FILE
 
 
+def learned_table_file(learned: Path | str | bool = True) -> Path | None:
+    """The learned table `load_lexicon(learned=...)` merges in: the given path, or the workspace's for
+    True; None for False, or when there is no such file."""
+    table = learned_table_path() if learned is True else Path(learned) if learned else None
+    return table if table is not None and table.is_file() else None
+
+
 def load_lexicon(path: str | None = None, learned: Path | str | bool = True) -> Lexicon:
     """The lexicon (`LMCR_LEXICON` or the packaged `lexicon.json`), with the predicates learned from the
     frame corpus merged in: `learned` a table's path, True for the workspace's (`learned_table_path`, when
     the frame build has written one), False for none (the frame build itself parses with the eleven)."""
     base = str(path or os.environ.get("LMCR_LEXICON") or LEXICON_PATH)
-    table = learned_table_path() if learned is True else Path(learned) if learned else None
-    if table is None or not table.is_file():
+    table = learned_table_file(learned)
+    if table is None:
         return _hand_written(base)
     return _with_learned(base, str(table.resolve()), table.stat().st_mtime_ns)

@@ -214,3 +214,26 @@ def test_tasks_json_carries_the_hit_settings(con, tmp_path):
     assert "00000000000000000040" not in quals  # 0 approved HITs: no requirement
     bad = CliRunner().invoke(app, args[:-6] + ["--reward", "$1", "--out", str(tmp_path / "u")])
     assert bad.exit_code == 1 and "reward must be dollars and cents" in bad.output and not (tmp_path / "u").exists()
+
+
+def test_one_mace_start_is_what_five_would_give():
+    """The worker table runs MACE once because crowd-kit seeds every restart alike: were a later crowd-kit
+    to vary its restarts, five starts would differ from one here, and the single start would need review."""
+    import warnings
+
+    import numpy as np
+    import pandas as pd
+    from crowdkit.aggregation import MACE
+
+    rng = np.random.default_rng(3)
+    data = pd.DataFrame(
+        {
+            "task": [f"t{i}" for i in range(40) for _ in range(4)],
+            "worker": [f"w{k}" for _ in range(40) for k in rng.choice(8, size=4, replace=False)],
+            "label": rng.integers(1, 6, size=160),
+        }
+    ).sort_values("worker", kind="stable")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one, five = (MACE(n_restarts=n, n_iter=10, random_state=0).fit(data).spamming_ for n in (1, 5))
+    assert np.array_equal(np.asarray(one), np.asarray(five))

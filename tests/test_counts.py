@@ -181,6 +181,23 @@ def test_counts_come_from_the_stores_robot_frames(tmp_path):
     assert FrameCountScorer.from_store(
         db, Workspace.from_env().sql_dir, "youcook2", mixture=Mixture.of({"recipes": 3})
     ).value == {"water": 1, "cup": 1}
+    # Kept counts: the first read writes them, a later one reads them (the store's rows no longer matter),
+    # and a file that is not a table of counts is counted afresh and replaced.
+    cache = tmp_path / "baselines" / "frame-counts-x"
+    kept = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", cache=cache)
+    files = sorted(p.name for p in cache.parent.iterdir())
+    assert files == ["frame-counts-x-frame_filler_pairs.parquet", "frame-counts-x-frame_fillers.parquet"]
+    assert (kept.value, kept.pair) == (every.value, every.pair)
+    con = connect(db, Workspace.from_env().sql_dir)
+    con.execute("delete from frame_roles where value = 'milk'")
+    con.close()
+    assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", cache=cache).value == every.value
+    (cache.parent / files[1]).write_text("not parquet")
+    assert FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", cache=cache).value == {
+        "water": 1,
+        "cup": 1,
+    }
+    assert sorted(p.name for p in cache.parent.iterdir()) == files  # replaced under the same name, no temp left
 
 
 def test_mixture_weights_parse_label_and_shares():

@@ -129,6 +129,26 @@ def test_the_published_table_merges_into_the_lexicon_and_the_count_model(tmp_pat
     assert counts.score_frame(bowl) > counts.score_frame(glass)
 
 
+def test_the_frame_counts_follow_a_table_learned_again_from_the_same_frames(tmp_path):
+    """The learned table decides what the count model counts (its slots) and how its verbs back off (their
+    classes): a table learned again from unchanged frames (other settings) changes the method's
+    fingerprint, so a calibration made under the old table is not reused, and its kept counts."""
+    from lmcr.scorers.registry import make_scorer, scorer_fingerprint
+    from lmcr.scorers.resources import MethodResources
+
+    con = _store(tmp_path, _kitchen())
+    path = tmp_path / PREDICATES_FILE
+    publish_predicates(con, learn_predicates(con, HAND), path, "b1")
+    res = MethodResources(tmp_path / "ckpt", db=tmp_path / "lmcr.duckdb", sql_dir=SQL, predicates=path)
+    put = [Frame.of("put", {"Theme": "milk", "Destination": "bowl"})]
+    before, learned_score = scorer_fingerprint("frame_counts", res), make_scorer("frame_counts", res)(put)
+    publish_predicates(con, learn_predicates(con, HAND, min_frames=10_000), path, "b1")  # the same build
+    con.close()
+    assert scorer_fingerprint("frame_counts", res) != before
+    assert scorer_fingerprint("verb_fillers", res) == scorer_fingerprint("frame_counts", res)
+    assert make_scorer("frame_counts", res)(put) < learned_score  # put's frames no longer counted
+
+
 def test_a_republished_table_replaces_the_old_one_whole(tmp_path):
     con = _store(tmp_path, _kitchen())
     path = tmp_path / PREDICATES_FILE

@@ -50,9 +50,13 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
+import pandas as pd
+from pyarrow import ArrowException
+
+from lmcr.files import atomic_path
 from lmcr.frame import Frame
 from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.resources import MethodUnavailable
@@ -79,18 +83,63 @@ def weighted_counts(
 ) -> list[list[tuple]]:
     """Each named count query's rows over the setting `corpus` (`all`: every corpus), the count (last
     column) of each corpus's rows times the weight the mixture gives it."""
-    found: list[list[tuple]] = [[] for _ in queries]
+    return [
+        list(df.itertuples(index=False, name=None)) for df in weighted_frames(db, sql_dir, queries, corpus, mixture)
+    ]
+
+
+def weighted_frames(
+    db: Path, sql_dir: Path, queries: tuple[str, ...], corpus: str = "all", mixture: Mixture = Mixture()
+) -> list[pd.DataFrame]:
+    """Each named count query's rows over the setting `corpus` as one data frame (read column-wise), the
+    count (last column) of each corpus's rows times the weight the mixture gives it."""
+    found: list[list[pd.DataFrame]] = [[] for _ in queries]
     con = read_connection(db)
     try:
         for part, weight in mixture.parts(corpus).items():
-            for rows, query in zip(found, queries):
-                rows += [
-                    (*row[:-1], weight * row[-1])
-                    for row in con.execute(named_query(sql_dir, query), {"corpus": part}).fetchall()
-                ]
+            for frames, query in zip(found, queries):
+                df = con.execute(named_query(sql_dir, query), {"corpus": part}).df()
+                df[df.columns[-1]] = df[df.columns[-1]].astype(float) * weight
+                frames.append(df)
     finally:
         con.close()
-    return found
+    return [pd.concat(frames, ignore_index=True) for frames in found]
+
+
+def cached_counts(path: Path | None, columns: int, count: Callable[[], pd.DataFrame]) -> pd.DataFrame:
+    """`count()`, kept as Parquet at `path` (written atomically): a saved file is read instead when it is
+    a table of `columns` columns; one that is missing, unreadable or otherwise shaped is counted afresh.
+    Parquet holds plain columns: reading it runs nothing."""
+    if path is None:
+        return count()
+    try:
+        saved = pd.read_parquet(path)
+        if len(saved.columns) == columns and pd.api.types.is_numeric_dtype(saved.iloc[:, -1]):
+            return saved
+    except (OSError, ValueError, ArrowException):
+        pass  # no cache yet, or not one of ours
+    counted = count()
+    with atomic_path(path) as tmp:
+        counted.to_parquet(tmp, index=False)
+    return counted
+
+
+FILLER_COLUMNS = ["v", "role", "value", "n"]
+PAIR_COLUMNS = ["v", "given_role", "given", "role", "value", "n"]
+
+
+def _frame(rows, columns: list[str]) -> pd.DataFrame:
+    """Count rows (tuples, or a data frame with the columns in this order) under the names `columns`."""
+    if isinstance(rows, pd.DataFrame):
+        return rows.set_axis(columns, axis=1).astype({"n": float})
+    return pd.DataFrame(list(rows), columns=columns).astype({"n": float})
+
+
+def _sums(df: pd.DataFrame, keys: list[str]) -> Counter:
+    """The summed counts by `keys`: a tuple per key, or the value itself for one key column."""
+    summed = df.groupby(keys, sort=False, dropna=False, as_index=False)["n"].sum()
+    columns = [summed[k].tolist() for k in keys]
+    return Counter(dict(zip(columns[0] if len(keys) == 1 else zip(*columns), summed["n"].tolist())))
 
 
 class FrameCountScorer:
@@ -103,36 +152,27 @@ class FrameCountScorer:
         alpha: float = ALPHA,
         classes: dict[str, str] | None = None,
     ):
-        """`classes`: predicate -> its class of motion, for the predicates that have one (module docstring)."""
+        """`classes`: predicate -> its class of motion, for the predicates that have one (module docstring).
+        `fillers` and `pairs`: count rows, or data frames of those columns (what `from_store` reads)."""
         self.alpha = alpha
         self.classes = dict(classes or {})
-        # Counts may be weighted (a mixture), hence floats.
-        self.filler: Counter[tuple[str, str, str]] = Counter()  # (v, role, value)
-        self.role_total: Counter[tuple[str, str]] = Counter()  # (v, role)
-        self.in_role: Counter[tuple[str, str]] = Counter()  # (role, value), over every predicate
-        self.role_n: Counter[str] = Counter()
-        self.value: Counter[str] = Counter()
-        self.class_filler: Counter[tuple[str, str, str]] = Counter()  # (class, role, value): pooled
-        self.class_role_total: Counter[tuple[str, str]] = Counter()
-        for v, role, value, n in fillers:
-            if v in self.classes:
-                self.class_filler[(self.classes[v], role, value)] += n
-                self.class_role_total[(self.classes[v], role)] += n
-            self.filler[(v, role, value)] += n
-            self.role_total[(v, role)] += n
-            self.in_role[(role, value)] += n
-            self.role_n[role] += n
-            self.value[value] += n
-        self.pair: Counter[tuple[str, str, str, str, str]] = Counter()  # (v, given role, given value, role, value)
-        self.given_total: Counter[tuple[str, str, str, str]] = Counter()
-        self.class_pair: Counter[tuple[str, str, str, str, str]] = Counter()  # (class, given role, ...): pooled
-        self.class_given_total: Counter[tuple[str, str, str, str]] = Counter()
-        for v, given_role, given, role, value, n in pairs:
-            self.pair[(v, given_role, given, role, value)] += n
-            self.given_total[(v, given_role, given, role)] += n
-            if v in self.classes:
-                self.class_pair[(self.classes[v], given_role, given, role, value)] += n
-                self.class_given_total[(self.classes[v], given_role, given, role)] += n
+        # Counts may be weighted (a mixture), hence floats. Each table is summed column-wise: the full
+        # store has about a million rows, which a loop over rows took seconds to add up at every start.
+        f = _frame(fillers, FILLER_COLUMNS)
+        f_k = f.assign(k=f["v"].map(self.classes)).dropna(subset=["k"])
+        self.filler = _sums(f, ["v", "role", "value"])  # (v, role, value)
+        self.role_total = _sums(f, ["v", "role"])  # (v, role)
+        self.in_role = _sums(f, ["role", "value"])  # (role, value), over every predicate
+        self.role_n = _sums(f, ["role"])
+        self.value = _sums(f, ["value"])
+        self.class_filler = _sums(f_k, ["k", "role", "value"])  # (class, role, value): pooled
+        self.class_role_total = _sums(f_k, ["k", "role"])
+        p = _frame(pairs, PAIR_COLUMNS)
+        p_k = p.assign(k=p["v"].map(self.classes)).dropna(subset=["k"])
+        self.pair = _sums(p, ["v", "given_role", "given", "role", "value"])  # (v, given role, given value, role, value)
+        self.given_total = _sums(p, ["v", "given_role", "given", "role"])
+        self.class_pair = _sums(p_k, ["k", "given_role", "given", "role", "value"])  # (class, given role, ...): pooled
+        self.class_given_total = _sums(p_k, ["k", "given_role", "given", "role"])
         self.n, self.types = sum(self.value.values()), len(self.value)
         verbs = {v for v, _ in self.role_total}
         # a phrasal verb's base verb ("put" of "put away"), when the frames count it too
@@ -148,13 +188,24 @@ class FrameCountScorer:
         mixture: Mixture = Mixture(),
         classes: dict[str, str] | None = None,
         pairs: bool = True,
+        cache: Path | None = None,
     ) -> FrameCountScorer:
         """Counts of the store's frames in one corpus setting (`all` for every corpus); in `all`, each
         corpus's frames count as often as the mixture weighs it. `classes`: as the constructor's. Without
-        `pairs`, the fillers alone are read (all `verb_preference` needs; a pair then scores as unseen)."""
+        `pairs`, the fillers alone are read (all `verb_preference` needs; a pair then scores as unseen).
+        `cache`: where the weighted counts are kept, each query's in `<cache>-<query>.parquet` (the caller
+        names it by the frames' content and the mixture): reading the counts takes the full store's queries
+        seconds, which every `lmcr complete` paid."""
         queries = ("frame_fillers", "frame_filler_pairs") if pairs else ("frame_fillers",)
-        fillers, *pair_rows = weighted_counts(db, sql_dir, queries, corpus, mixture)
-        if not fillers:
+        fillers, *pair_rows = [
+            cached_counts(
+                cache and cache.with_name(f"{cache.name}-{query}.parquet"),
+                len(FILLER_COLUMNS if query == "frame_fillers" else PAIR_COLUMNS),
+                lambda query=query: weighted_frames(db, sql_dir, (query,), corpus, mixture)[0],
+            )
+            for query in queries
+        ]
+        if fillers.empty:
             raise MethodUnavailable(f"no robot-predicate frames for corpus {corpus!r} in {db} (run `lmcr frames`)")
         return cls(fillers, pair_rows[0] if pair_rows else [], alpha, classes)
 

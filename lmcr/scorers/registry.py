@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 from lmcr.files import file_sha256
-from lmcr.lexicon import load_lexicon
+from lmcr.lexicon import learned_table_file, load_lexicon
 from lmcr.scorers.caches import cache_dir, count_cache, word_vectors
 from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir, load_lm
 from lmcr.scorers.resources import (
@@ -116,7 +116,10 @@ def _frame_count_model(res: MethodResources, method: str, pairs: bool = True):
 
     classes = load_lexicon(learned=res.predicates).motion_classes
     db = store_path(res, method)
-    return FrameCountScorer.from_store(db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=pairs)
+    cache = count_cache(res, "frame-counts", "frame", f"-{_learned_table_digest(res)}").with_suffix("")
+    return FrameCountScorer.from_store(
+        db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=pairs, cache=cache
+    )
 
 
 def _frame_counts(res: MethodResources) -> Scorer:
@@ -131,7 +134,15 @@ def _verb_fillers(res: MethodResources) -> Scorer:
 def _frame_counts_fingerprint(res: MethodResources) -> str:
     from lmcr.scorers.frame_counts import ALPHA, BACKOFF
 
-    return f"{_frame_corpus_hash(res)}*{ALPHA:g}/{BACKOFF}"
+    return f"{_frame_corpus_hash(res)}*{ALPHA:g}/{BACKOFF}/{_learned_table_digest(res)}"
+
+
+def _learned_table_digest(res: MethodResources) -> str:
+    """The content hash of the learned predicate table: its slots decide what the frame counts count (the
+    store's robot_fillers view), its classes of motion what a learned verb's pairs back off to; both can
+    change while the frames do not (a table learned again with other settings)."""
+    table = learned_table_file(res.predicates)
+    return file_sha256(table)[:12] if table is not None else "none"
 
 
 def _similar_verbs(res: MethodResources) -> Scorer:
