@@ -257,6 +257,10 @@ def test_the_command_checks_its_arguments(tmp_path):
         port = taken.getsockname()[1]
         busy = runner.invoke(app, ["serve", "--port", str(port), "--data-dir", str(tmp_path)])
     assert busy.exit_code == 1 and f"cannot listen on 127.0.0.1:{port}" in busy.output
+    budget = runner.invoke(app, ["serve", "--data-dir", str(tmp_path)], env={"LMCR_PLAN_SECONDS": "soon"})
+    assert budget.exit_code == 1 and budget.output.strip().splitlines() == [
+        "error: $LMCR_PLAN_SECONDS='soon': not a number of seconds from 0.01 to 3600"
+    ]  # said before serving, not to each request that plans
     assert "Traceback" not in bad_port.output + missing.output + busy.output
 
 

@@ -9,7 +9,15 @@ from pathlib import Path
 import typer
 
 from lmcr.cli.common import SPACY_MODEL_HELP, CorpusSetting, app, console, fail, note, one_or_batch, write_batch
-from lmcr.robot.budget import IK_CALLS, IK_CALLS_RANGE, PLAN_SECONDS, PLAN_SECONDS_ENV, PLAN_SECONDS_RANGE, Budget
+from lmcr.robot.budget import (
+    IK_CALLS,
+    IK_CALLS_RANGE,
+    PLAN_SECONDS,
+    PLAN_SECONDS_ENV,
+    PLAN_SECONDS_RANGE,
+    Budget,
+    default_plan_seconds,
+)
 from lmcr.scorers.registry import COMPLETION_METHOD, METHODS
 from lmcr.speech.domain_lm import SpeechLMConfig
 from lmcr.workspace import Workspace
@@ -284,6 +292,7 @@ def serve(
     unknown = [m for m in method.split("+") if m not in METHODS]
     if unknown:  # checked now: the models load on the first request
         fail(f"--method: unknown {unknown[0]!r}; available: {', '.join(METHODS)} (a+b sums two)")
+    default_plan_seconds()  # each request plans under it: a bad $LMCR_PLAN_SECONDS is said now, once
     ws = Workspace.from_env(data_dir=data_dir)
     if not ws.data_dir.is_dir():
         fail(f"{ws.data_dir}: no such data folder (run `make demo`, or give --data-dir)")

@@ -37,6 +37,7 @@ from pathlib import Path
 from lmcr.files import cached_json
 from lmcr.frame import Frame
 from lmcr.lm.linearize import tokens
+from lmcr.scorers.ngram_index import PLURALS
 from lmcr.scorers.rarity import phrase_pattern
 from lmcr.store import named_query, read_connection
 
@@ -151,4 +152,4 @@ class ContextCooccurrence:
 
 def _names(word: str, value: str) -> bool:
     """Whether `word` is a word of the filler `value` (or its plural): "pasta" in "boil the pasta"."""
-    return any(word in (part, part + "s", part + "es") for part in value.lower().split())
+    return any(word in {part + end for end in PLURALS} for part in value.lower().split())

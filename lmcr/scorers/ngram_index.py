@@ -25,7 +25,9 @@ from lmcr.files import atomic_path
 from lmcr.store import named_query, read_connection
 
 MAX_WORDS = 3
-PLURALS = ("", "s", "es")  # the endings the phrase scan lets a phrase's last word take
+# the endings a phrase's last word may take where a filler is counted or recognised in text (the named
+# queries phrase_counts and context_cooccurrence spell the same rule as a regex, (?:s|es)?)
+PLURALS = ("", "s", "es")
 WORD = re.compile(r"[a-z0-9_]+")
 
 
