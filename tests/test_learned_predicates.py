@@ -9,7 +9,14 @@ import json
 import pytest
 
 from lmcr.frame import Frame
-from lmcr.frame_corpus.predicates import MIN_FRAMES, learn_predicates, publish_predicates, refresh_predicates
+from lmcr.frame_corpus.predicates import (
+    MIN_ALTERNATIVE_FRAMES,
+    MIN_FRAMES,
+    MIN_RATE,
+    learn_predicates,
+    publish_predicates,
+    refresh_predicates,
+)
 from lmcr.lexicon import PREDICATES_FILE, load_lexicon
 from lmcr.scorers.frame_counts import FrameCountScorer
 from lmcr.store import connect
@@ -92,6 +99,19 @@ def test_a_verb_with_two_open_roles_keeps_both_with_their_sentences(tmp_path):
     spec = warm.spec_json()
     assert spec["preps"] == {"Instrument": ["in"], "Destination": ["into"]}
     assert warm.rates == {"Theme": 1.0, "Instrument": 0.6667, "Destination": 0.3333}
+
+
+def test_a_second_role_stated_in_too_few_frames_is_no_reading(tmp_path):
+    """ "dispose" states its Instrument in 3 of its frames (a misparse more likely than a reading): not an
+    open role beside its Destination; with a lower bound, or a verb that states it more often, it is."""
+    frames = [("dispose", {"of": "milk", "in": "bowl"}, False)] * 25 + [("dispose", {"of": "milk"}, False)] * 12
+    frames += [("dispose", {"of": "milk", "with": "microwave"}, False)] * 3 + _kitchen()
+    con = _store(tmp_path, frames)
+    dispose = learn_predicates(con, HAND).predicates["dispose"]
+    assert dispose.rates["Instrument"] >= MIN_RATE and 3 < MIN_ALTERNATIVE_FRAMES
+    assert dispose.roles == ("Theme", "Destination") and dispose.alternatives == {}
+    loose = learn_predicates(con, HAND, min_alternative_frames=3).predicates["dispose"]
+    assert loose.alternatives == {"Instrument": "dispose of {Theme} with the {Instrument}"}
 
 
 def test_the_hand_written_eleven_are_never_learned_and_evidence_bounds_what_is(tmp_path):

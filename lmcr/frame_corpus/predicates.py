@@ -64,6 +64,10 @@ PREP_ROLES: dict[str, tuple[str, ...]] = {
 OBJECT_SLOT = "Theme"  # the generic frame's direct object
 MIN_FRAMES = 20  # frames a verb needs before it is learned
 MIN_RATE = 0.02  # how often its best role must be stated
+# frames' worth of evidence a second open role needs to compete with the first: a role stated in a
+# handful of a rare verb's frames is likelier a misparse than a reading ("dispose" states an Instrument
+# in 3 of 66 frames, and chose an orange as what to dispose of the chips with; docs/guide/frames.md)
+MIN_ALTERNATIVE_FRAMES = 10
 MIN_SHARE = 0.2  # share of a slot's fillers that must be things (robot-role fillers) for it to fill a role
 MIN_POOL = 2  # times a word fills a robot role before it counts as a thing
 PHRASAL_PRIOR = 50.0  # frames' worth of the base verb's rates a phrasal verb starts from
@@ -218,6 +222,7 @@ def learn_predicates(
     min_frames: int = MIN_FRAMES,
     min_rate: float = MIN_RATE,
     min_share: float = MIN_SHARE,
+    min_alternative_frames: float = MIN_ALTERNATIVE_FRAMES,
 ) -> LearnedTable:
     """The learned table of the store's frame corpus (see the module's docstring)."""
     frames, fillers, totals = _slot_counts(con)
@@ -237,14 +242,19 @@ def learn_predicates(
             "min_rate": min_rate,
             "min_share": min_share,
             "phrasal_prior": PHRASAL_PRIOR,
+            "min_alternative_frames": min_alternative_frames,
         }
     )
     for name, n in frames.items():
         base, particle = _split(name)
         if name in lex.predicates or base in lex.predicates:
             continue  # the hand-written lexicon wins
-        rates = _smoothed(raw_rates[name], n, raw_rates.get(base) if particle else None)
-        learned = _predicate(name, n, rates, dict(sorted(slots_of[name].items())), totals, min_rate)
+        base_rates = raw_rates.get(base) if particle else None
+        rates = _smoothed(raw_rates[name], n, base_rates)
+        # the frames' worth behind the rates: a phrasal verb's include its base verb's prior
+        worth = n + (PHRASAL_PRIOR if base_rates is not None else 0.0)
+        evidence = {"min_rate": min_rate, "min_alternative": min_alternative_frames / worth if worth else math.inf}
+        learned = _predicate(name, n, rates, dict(sorted(slots_of[name].items())), totals, evidence)
         if n >= min_frames and learned is not None:
             table.predicates[name] = learned
         elif n >= REFUSED_LISTED:
@@ -299,12 +309,14 @@ def _smoothed(own: Counter, n: int, base: Counter | None) -> dict[str, float]:
 
 
 def _predicate(
-    name: str, n: int, rates: dict[str, float], slots: dict[str, str], totals: Counter, min_rate: float
+    name: str, n: int, rates: dict[str, float], slots: dict[str, str], totals: Counter, evidence: dict[str, float]
 ) -> LearnedPredicate | None:
     """The predicate of a verb's evidence, or None when no role a request can leave missing is stated often
-    enough."""
+    enough. `evidence`: the rate a role needs to be open (`min_rate`), and the rate a second open role
+    needs besides (`min_alternative`: MIN_ALTERNATIVE_FRAMES over the frames' worth behind the rates)."""
     base, particle = _split(name)
-    open_roles = sorted((r for r in OPEN_ROLES if rates.get(r, 0.0) >= min_rate), key=lambda r: -rates[r])
+    open_roles = sorted((r for r in OPEN_ROLES if rates.get(r, 0.0) >= evidence["min_rate"]), key=lambda r: -rates[r])
+    open_roles = open_roles[:1] + [r for r in open_roles[1:] if rates[r] >= evidence["min_alternative"]]
     if not open_roles:
         return None
     # A prepositional verb: its "of" phrase, about as usual as a direct object, is the Theme ("dispose of
