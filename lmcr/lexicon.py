@@ -124,6 +124,14 @@ class Lexicon:
     # frames say (no role a request leaves open), one with fewer for having too few of them
     min_frames: int = 0
 
+    def refusal(self, name: str) -> str:
+        """Why the refused verb `name` was not learned, in words for a one-line message: too few frames, or
+        frames that seldom say where it puts things or with what (the roles a request leaves open)."""
+        seen = self.refused[name]
+        if seen < self.min_frames:
+            return f"the corpora have {seen:,} frames of {name!r}, too few to learn what it needs"
+        return f"the corpora's {seen:,} frames of {name!r} seldom say where it puts things or with what"
+
     @property
     def hand_written(self) -> list[str]:
         """The predicates of the hand-written lexicon (the paper's eleven)."""

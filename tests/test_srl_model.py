@@ -55,11 +55,14 @@ def test_a_verb_the_corpora_say_too_little_about_is_named_by_the_srl_command_too
 
     from lmcr.srl.instruction import no_predicate
 
-    lex = replace(parser.lex, refused={"recycle": 5})
-    said = (
-        "no known predicate in 'recycle the bottle': the corpora say too little about 'recycle' to learn what it needs"
+    lex = replace(parser.lex, refused={"recycle": 5}, min_frames=20)
+    said = "no known predicate in 'recycle the bottle': the corpora have 5 frames of 'recycle', too few to learn"
+    assert no_predicate(lex, "recycle the bottle", parser.parse("recycle the bottle")) == f"{said} what it needs"
+    # a verb with the frames a verb needs was refused for what they say, and is said so
+    seldom = no_predicate(
+        replace(lex, refused={"recycle": 2_000}), "recycle the bottle", parser.parse("recycle the bottle")
     )
-    assert no_predicate(lex, "recycle the bottle", parser.parse("recycle the bottle")) == f"{said} (5 frames)"
+    assert seldom.endswith("the corpora's 2,000 frames of 'recycle' seldom say where it puts things or with what")
     monkeypatch.setattr(parser, "lex", lex)
     monkeypatch.setattr(Workspace, "parser", lambda self, model=None, resources=None: parser)
     result = CliRunner().invoke(app, ["srl", "recycle the bottle"])

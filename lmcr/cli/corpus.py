@@ -167,7 +167,9 @@ def predicates(
         _show_predicate(verb, rows, lex)
         return
     print_rows(f"predicates learned from {ws.db} (top {top} of {len(rows):,})", rows[:top])
-    console.print(f"{len(rows):,} learned, {len(lex.refused):,} verbs refused for too little evidence")
+    console.print(
+        f"{len(rows):,} learned, {len(lex.refused):,} verbs refused (too few frames, or no place or tool said)"
+    )
 
 
 def _show_predicate(verb: str, rows: list[dict], lex) -> None:
@@ -179,7 +181,7 @@ def _show_predicate(verb: str, rows: list[dict], lex) -> None:
     if found:
         print_rows(f"learned predicate {name!r}", found)
     elif name in lex.refused:
-        console.print(f"{name!r}: refused, {lex.refused[name]:,} frames (too little evidence)")
+        console.print(f"{name!r}: refused: {lex.refusal(name)}")
     elif name in lex.predicates:
         console.print(
             f"{name!r}: hand-written ({', '.join(lex.predicates[name].roles)}): {lex.predicates[name].sentence}"

@@ -212,4 +212,5 @@ def _learn(con: duckdb.DuckDBPyConnection, srl_dir: Path, build: str | None, log
     """Learn the predicates of the build when it has no table yet (`frame_corpus.predicates`)."""
     table = refresh_predicates(con, load_lexicon(learned=False), srl_dir, build)
     if table is not None:
-        log(f"learned {len(table.predicates):,} predicates; {len(table.refused):,} verbs refused (too little evidence)")
+        refused = f"{len(table.refused):,} verbs refused (too few frames, or no place or tool said)"
+        log(f"learned {len(table.predicates):,} predicates; {refused}")

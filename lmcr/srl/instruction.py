@@ -60,11 +60,7 @@ def no_predicate(lex: Lexicon, text: str, frames: list[FrameMention]) -> str:
     little about (named, with its evidence), else none of the learned verbs, else the hand-written ones."""
     refused = [f.predicate for f in frames if f.predicate in lex.refused]
     if refused:
-        name, seen = refused[0], lex.refused[refused[0]]
-        return (
-            f"no known predicate in {text!r}: the corpora say too little about {name!r} to learn what it needs"
-            f" ({seen:,} frames)"
-        )
+        return f"no known predicate in {text!r}: {lex.refusal(refused[0])}"
     if lex.learned:
         return (
             f"no known predicate in {text!r}: none of the {len(lex.predicates):,} verbs the robot learned"
