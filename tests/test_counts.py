@@ -200,6 +200,38 @@ def test_counts_come_from_the_stores_robot_frames(tmp_path):
     assert sorted(p.name for p in cache.parent.iterdir()) == files  # replaced under the same name, no temp left
 
 
+def test_the_default_methods_two_count_terms_read_the_counts_once(tmp_path, monkeypatch):
+    """`verb_fillers` reads the model `frame_counts` built for the same counts; alone first (fillers only),
+    it leaves `frame_counts` to build one with the pairs; another mixture is other counts."""
+    from lmcr.scorers import registry
+    from lmcr.scorers.resources import MethodResources
+
+    db = tmp_path / "lmcr.duckdb"
+    con = connect(db, Workspace.from_env().sql_dir)
+    con.execute(
+        "insert into frames (corpus, doc_id, sent_id, frame_no, predicate, known, pred_start, pred_end) "
+        "values ('recipes', 'd', 0, 0, 'pour', true, 0, 1)"
+    )
+    con.execute("insert into frame_roles values ('recipes', 'd', 0, 0, 'Theme', 'water', 0, 1)")
+    con.close()
+    built = []
+    real = FrameCountScorer.from_store.__func__
+    monkeypatch.setattr(
+        FrameCountScorer, "from_store", classmethod(lambda cls, *a, **k: built.append(k["pairs"]) or real(cls, *a, **k))
+    )
+    res = MethodResources(tmp_path / "ckpt", db=db, predicates=False)
+    registry._LAST_MODEL.clear()
+    registry.make_scorer("frame_counts+verb_fillers", res)
+    assert built == [True]
+    registry._LAST_MODEL.clear()
+    registry.make_scorer("verb_fillers+frame_counts", res)
+    assert built == [True, False, True]
+    registry.make_scorer(
+        "frame_counts", MethodResources(tmp_path / "ckpt", db=db, predicates=False, mixture=Mixture.of({"recipes": 3}))
+    )
+    assert built == [True, False, True, True]
+
+
 def test_mixture_weights_parse_label_and_shares():
     mixture = Mixture.parse("household=30, youcook2=1")
     assert (mixture.weights, mixture.label, mixture.weight("recipes")) == ((("household", 30.0),), "household=30", 1.0)

@@ -109,17 +109,31 @@ def _lm_fingerprint(linearization: str) -> Callable[[MethodResources], str]:
     return fingerprint
 
 
+# The last frame-count model built (with whether it has the pairs), by the counts it was made of: the
+# default method's `verb_fillers` reads the model `frame_counts` built just before it, instead of summing
+# the same fillers again (a second of every start on the full store).
+_LAST_MODEL: dict[tuple, tuple] = {}
+
+
 def _frame_count_model(res: MethodResources, method: str, pairs: bool = True):
     """The store's frame counts for `method`, each learned verb with its class of motion (its pairs back
     off to its class's; `verb_fillers` sets it against its class); `pairs`: as `FrameCountScorer.from_store`."""
     from lmcr.scorers.frame_counts import FrameCountScorer
 
-    classes = load_lexicon(learned=res.predicates).motion_classes
     db = store_path(res, method)
+    # named by the frames' content, the mixture, the setting and the learned table (its classes too)
     cache = count_cache(res, "frame-counts", "frame", f"-{_learned_table_digest(res)}").with_suffix("")
-    return FrameCountScorer.from_store(
+    key = (cache, res.sql_dir)
+    found = _LAST_MODEL.get(key)
+    if found is not None and (found[1] or not pairs):
+        return found[0]
+    classes = load_lexicon(learned=res.predicates).motion_classes
+    model = FrameCountScorer.from_store(
         db, res.sql_dir, res.corpus, mixture=res.mixture, classes=classes, pairs=pairs, cache=cache
     )
+    _LAST_MODEL.clear()
+    _LAST_MODEL[key] = (model, pairs)
+    return model
 
 
 def _frame_counts(res: MethodResources) -> Scorer:
