@@ -198,6 +198,10 @@ def test_counts_come_from_the_stores_robot_frames(tmp_path):
         "cup": 1,
     }
     assert sorted(p.name for p in cache.parent.iterdir()) == files  # replaced under the same name, no temp left
+    # where the counts cannot be kept (a file stands where the cache folder would be), they are used unkept
+    (tmp_path / "not-a-folder").write_text("")
+    unkept = FrameCountScorer.from_store(db, Workspace.from_env().sql_dir, "all", cache=tmp_path / "not-a-folder" / "x")
+    assert unkept.value == {"water": 1, "cup": 1} and (tmp_path / "not-a-folder").read_text() == ""
 
 
 def test_the_default_methods_two_count_terms_read_the_counts_once(tmp_path, monkeypatch):

@@ -56,7 +56,7 @@ from pathlib import Path
 import pandas as pd
 from pyarrow import ArrowException
 
-from lmcr.files import atomic_path
+from lmcr.files import OutputError, atomic_path
 from lmcr.frame import Frame
 from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.resources import MethodUnavailable
@@ -109,7 +109,8 @@ def weighted_frames(
 def cached_counts(path: Path | None, columns: int, count: Callable[[], pd.DataFrame]) -> pd.DataFrame:
     """`count()`, kept as Parquet at `path` (written atomically): a saved file is read instead when it is
     a table of `columns` columns; one that is missing, unreadable or otherwise shaped is counted afresh.
-    Parquet holds plain columns: reading it runs nothing."""
+    Parquet holds plain columns: reading it runs nothing. Where the file cannot be written (a store in a
+    read-only folder), the counts are used unkept: they only save time."""
     if path is None:
         return count()
     try:
@@ -119,8 +120,11 @@ def cached_counts(path: Path | None, columns: int, count: Callable[[], pd.DataFr
     except (OSError, ValueError, ArrowException):
         pass  # no cache yet, or not one of ours
     counted = count()
-    with atomic_path(path) as tmp:
-        counted.to_parquet(tmp, index=False)
+    try:
+        with atomic_path(path) as tmp:
+            counted.to_parquet(tmp, index=False)
+    except OutputError:
+        pass
     return counted
 
 
