@@ -20,6 +20,9 @@ from lmcr.evaluate.run import SETTINGS, run_evaluation
 from lmcr.files import cached_json, file_sha256
 from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
+from lmcr.scorers.context_pmi import WEIGHT as CONTEXT_WEIGHT
+from lmcr.scorers.mixture import FILE as MIXTURE_FILE
+from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.registry import COMPLETION_METHOD, EVALUATED
 from lmcr.scorers.resources import MethodResources
 from lmcr.setting import Setting
@@ -31,9 +34,14 @@ def evaluation_key(parameters: dict) -> str:
     """Cache key of an evaluation: the LM versions in use, the ratings (the store's rating files or the
     CSV's content), the frame builds (frame_counts), the parameters, this flow's source, and whether the
     report is still there (a deleted report is written again)."""
-    res: MethodResources = parameters["res"]
+    report_there = (Path(parameters["out"]) / "report.md").exists()
+    return inputs_key(parameters["res"], Path(parameters["ratings"]), [report_there, parameters])
+
+
+def inputs_key(res: MethodResources, ratings: Path, extra: list) -> str:
+    """Cache key of what a task reads: the LM versions in use, the ratings (the store's rating files or the
+    CSV's content), the frame builds, this flow's source, and `extra` (its parameters)."""
     versions = [str(ckpt.resolve(p.parent)) for p in sorted(Path(res.checkpoints).glob("*/LATEST"))]
-    ratings = Path(parameters["ratings"])
     if res.db is not None and ratings.resolve() == Path(res.db).resolve():
         with read_connection(res.db) as con:
             rating_files = con.execute("select sha256 from rating_files order by 1").fetchall()
@@ -43,12 +51,7 @@ def evaluation_key(parameters: dict) -> str:
     if res.db is not None and Path(res.db).exists():
         with read_connection(res.db) as con:
             frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()
-    report_there = (Path(parameters["out"]) / "report.md").exists()
-    blob = json.dumps(
-        [versions, rating_files, frames, report_there, file_sha256(Path(__file__)), parameters],
-        default=str,
-        sort_keys=True,
-    )
+    blob = json.dumps([versions, rating_files, frames, file_sha256(Path(__file__)), extra], default=str, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -101,18 +104,34 @@ def evaluate_task(
     return cached_json(ws.data_dir / "cache" / f"evaluate-{key}.json", usable, evaluate)
 
 
-@task(name="choose-mixture")
+@task(name="choose-mixture", cache_policy=NO_CACHE)  # its own JSON cache, below
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
     """Choose the household weight of the pooled setting on the ratings (and on the instructions, with the
-    context term's weight: `lmcr mixture`) and save them."""
+    context term's weight: `lmcr mixture`) and save them. The choice is kept as plain JSON in the workspace
+    (`cache/mixture-KEY.json`, keyed on what it reads: the LMs, ratings, frames and instructions): an
+    unchanged re-run, whose mixture file still holds that choice, does not choose again (16 s of the
+    sample pipeline's re-run)."""
     from lmcr.evaluate.choose_mixture import DevInstructions, choose_and_save
 
-    rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
-    dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None
-    chosen, context_weight, _ = choose_and_save(
-        rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info, instructions=dev
-    )
-    return chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
+    # the mixture in use and the context term's weight are what is chosen here: not inputs of the choice
+    neutral = replace(res, mixture=Mixture(), context_weight=CONTEXT_WEIGHT)
+    said = file_sha256(Path(instructions)) if instructions and Path(instructions).is_file() else instructions
+    key = inputs_key(neutral, Path(ratings), [COMPLETION_METHOD, neutral, said])
+    mixture_file = ws.data_dir / MIXTURE_FILE
+
+    def choose() -> dict:
+        rated = load_ratings(Path(ratings), ws.sql_dir, set(load_lexicon().predicates))
+        dev = DevInstructions.read(Path(instructions), ws.parser) if instructions else None
+        chosen, context_weight, path = choose_and_save(
+            rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info, instructions=dev
+        )
+        said = chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
+        return {"chosen": said, "mixture_sha256": file_sha256(path)}
+
+    def usable(saved) -> bool:  # the choice stands while the mixture file is the one it wrote
+        return mixture_file.is_file() and saved["mixture_sha256"] == file_sha256(mixture_file)
+
+    return cached_json(ws.data_dir / "cache" / f"mixture-{key}.json", usable, choose)["chosen"]
 
 
 @task(name="calibrate-learned-verbs")

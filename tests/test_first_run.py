@@ -114,6 +114,8 @@ def test_the_demo_pipeline_on_busy_cores_then_an_unchanged_rerun(tmp_path, monke
 
     from flows.pipeline import PipelineParams, pipeline_flow
 
+    chosen = tmp_path / "data" / "mixture.json"
+    chosen_at = chosen.stat().st_mtime_ns
     monkeypatch.setenv("PREFECT_HOME", env["PREFECT_HOME"])
     with local_server():
         second = pipeline_flow(PipelineParams(**SMALL, data_dir=str(tmp_path / "data")))
@@ -122,6 +124,8 @@ def test_the_demo_pipeline_on_busy_cores_then_an_unchanged_rerun(tmp_path, monke
     speech = tmp_path / "data" / "speech" / "en-us"  # the speech model: built once, kept on the unchanged re-run
     assert (speech / "LATEST").exists() and len([v for v in speech.iterdir() if v.name.startswith("v")]) == 1
     assert second["table1"] == table1
+    # the mixture was not chosen again: its choice kept for the same inputs, its file as the first run wrote it
+    assert chosen.stat().st_mtime_ns == chosen_at and len(list((tmp_path / "data" / "cache").glob("mixture-*"))) == 1
     assert second["executor_check"]["frame"]["predicate"] == "pour" and "grasped" in second["executor_check"]["checks"]
     # What a Prefect UI user sees of the runs: Table I, the report and the executor check as artifacts.
     assert {"table-i", "evaluation-report", "evaluation-report-html", "executor-check"} <= keys
