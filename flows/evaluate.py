@@ -125,8 +125,8 @@ def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions
         chosen, context_weight, path = choose_and_save(
             rated, Path(ratings), res, COMPLETION_METHOD, ws.data_dir, log=get_run_logger().info, instructions=dev
         )
-        said = chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
-        return {"chosen": said, "mixture_sha256": file_sha256(path)}
+        label = chosen.label + (f", context weight {context_weight:g}" if context_weight else "")
+        return {"chosen": label, "mixture_sha256": file_sha256(path)}
 
     def usable(saved) -> bool:  # the choice stands while the mixture file is the one it wrote
         return mixture_file.is_file() and saved["mixture_sha256"] == file_sha256(mixture_file)
