@@ -115,8 +115,8 @@ def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions
 
     # the mixture in use and the context term's weight are what is chosen here: not inputs of the choice
     neutral = replace(res, mixture=Mixture(), context_weight=CONTEXT_WEIGHT)
-    said = file_sha256(Path(instructions)) if instructions and Path(instructions).is_file() else instructions
-    key = inputs_key(neutral, Path(ratings), [COMPLETION_METHOD, neutral, said])
+    dev_sha = file_sha256(Path(instructions)) if instructions and Path(instructions).is_file() else instructions
+    key = inputs_key(neutral, Path(ratings), [COMPLETION_METHOD, neutral, dev_sha])
     mixture_file = ws.data_dir / MIXTURE_FILE
 
     def choose() -> dict:

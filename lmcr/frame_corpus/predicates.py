@@ -251,10 +251,10 @@ def learn_predicates(
             continue  # the hand-written lexicon wins
         base_rates = raw_rates.get(base) if particle else None
         rates = _smoothed(raw_rates[name], n, base_rates)
-        # the frames' worth behind the rates: a phrasal verb's include its base verb's prior
+        # the frames' worth behind the rates (a phrasal verb's include its base verb's prior): at least 1
         worth = n + (PHRASAL_PRIOR if base_rates is not None else 0.0)
-        evidence = {"min_rate": min_rate, "min_alternative": min_alternative_frames / worth if worth else math.inf}
-        learned = _predicate(name, n, rates, dict(sorted(slots_of[name].items())), totals, evidence)
+        slots = dict(sorted(slots_of[name].items()))
+        learned = _predicate(name, n, rates, slots, totals, min_rate, min_alternative_frames / worth)
         if n >= min_frames and learned is not None:
             table.predicates[name] = learned
         elif n >= REFUSED_LISTED:
@@ -309,14 +309,20 @@ def _smoothed(own: Counter, n: int, base: Counter | None) -> dict[str, float]:
 
 
 def _predicate(
-    name: str, n: int, rates: dict[str, float], slots: dict[str, str], totals: Counter, evidence: dict[str, float]
+    name: str,
+    n: int,
+    rates: dict[str, float],
+    slots: dict[str, str],
+    totals: Counter,
+    min_rate: float,
+    min_alternative_rate: float,
 ) -> LearnedPredicate | None:
     """The predicate of a verb's evidence, or None when no role a request can leave missing is stated often
-    enough. `evidence`: the rate a role needs to be open (`min_rate`), and the rate a second open role
-    needs besides (`min_alternative`: MIN_ALTERNATIVE_FRAMES over the frames' worth behind the rates)."""
+    enough: a role is open at `min_rate`, a second one at `min_alternative_rate` besides
+    (MIN_ALTERNATIVE_FRAMES over the frames' worth behind the rates)."""
     base, particle = _split(name)
-    open_roles = sorted((r for r in OPEN_ROLES if rates.get(r, 0.0) >= evidence["min_rate"]), key=lambda r: -rates[r])
-    open_roles = open_roles[:1] + [r for r in open_roles[1:] if rates[r] >= evidence["min_alternative"]]
+    open_roles = sorted((r for r in OPEN_ROLES if rates.get(r, 0.0) >= min_rate), key=lambda r: -rates[r])
+    open_roles = open_roles[:1] + [r for r in open_roles[1:] if rates[r] >= min_alternative_rate]
     if not open_roles:
         return None
     # A prepositional verb: its "of" phrase, about as usual as a direct object, is the Theme ("dispose of

@@ -130,6 +130,7 @@ def cached_counts(path: Path | None, columns: int, count: Callable[[], pd.DataFr
 
 FILLER_COLUMNS = ["v", "role", "value", "n"]
 PAIR_COLUMNS = ["v", "given_role", "given", "role", "value", "n"]
+COLUMNS = {"frame_fillers": FILLER_COLUMNS, "frame_filler_pairs": PAIR_COLUMNS}  # each count query's
 
 
 def _frame(rows, columns: list[str]) -> pd.DataFrame:
@@ -204,7 +205,7 @@ class FrameCountScorer:
         fillers, *pair_rows = [
             cached_counts(
                 cache and cache.with_name(f"{cache.name}-{query}.parquet"),
-                len(FILLER_COLUMNS if query == "frame_fillers" else PAIR_COLUMNS),
+                len(COLUMNS[query]),
                 lambda query=query: weighted_frames(db, sql_dir, (query,), corpus, mixture)[0],
             )
             for query in queries
