@@ -1,7 +1,7 @@
 """Evaluate flow: ratings from the store (or an MTurk CSV) -> scores of every method -> Table I and
 Fig. 4 report, published as Prefect artifacts (the Table I table, the report's markdown and a link to
 its HTML). The evaluation task is cached on what it reads (LM versions, ratings, frame builds and its
-parameters), so an unchanged re-run of the pipeline costs nothing."""
+parameters) and on the code that computes it, so an unchanged re-run of the pipeline costs nothing."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_link_artifact, create_markdown_artifact, create_table_artifact
 from prefect.cache_policies import NO_CACHE
 
+from lmcr.checkout import library_fingerprint
 from lmcr.evaluate.protocol import EvalConfig
 from lmcr.evaluate.ratings import load_ratings
 from lmcr.evaluate.run import SETTINGS, run_evaluation
@@ -32,15 +33,16 @@ from lmcr.workspace import Workspace
 
 def evaluation_key(parameters: dict) -> str:
     """Cache key of an evaluation: the LM versions in use, the ratings (the store's rating files or the
-    CSV's content), the frame builds (frame_counts), the parameters, this flow's source, and whether the
-    report is still there (a deleted report is written again)."""
+    CSV's content), the frame builds (frame_counts), the parameters, the library's code and this flow's
+    source, and whether the report is still there (a deleted report is written again)."""
     report_there = (Path(parameters["out"]) / "report.md").exists()
     return inputs_key(parameters["res"], Path(parameters["ratings"]), [report_there, parameters])
 
 
 def inputs_key(res: MethodResources, ratings: Path, extra: list) -> str:
     """Cache key of what a task reads: the LM versions in use, the ratings (the store's rating files or the
-    CSV's content), the frame builds, this flow's source, and `extra` (its parameters)."""
+    CSV's content), the frame builds, the library's code and this flow's source, and `extra` (its
+    parameters)."""
     versions = [str(ckpt.resolve(p.parent)) for p in sorted(Path(res.checkpoints).glob("*/LATEST"))]
     if res.db is not None and ratings.resolve() == Path(res.db).resolve():
         with read_connection(res.db) as con:
@@ -51,7 +53,8 @@ def inputs_key(res: MethodResources, ratings: Path, extra: list) -> str:
     if res.db is not None and Path(res.db).exists():
         with read_connection(res.db) as con:
             frames = con.execute("select fingerprint from frame_builds order by built_at").fetchall()
-    blob = json.dumps([versions, rating_files, frames, file_sha256(Path(__file__)), extra], default=str, sort_keys=True)
+    code = [library_fingerprint(), file_sha256(Path(__file__))]
+    blob = json.dumps([versions, rating_files, frames, code, extra], default=str, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -108,8 +111,8 @@ def evaluate_task(
 def mixture_task(ratings: str, res: MethodResources, ws: Workspace, instructions: str | None = None) -> str:
     """Choose the household weight of the pooled setting on the ratings (and on the instructions, with the
     context term's weight: `lmcr mixture`) and save them. The choice is kept as plain JSON in the workspace
-    (`cache/mixture-KEY.json`, keyed on what it reads: the LMs, ratings, frames and instructions): an
-    unchanged re-run, whose mixture file still holds that choice, does not choose again (16 s of the
+    (`cache/mixture-KEY.json`, keyed on what it reads: the LMs, ratings, frames and instructions, and on the
+    code): an unchanged re-run, whose mixture file still holds that choice, does not choose again (16 s of the
     sample pipeline's re-run)."""
     from lmcr.evaluate.choose_mixture import DevInstructions, choose_and_save
 

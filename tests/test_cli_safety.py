@@ -494,6 +494,48 @@ def test_the_evaluate_task_caches_json(prefect_api, tmp_path, sample_dir):
     assert remade[0].stat().st_mtime_ns != touched[cached.index(remade[0])]
 
 
+def test_a_library_change_evaluates_and_chooses_again(monkeypatch, tmp_path, sample_dir):
+    """The cache keys of the evaluation and of the mixture's choice hold the library's code: after an
+    upgrade or an edit of a scorer, the same inputs are no longer answered with what the old code found."""
+    import flows.evaluate as flow_module
+    from lmcr.workspace import Workspace
+
+    ws = Workspace.from_env(data_dir=tmp_path / "data")
+    ratings = sample_dir / "ratings" / "sample_ratings_mturk.csv"
+    parameters = {"ratings": str(ratings), "out": str(tmp_path / "report"), "res": ws.resources()}
+    before = flow_module.evaluation_key(parameters), flow_module.inputs_key(ws.resources(), ratings, [])
+    assert before == (flow_module.evaluation_key(parameters), flow_module.inputs_key(ws.resources(), ratings, []))
+    monkeypatch.setattr(flow_module, "library_fingerprint", lambda: "another version of the code")
+    after = flow_module.evaluation_key(parameters), flow_module.inputs_key(ws.resources(), ratings, [])
+    assert before[0] != after[0] and before[1] != after[1]
+
+
+def test_the_library_fingerprint_follows_code_and_shipped_files_not_bytecode(tmp_path):
+    """Every .py, .json and .sql file under the roots counts, by path and content; bytecode and other
+    files do not."""
+    from lmcr.checkout import library_fingerprint
+
+    code, sql = tmp_path / "lmcr", tmp_path / "sql"
+    (code / "scorers").mkdir(parents=True)
+    sql.mkdir()
+    (code / "scorers" / "counts.py").write_text("WEIGHT = 0.25\n")
+    (code / "lexicon.json").write_text("{}")
+    (sql / "001_init.sql").write_text("select 1;")
+    first = library_fingerprint.__wrapped__((code, sql))
+    (code / "scorers" / "__pycache__").mkdir()
+    (code / "scorers" / "__pycache__" / "counts.cpython-311.pyc").write_bytes(b"\x00")
+    (code / "notes.txt").write_text("not code")
+    assert library_fingerprint.__wrapped__((code, sql)) == first
+    for path, text in ((code / "scorers" / "counts.py", "WEIGHT = 0.5\n"), (code / "lexicon.json", '{"a": 1}')):
+        old = path.read_text()
+        path.write_text(text)
+        assert library_fingerprint.__wrapped__((code, sql)) != first
+        path.write_text(old)
+    (sql / "001_init.sql").rename(sql / "002_init.sql")  # a renamed file is another library
+    assert library_fingerprint.__wrapped__((code, sql)) != first
+    assert library_fingerprint() == library_fingerprint()  # the shipped library's, once a process
+
+
 # 7. the defaults need only the checkpoints the pipeline's defaults train
 
 
