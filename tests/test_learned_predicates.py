@@ -167,6 +167,9 @@ def test_the_frame_counts_follow_a_table_learned_again_from_the_same_frames(tmp_
     assert scorer_fingerprint("frame_counts", res) != before
     assert scorer_fingerprint("verb_fillers", res) == scorer_fingerprint("frame_counts", res)
     assert make_scorer("frame_counts", res)(put) < learned_score  # put's frames no longer counted
+    # the counts kept under the old table are gone: nothing names them again
+    kept = sorted(p.name for p in (tmp_path / "baselines").glob("frame-counts-*"))
+    assert len(kept) == 2 and len({name.split("-")[-2] for name in kept}) == 1, kept
 
 
 def test_a_republished_table_replaces_the_old_one_whole(tmp_path):

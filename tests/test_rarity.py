@@ -175,3 +175,30 @@ def test_the_rarity_scorer_indexes_the_store_at_its_first_new_label(store, tmp_p
     expected = -WEIGHT * (scanned.log_p("cheese") + scanned.log_p("panini pan"))
     assert make_scorer("rarity", res)(frames) == pytest.approx([expected])
     assert [p.name.split("-")[0] for p in (tmp_path / "caches").glob("ngrams-*.npz")] == ["ngrams"]
+
+
+def test_a_cache_named_afresh_removes_only_those_it_supersedes(tmp_path):
+    """Files named as the new cache but for their content hashes (another corpus content, frame build or
+    learned table), with any ending, are removed; other settings, mixtures, kinds and the new cache's own
+    files stay, and so does a name with no hash."""
+    from lmcr.scorers.caches import superseding
+
+    old, new = "0123456789ab", "ba9876543210"
+    names = [
+        f"frame-counts-all-household=10-{old}-{old}-frame_fillers.parquet",  # superseded
+        f"frame-counts-all-household=10-{old}-{new}-frame_filler_pairs.parquet",  # superseded (frames)
+        f"frame-counts-all-household=10-{new}-{new}-frame_fillers.parquet",  # the new one's own
+        f"frame-counts-all-household=100-{old}-{old}-frame_fillers.parquet",  # another mixture
+        f"frame-counts-recipes-household=10-{old}-{old}-frame_fillers.parquet",  # another setting
+        f"context-sentences-all-household=10-{old}.json",  # another kind
+        "frame-counts-all-household=10-notes.txt",  # no hash
+    ]
+    for name in names:
+        (tmp_path / name).write_text("x")
+    path = tmp_path / f"frame-counts-all-household=10-{new}-{new}.json"
+    assert superseding(path) == path
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names[2:])
+    assert superseding(tmp_path / "missing" / f"ngrams-{new}.npz").name == f"ngrams-{new}.npz"  # no folder yet
+    (tmp_path / f"ngrams-{old}.npz").write_text("x")
+    superseding(tmp_path / f"ngrams-{new}.npz")
+    assert not (tmp_path / f"ngrams-{old}.npz").exists()

@@ -1,9 +1,11 @@
 """What scorers derive from the store and keep on disk: count caches named by the setting, the mixture
 and the corpus content hash (so that changed inputs are counted afresh), and the word vectors of the
-baselines (a given file, the installed GloVe, or word2vec trained on the corpus and cached)."""
+baselines (a given file, the installed GloVe, or word2vec trained on the corpus and cached). A cache
+named afresh removes those it supersedes (`superseding`)."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from lmcr.scorers.resources import MethodResources, corpus_sentences, store_corpus_hash
@@ -20,7 +22,31 @@ def count_cache(res: MethodResources, kind: str, linearization: str, suffix: str
     """The cache file of a count-based scorer's counts: named by the setting, the mixture and the content
     hash of the store's sentences or frames (`linearization`), so that changed inputs are counted afresh."""
     digest = store_corpus_hash(res.db, linearization)[:12]
-    return cache_dir(res) / f"{kind}-{res.corpus}-{res.mixture.label}-{digest}{suffix}.json"
+    return superseding(cache_dir(res) / f"{kind}-{res.corpus}-{res.mixture.label}-{digest}{suffix}.json")
+
+
+CONTENT_HASH = re.compile(r"(?<![0-9a-f])[0-9a-f]{12}(?![0-9a-f])")  # how a cache's name holds a content hash
+
+
+def superseding(path: Path) -> Path:
+    """`path`, a cache named by content hashes (12 hex digits each), once the caches it supersedes are
+    removed: the files of its folder named as it is (less its extension, with any ending) but for those
+    hashes. They were derived from a corpus, frame build or learned table the store no longer holds, of the
+    same kind, setting and mixture, and nothing names them again: each scheduled retrain on new text would
+    otherwise leave about 100 MB behind on the full corpora (n-grams 77 MB, counts 3 MB a mixture). A file
+    that cannot be removed stays; it only takes room."""
+    stem = path.name[: -len(path.suffix)] if path.suffix else path.name
+    parts = CONTENT_HASH.split(stem)
+    if len(parts) == 1 or not path.parent.is_dir():
+        return path
+    same_but_hashes = re.compile("[0-9a-f]{12}".join(map(re.escape, parts)) + r"(?![0-9a-f]).*", re.DOTALL)
+    for other in path.parent.iterdir():
+        if same_but_hashes.fullmatch(other.name) and not other.name.startswith(stem) and other.is_file():
+            try:
+                other.unlink()
+            except OSError:
+                pass
+    return path
 
 
 def word_vectors(res: MethodResources) -> Path:
@@ -38,7 +64,7 @@ def corpus_word2vec(res: MethodResources) -> Path:
     from lmcr.scorers.baselines.vectors import train_word2vec
 
     digest = store_corpus_hash(res.db, "sentence")[:12]
-    path = cache_dir(res) / f"word2vec-{res.corpus}-{digest}.bin"
+    path = superseding(cache_dir(res) / f"word2vec-{res.corpus}-{digest}.bin")
     if not path.exists():
         train_word2vec(corpus_sentences(res), path, seed=res.seed + 1)
     return path

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from lmcr.files import file_sha256
 from lmcr.lexicon import learned_table_file, load_lexicon
-from lmcr.scorers.caches import cache_dir, count_cache, word_vectors
+from lmcr.scorers.caches import cache_dir, count_cache, superseding, word_vectors
 from lmcr.scorers.lm_checkpoints import lm_experts, lm_version_dir, load_lm
 from lmcr.scorers.resources import (
     MethodResources,
@@ -189,7 +189,7 @@ def _rarity(res: MethodResources) -> Scorer:
     @functools.cache
     def index() -> NgramIndex:  # named by the corpus content, read (or built) at the first new label only
         return NgramIndex.cached(
-            db, res.sql_dir, cache_dir(res) / f"ngrams-{store_corpus_hash(db, 'sentence')[:12]}.npz"
+            db, res.sql_dir, superseding(cache_dir(res) / f"ngrams-{store_corpus_hash(db, 'sentence')[:12]}.npz")
         )
 
     counts = PhraseCounts(db, res.sql_dir, corpus_words(res), res.corpus, res.mixture, index)
