@@ -192,6 +192,26 @@ def test_a_cooking_verb_puts_the_theme_where_it_cooks(frame, role):
         assert task.program is tasks.TASKS["heat"].program and task.check is tasks.TASKS["heat"].check
 
 
+@pytest.mark.parametrize(
+    "frame, motion",
+    [
+        (Frame.of("warm up", {"Theme": "cookies", "Instrument": "microwave"}), "cook"),
+        (Frame.of("warm up", {"Theme": "soup", "Instrument": "stove"}), "cook"),
+        (Frame.of("warm up", {"Theme": "cookies", "Instrument": "knife"}), None),  # no tool to cook with
+        (Frame.of("warm up", {"Theme": "cookies", "Destination": "bowl", "Instrument": "oven"}), "place"),
+        (Frame.of("warm up", {"Theme": "cookies"}), None),
+    ],
+)
+def test_a_placing_verb_given_what_cooks_for_a_tool_and_no_place_cooks_there(frame, motion):
+    """The corpus says "warm it up in the microwave", which the learned slots read as an Instrument, and
+    "warm up" is learned as a placing verb: given an appliance that cooks and no place, it puts the Theme
+    in it as the cook class does; with a place it places there, as before."""
+    task = tasks.task_for(frame, "place")
+    assert (task.motion if task else None) == motion
+    if motion == "cook":
+        assert (task.held_role, task.target_role) == ("Theme", "Instrument")
+
+
 def _run(tmp_path, layout: list, frame: Frame, verb_motion: str = "place") -> dict:
     from lmcr.robot.act import run_plan
     from lmcr.robot.plan import Plan, Planner

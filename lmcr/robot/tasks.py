@@ -1168,14 +1168,17 @@ def task_for(frame: Frame, verb_motion: str | None = None) -> Task | None:
     verb's class ("whisk the batter with the spoon": stir; "slice the bread with the knife": cut; "cover the pot
     with the lid": cover) when the tool's shape can do it; a verb of the serve class ladles the Theme's
     content into the Destination ("ladle the soup into the bowl"); one of the cook class puts the Theme in
-    or on what cooks it (`cooks`). None when the robot has no motion for it."""
+    or on what cooks it (`cooks`), and so does one of the place class given what cooks for a tool and no
+    place. None when the robot has no motion for it."""
     if frame.predicate in TASKS:
         return TASKS[frame.predicate]
     roles = frame.role_map
     if verb_motion == "serve" and {"Theme", "Destination"} <= set(roles) and roles["Destination"] not in household():
         served = serves(roles["Theme"], roles["Destination"], roles.get("Instrument"))
         return SERVE if served else None
-    if verb_motion == "cook":
+    # a placing verb whose frame names no place but a tool that cooks ("warm up the cookies", the corpus's
+    # "warm it up in the microwave" learned as its Instrument) puts the Theme in it, as the cook class does
+    if verb_motion == "cook" or (verb_motion == "place" and "Destination" not in roles):
         return _cook_task(roles)
     if verb_motion in TOOL_MOTIONS and {"Theme", "Instrument"} <= set(roles):
         return TOOL_MOTIONS[verb_motion] if unfit_tool(frame, verb_motion) is None else None
