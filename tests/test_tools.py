@@ -228,3 +228,21 @@ def test_the_robot_says_it_cut_covered_or_served(motion, roles, said):
     from lmcr.robot.reply import motion_done
 
     assert motion_done(motion, roles) == said
+
+
+def test_a_ladle_is_tipped_over_the_targets_middle_first_then_nearer_the_robot_inside_it():
+    """The spout's places over a bowl: TIP_HEIGHTS over its middle first, then the same heights moved
+    towards the robot's base (the origin) but still inside the bowl's inner walls, for a bowl at the far
+    edge of the arm's reach."""
+    from lmcr.robot.scene import WALL, SceneObject
+
+    top, half = np.array([0.75, 0.3, 0.82]), 0.08  # a bowl 16 cm across at the table's far left
+    box = (top - [half, half, 0.07], top + [half, half, 0.0])
+    g = tasks.Geometry(SceneObject("ladle", (0, 0)), SceneObject("bowl", (0, 0)), target_top=top, target_box=box)
+    spouts = tasks._spouts(g)
+    heights = len(tasks.TIP_HEIGHTS)
+    assert [s[2] - top[2] for s in spouts] == pytest.approx(list(tasks.TIP_HEIGHTS) * 2)
+    assert all(np.allclose(s[:2], top[:2]) for s in spouts[:heights])
+    for near in spouts[heights:]:
+        assert np.linalg.norm(near[:2]) < np.linalg.norm(top[:2]) - 0.03  # nearer the robot
+        assert np.all(np.abs(near[:2] - top[:2]) < half - WALL)  # inside the inner walls

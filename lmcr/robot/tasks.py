@@ -95,6 +95,9 @@ SCOOP_DEPTH, SCOOP_FLOOR, SCOOP_GRAINS, TIP_HEIGHTS = 0.045, 0.015, 12, (0.06, 0
 TIPS = tuple(math.radians(a) for a in (15, 30, 45))  # it is tipped out in steps, its spout kept in place
 LEVEL_CARRY, LEVEL_LEG = 0.08, 0.08  # ... carried level this far above the higher rim, in legs this long
 SERVED = 0.6  # this share of what the ladle carried must end in the target
+# where the arm cannot tip it out over the target's middle (a bowl at the far edge of its reach), the spout
+# is held this share of the way from the middle to the target's inner wall on the robot's side
+SPOUT_NEAR = 0.8
 
 
 @dataclass(frozen=True)
@@ -872,7 +875,7 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
     # the way of turning the hand that tips the bowl down (the other would run the content down the handle)
     sign = max((1, -1), key=lambda s: gripper_over(bowl, tilted(replace(v, tilt_sign=s), TIPS[-1])))
     tips = [tilted(replace(v, tilt_sign=sign), angle) for angle in TIPS]
-    spouts = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
+    spouts = _spouts(g)
     pours = tuple(gripper_for(lip, orn, spout) for spout in spouts)  # level, the spout over the target
     name, into = g.source.name, g.target.name
     return [
@@ -900,6 +903,18 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
         ],
         Step("move", "lift it", tuple(x + [0, 0, LEVEL_CARRY] for x in pours), orn, straight=True),
     ]
+
+
+def _spouts(g: Geometry) -> list[np.ndarray]:
+    """Where a ladle's spout is held over the target, in the order tried: TIP_HEIGHTS over its middle, then
+    the same SPOUT_NEAR of the way towards its inner wall on the robot's side (its base stands at the
+    origin), where the content still falls inside and the arm reaches a few centimetres less far."""
+    middle = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
+    lo, hi = g.target_box
+    inner = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - WALL
+    towards = -g.target_top[:2] / max(float(np.linalg.norm(g.target_top[:2])), 1e-9)
+    near = np.array([*(towards * SPOUT_NEAR * max(inner, 0.0)), 0.0])
+    return middle + [m + near for m in middle]
 
 
 def _level_carry(start: np.ndarray, end: np.ndarray, orn, into: str) -> list[Step]:
