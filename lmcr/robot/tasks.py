@@ -907,8 +907,9 @@ def program_serve(g: Geometry, v: Variant, holding: bool) -> list[Step]:
 
 def _spouts(g: Geometry) -> list[np.ndarray]:
     """Where a ladle's spout is held over the target, in the order tried: TIP_HEIGHTS over its middle, then
-    the same SPOUT_NEAR of the way towards its inner wall on the robot's side (its base stands at the
-    origin), where the content still falls inside and the arm reaches a few centimetres less far."""
+    the same heights moved SPOUT_NEAR of the way towards its inner wall on the robot's side (the robot's
+    base stands at the origin): the content still falls inside, and the arm reaches a few centimetres less
+    far."""
     middle = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
     lo, hi = g.target_box
     inner = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - WALL
