@@ -124,6 +124,9 @@ class Lexicon:
     # frames say (no role a request leaves open), one with fewer for having too few of them
     min_frames: int = 0
 
+    # the two reasons of `refusal`, for a count of refused verbs
+    REFUSED_BECAUSE = "too few frames, or no place or tool said"
+
     def refusal(self, name: str) -> str:
         """Why the refused verb `name` was not learned, in words for a one-line message: too few frames, or
         frames that seldom say where it puts things or with what (the roles a request leaves open)."""

@@ -167,9 +167,7 @@ def predicates(
         _show_predicate(verb, rows, lex)
         return
     print_rows(f"predicates learned from {ws.db} (top {top} of {len(rows):,})", rows[:top])
-    console.print(
-        f"{len(rows):,} learned, {len(lex.refused):,} verbs refused (too few frames, or no place or tool said)"
-    )
+    console.print(f"{len(rows):,} learned, {len(lex.refused):,} verbs refused ({lex.REFUSED_BECAUSE})")
 
 
 def _show_predicate(verb: str, rows: list[dict], lex) -> None:

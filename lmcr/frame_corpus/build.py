@@ -44,7 +44,7 @@ from lmcr.frame_corpus.shards import (
     parser_setup,
     unparsed_count,
 )
-from lmcr.lexicon import load_lexicon
+from lmcr.lexicon import Lexicon, load_lexicon
 from lmcr.srl.compounds import Compounds, learn_compounds
 from lmcr.srl.parser import COMPOUNDS_FILE, FIRST_WORDS_FILE, PRIORS_FILE, read_first_words
 
@@ -212,5 +212,5 @@ def _learn(con: duckdb.DuckDBPyConnection, srl_dir: Path, build: str | None, log
     """Learn the predicates of the build when it has no table yet (`frame_corpus.predicates`)."""
     table = refresh_predicates(con, load_lexicon(learned=False), srl_dir, build)
     if table is not None:
-        refused = f"{len(table.refused):,} verbs refused (too few frames, or no place or tool said)"
+        refused = f"{len(table.refused):,} verbs refused ({Lexicon.REFUSED_BECAUSE})"
         log(f"learned {len(table.predicates):,} predicates; {refused}")

@@ -912,9 +912,9 @@ def _spouts(g: Geometry) -> list[np.ndarray]:
     far."""
     middle = [g.target_top + [0, 0, h] for h in TIP_HEIGHTS]
     lo, hi = g.target_box
-    inner = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - WALL
-    towards = -g.target_top[:2] / max(float(np.linalg.norm(g.target_top[:2])), 1e-9)
-    near = np.array([*(towards * SPOUT_NEAR * max(inner, 0.0)), 0.0])
+    inner = min(hi[0] - lo[0], hi[1] - lo[1]) / 2 - WALL  # a target served into has walls (`serves`)
+    towards = -g.target_top[:2] / np.linalg.norm(g.target_top[:2])  # it stands on the table, off the origin
+    near = np.array([*(towards * SPOUT_NEAR * inner), 0.0])
     return middle + [m + near for m in middle]
 
 
