@@ -40,8 +40,12 @@ def superseding(path: Path) -> Path:
     if len(parts) == 1 or not path.parent.is_dir():
         return path
     same_but_hashes = re.compile("[0-9a-f]{12}".join(map(re.escape, parts)) + r"(?![0-9a-f]).*", re.DOTALL)
-    for other in path.parent.iterdir():
-        if same_but_hashes.fullmatch(other.name) and not other.name.startswith(stem) and other.is_file():
+    try:
+        names = [other for other in path.parent.iterdir() if same_but_hashes.fullmatch(other.name)]
+    except OSError:  # a folder that cannot be listed: what it holds only takes room
+        return path
+    for other in names:
+        if not other.name.startswith(stem) and other.is_file():
             try:
                 other.unlink()
             except OSError:
