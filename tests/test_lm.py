@@ -13,6 +13,7 @@ import torch
 from torch.nn import functional as F
 
 from lmcr.lm import checkpoint as ckpt
+from lmcr.lm import score as score_module
 from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
@@ -377,14 +378,59 @@ def test_setting_reads_both_spellings():
 
 def test_decoder_blocks_give_the_scores_of_one_pass(overfit, tmp_path, monkeypatch):
     """An evaluation's many rows go through the decoder a block at a time; a completion's few in one."""
-    from lmcr.lm import score as score_module
-
     model, vocab, _ = overfit
     scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})))
     texts = ["pour water into the cup", "pour water into the glass", "fill the pot with water", "pour milk"]
     whole = scorer.score(texts)
     monkeypatch.setattr(score_module, "DECODER_BLOCK", 3)
     assert scorer.score(texts) == pytest.approx(whole, abs=1e-6)
+
+
+HALF = score_module._half_weights(torch.zeros(1, 1)) is not None
+needs_half = pytest.mark.skipif(not HALF, reason="this torch build has no fbgemm fp16 product")
+
+
+@needs_half
+def test_fp16_weights_products_and_lstm_steps_are_within_rounding_of_fp32():
+    """fbgemm's product with fp16 weights (fp32 sums) is F.linear to fp16 rounding, and the step-at-a-time
+    LSTM with them reads a whole sequence from zeros as `nn.LSTM` does."""
+    from lmcr.lm.score import _half_weights, _OneStep
+
+    torch.manual_seed(0)
+    weight, bias, rows = torch.randn(40, 16), torch.randn(40), torch.randn(5, 16)
+    assert torch.allclose(_half_weights(weight, bias)(rows), F.linear(rows, weight, bias), atol=0.01)
+    assert torch.allclose(_half_weights(weight)(rows), F.linear(rows, weight), atol=0.01)
+    rnn = torch.nn.LSTM(16, 16, 2, batch_first=True)
+    x = torch.randn(3, 4, 16)
+    with torch.no_grad():
+        out, (h1, c1) = rnn(x)
+        for step, tol in ((_OneStep(rnn), 1e-5), (_OneStep(rnn, half=True), 0.01)):
+            mine, (h2, c2) = step(x)
+            for a, b in ((out, mine), (h1, h2), (c1, c2)):
+                assert torch.allclose(a, b, atol=tol)
+
+
+@pytest.mark.skipif(not NO_BF16 or not HALF, reason="auto is bf16 on this CPU, or no fbgemm")
+def test_auto_precision_without_bf16_reads_fp16_weights_and_scores_as_fp32_does(overfit, tmp_path, monkeypatch):
+    """Where the CPU has no bf16, "auto" holds the decoder's and the LSTM's weights in fp16 (fbgemm's
+    kernels): a frame's score moves by rounding only, with and without a context; "fp32" stays exact, and
+    a build without the kernels scores in fp32."""
+    model, vocab, _ = overfit
+    loaded = ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {}))
+    exact, half = LMScorer(loaded, precision="fp32"), LMScorer(loaded)
+    assert half.half and not exact.half and half.precision == exact.precision == "fp32"
+    frames = [("pour", {"Theme": "water", "Destination": o}) for o in ("cup", "scissors", "glass")]
+    texts = ["pour water into the cup", "pour milk into the glass", "fry egg"]
+    assert half.score(texts) == pytest.approx(exact.score(texts), abs=0.01)
+    assert half.score(texts) != exact.score(texts)  # it did read fp16 weights
+    assert half.score_frames(frames, "for my tea") == pytest.approx(exact.score_frames(frames, "for my tea"), abs=0.02)
+
+    def missing(*args):
+        raise RuntimeError("no fbgemm")
+
+    monkeypatch.setattr(torch.ops.quantized, "linear_prepack_fp16", missing)
+    fallback = LMScorer(loaded)
+    assert not fallback.half and fallback.score(texts) == pytest.approx(exact.score(texts), abs=1e-5)
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, pytest.param(torch.bfloat16, marks=needs_bf16)])

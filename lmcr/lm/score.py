@@ -21,7 +21,12 @@ reading weights (the decoder's 14k x 256, each LSTM layer's 2 x 1024 x 256), and
 kernels are oneDNN's; the decoder and the trie walk's one-step LSTM calls use weights laid out for it
 once (`_prepacked`, `_OneStep`), where `F.linear` and `nn.LSTM` would lay them out at every call.
 Log-probabilities move by a few hundredths of a nat per text (README: what that does to Table I and
-the dev instructions).
+the dev instructions). Where the CPU has no bf16 (AVX2 only), "auto" holds the decoder's and the
+LSTM's weights in fp16 instead, through fbgemm's kernel for them (fp32 sums), and the LSTM reads the
+shared prefix a step at a time with them too (`_OneStep`): completion among 40 objects went from 20.5
+to 17.6 ms p50, 30.4 to 22.9 ms with a purpose clause (interleaved runs, 2 cores), and on the full
+store no score moved by more than 0.0035 nats (Table I, the dev instructions and every external
+request's best guess unchanged). "fp32" keeps every product in fp32.
 """
 
 from __future__ import annotations
@@ -80,32 +85,59 @@ def _prepacked(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Callab
     return lambda x: torch.ops.mkldnn._linear_pointwise(x, packed, bias, "none", [], "")
 
 
-class _OneStep:
-    """One time step of an LSTM, each layer's four gates one product of [input, h] with the weights laid
-    out once (`_prepacked`); the gates and the cell in fp32. The trie walk's calls below the shared
-    prefix are one step for a few rows, where oneDNN's LSTM, laying out its weights at every call, takes
-    0.3 ms and this 0.14 ms (bf16, 3 rows, 2 layers of 256)."""
+Product = Callable[[torch.Tensor], torch.Tensor]
 
-    def __init__(self, rnn: torch.nn.LSTM):
-        self.dtype = rnn.weight_ih_l0.dtype
+
+def _half_weights(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Product | None:
+    """x -> x @ weight.T + bias with the weight held in fp16 and the products summed in fp32 (fbgemm's
+    kernel, which AVX2 runs converting fp16 as it loads it), or None where this build lacks it. Where
+    the CPU has no bf16, a completion's products are bound by reading the weights (the decoder's
+    14k x 256; bench/bench_complete.py), and fp16 halves that; see `LMScorer` for what it changes."""
+    try:
+        packed = torch.ops.quantized.linear_prepack_fp16(
+            weight.detach().float(), None if bias is None else bias.detach().float()
+        )
+    except (AttributeError, NotImplementedError, RuntimeError):  # a build without fbgemm
+        return None
+    return lambda x: torch.ops.quantized.linear_dynamic_fp16(x.float(), packed)
+
+
+class _OneStep:
+    """An LSTM a time step at a time, each layer's four gates one product of [input, h] with the weights
+    laid out once (`_prepacked`, or `_half_weights` where `half`); the gates and the cell in fp32. The
+    trie walk's calls below the shared prefix are one step for a few rows, where oneDNN's LSTM, laying
+    out its weights at every call, takes 0.3 ms and this 0.14 ms (bf16, 3 rows, 2 layers of 256). With
+    fp16 weights it also reads the shared prefix, a step at a time."""
+
+    def __init__(self, rnn: torch.nn.LSTM, half: bool = False):
+        self.dtype = torch.float32 if half else rnn.weight_ih_l0.dtype
+        self.hidden = (rnn.num_layers, rnn.hidden_size)
+        product = _half_weights if half else _prepacked
         self.layers = [
-            _prepacked(
+            product(
                 torch.cat([getattr(rnn, f"weight_ih_l{k}"), getattr(rnn, f"weight_hh_l{k}")], 1).detach(),
                 (getattr(rnn, f"bias_ih_l{k}") + getattr(rnn, f"bias_hh_l{k}")).detach().float(),
             )
             for k in range(rnn.num_layers)
         ]
 
-    def __call__(self, x: torch.Tensor, state: tuple[torch.Tensor, torch.Tensor]):
-        """x (B, 1, E) and state ((layers, B, H) twice), fp32, as `nn.LSTM` takes and gives them."""
-        inp, hs, cs = x[:, 0], [], []
-        for k, gates in enumerate(self.layers):
-            i, f, g, o = gates(torch.cat([inp, state[0][k]], 1).to(self.dtype)).float().chunk(4, 1)
-            c = torch.sigmoid(f) * state[1][k] + torch.sigmoid(i) * torch.tanh(g)
-            inp = torch.sigmoid(o) * torch.tanh(c)
-            hs.append(inp)
-            cs.append(c)
-        return inp.unsqueeze(1), (torch.stack(hs), torch.stack(cs))
+    def __call__(self, x: torch.Tensor, state: tuple[torch.Tensor, torch.Tensor] | None = None):
+        """x (B, T, E) and state ((layers, B, H) twice, None: zeros), fp32, as `nn.LSTM` takes and gives them."""
+        if state is None:
+            zeros = torch.zeros(self.hidden[0], x.shape[0], self.hidden[1])
+            state = (zeros, zeros)
+        outputs = []
+        for t in range(x.shape[1]):
+            inp, hs, cs = x[:, t], [], []
+            for k, gates in enumerate(self.layers):
+                i, f, g, o = gates(torch.cat([inp, state[0][k]], 1).to(self.dtype)).float().chunk(4, 1)
+                c = torch.sigmoid(f) * state[1][k] + torch.sigmoid(i) * torch.tanh(g)
+                inp = torch.sigmoid(o) * torch.tanh(c)
+                hs.append(inp)
+                cs.append(c)
+            outputs.append(inp)
+            state = (torch.stack(hs), torch.stack(cs))
+        return torch.stack(outputs, 1), state
 
 
 @dataclass
@@ -150,17 +182,20 @@ class LMScorer:
         self.precision = pick_precision(precision, decoder.weight.device)
         dtype = torch.bfloat16 if self.precision == "bf16" else decoder.weight.dtype
         self._decoder = (decoder.weight.detach().to(dtype), decoder.bias.detach())
-        self._decode = _prepacked(self._decoder[0])
+        # "auto" without bf16: fp16 weights where this build has fbgemm's kernel for them
+        self.half = precision == "auto" and self.precision == "fp32" and _half_weights(torch.zeros(1, 1)) is not None
+        self._decode = _half_weights(self._decoder[0]) if self.half else _prepacked(self._decoder[0])
         # The LSTM in the same precision, a copy: the model's own weights stay fp32 for training code.
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
-        self._step = _OneStep(self._rnn)
+        self._step = _OneStep(self._rnn, self.half)
         self._unk = self.vocab.words.index(UNK)
 
     def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
         """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. One step
-        from a state (the trie walk below the shared prefix) is `_OneStep`; longer runs are oneDNN's in
-        bf16, and in fp32 PyTorch's own kernel for `few_rows` (`_native_rnn`)."""
-        if x.shape[1] == 1 and state is not None:
+        from a state (the trie walk below the shared prefix), and every run with fp16 weights, is
+        `_OneStep`; longer runs are oneDNN's in bf16, and in fp32 PyTorch's own kernel for `few_rows`
+        (`_native_rnn`)."""
+        if self.half or (x.shape[1] == 1 and state is not None):
             return self._step(x, state)
         if self._rnn is self.model.rnn:
             return _native_rnn(self._rnn, x, state) if few_rows else self._rnn(x, state)
