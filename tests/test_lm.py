@@ -12,12 +12,13 @@ import pytest
 import torch
 from torch.nn import functional as F
 
+from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm import score as score_module
 from lmcr.lm.data import bucket_batches, split_by_document
 from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
 from lmcr.lm.model import LMConfig, RecurrentLM
-from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer
+from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer, MixedLM
 from lmcr.lm.train import (
     FINAL_LR_FRACTION,
     PrecisionError,
@@ -315,6 +316,10 @@ def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monke
     assert lm_checkpoints.lm_experts(mixed) == [("all", pytest.approx(1 - share)), ("household", pytest.approx(share))]
     assert scorer_fingerprint("sentence_lm", mixed).endswith("@household=9")
     assert "@" not in scorer_fingerprint("sentence_lm", plain)
+    house = LMScorer(ckpt.load(tmp_path / "sentence-household"))
+    house.lex = load_lexicon(learned=False)  # reads frames with another lexicon than the first expert's
+    with pytest.raises(ValueError, match="same text"):
+        MixedLM([(1.0, LMScorer(ckpt.load(tmp_path / "sentence-household"))), (1.0, house)])
 
 
 @pytest.mark.parametrize(

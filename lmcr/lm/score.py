@@ -43,7 +43,7 @@ from lmcr.lexicon import Lexicon
 from lmcr.lm.checkpoint import Checkpoint
 from lmcr.lm.linearize import linearize, tokens
 from lmcr.lm.train import pick_precision
-from lmcr.lm.vocab import UNK
+from lmcr.lm.vocab import BOS, UNK
 
 NORMS = ("sum", "mean")
 # Frames whose score reads the instruction's context (`LMScorer.score_frames`): the best by the frame
@@ -189,6 +189,9 @@ class LMScorer:
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
         self._step = _OneStep(self._rnn, self.half)
         self._unk = self.vocab.words.index(UNK)
+        self._start: tuple[int, tuple] | None = None  # (<s>, the LSTM's output and state after it)
+        with torch.no_grad():
+            self._prefix([self.vocab.words.index(BOS)])
 
     def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
         """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. One step
@@ -202,6 +205,17 @@ class LMScorer:
         low = self._decoder[0].dtype
         out, (h, c) = self._rnn(x.to(low), None if state is None else (state[0].to(low), state[1].to(low)))
         return out.float(), (h.float(), c.float())
+
+    def _prefix(self, ids: list[int]) -> tuple[torch.Tensor, tuple[torch.Tensor, torch.Tensor]]:
+        """The LSTM over a shared prefix, from the state after <s> (every text's first token, read once
+        when the checkpoint is loaded: the same for every text, so no request pays for it)."""
+        if self._start is None or ids[0] != self._start[0]:
+            self._start = (ids[0], self._lstm(self.model.embed(torch.tensor([ids[:1]])), few_rows=True))
+        first, state = self._start[1]
+        if len(ids) == 1:
+            return first, state
+        out, state = self._lstm(self.model.embed(torch.tensor([ids[1:]])), state, few_rows=True)
+        return torch.cat([first, out], 1), state
 
     def encode(self, text: str) -> list[int]:
         ids = self.vocab.encode(tokens(text, self.checkpoint.articles))
@@ -234,7 +248,7 @@ class LMScorer:
         ctx = self.context_ids(context)
         if not frames or not ctx:
             return self.score(self.frame_texts(frames), norm)  # in chunks: an evaluation's frames come at once
-        walk = self.read_frames(frames)
+        walk = self.read_texts(self.frame_texts(frames))
         lengths = [len(seq) - 1 for seq in walk.seqs]
         scores = [_normed(total, n, norm) for total, n in zip(walk.totals, lengths)]
 
@@ -251,13 +265,17 @@ class LMScorer:
         """The context's token ids as this model reads them after a frame (no <s>, no </s>)."""
         return self.vocab.encode(tokens(context, self.checkpoint.articles))[1:-1] if context else []
 
-    def read_frames(self, frames: list[tuple[str, dict[str, str]]]) -> _Walk:
-        """One walk over the frames' texts (`walk.totals`: each one's total log-probability) that keeps
-        the LSTM states a context is read on from (`context_logprobs`)."""
-        return self._walk([self.encode(t) for t in self.frame_texts(frames)], keep_states=True)
+    def reads_like(self, other: LMScorer) -> bool:
+        """Whether this model reads a frame as the same text as `other` does (`frame_texts`)."""
+        return self.checkpoint.linearization == other.checkpoint.linearization and self.lex is other.lex
+
+    def read_texts(self, texts: list[str]) -> _Walk:
+        """One walk over frames' texts (`walk.totals`: each one's total log-probability) that keeps the
+        LSTM states a context is read on from (`context_logprobs`)."""
+        return self._walk([self.encode(t) for t in texts], keep_states=True)
 
     def context_logprobs(self, walk: _Walk, which: list[int], ctx: list[int]) -> list[float]:
-        """log P(context | frame) for the frames `which` of a `read_frames` walk."""
+        """log P(context | frame) for the frames `which` of a `read_texts` walk."""
         return self._continue(walk, [walk.trie.leaf_of[i] for i in which], ctx)  # oneDNN: one call, many rows
 
     @torch.no_grad()
@@ -304,7 +322,7 @@ class LMScorer:
         shortest = min(len(s) for s in seqs)
         shared = next((i for i in range(1, shortest) if any(s[i] != seqs[0][i] for s in seqs)), shortest)
         shared = max(1, min(shared, shortest - 1))
-        out, state = self._lstm(model.embed(torch.tensor([seqs[0][:shared]])), few_rows=True)  # (1, L, E)
+        out, state = self._prefix(seqs[0][:shared])  # (1, L, H)
         rows, row_of = [out[0]], {n: n for n in range(shared)}
         walk = _Walk(trie, seqs, [], {}, [])
         if keep_states:
@@ -392,14 +410,17 @@ class MixedLM:
     def __init__(self, experts: list[tuple[float, LMScorer]]):
         if not experts or any(w <= 0 for w, _ in experts):  # a bug: lm_experts keeps positive weights only
             raise ValueError("a mixture needs LMs with positive weights")
+        if any(not lm.reads_like(experts[0][1]) for _, lm in experts):  # a bug: _lm_scorer gives them one lexicon
+            raise ValueError("a mixture's LMs must read a frame as the same text")
         self.experts = [(math.log(w), lm) for w, lm in experts]
 
     def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "") -> list[float]:
         """log sum_i w_i P_i(frame), plus log P_1(context | frame) with a context."""
         (_, first), *rest = self.experts
         ctx = first.context_ids(context)
-        walk = first.read_frames(frames) if ctx and frames else None
-        columns = [walk.totals if walk else first.score_frames(frames), *(lm.score_frames(frames) for _, lm in rest)]
+        texts = first.frame_texts(frames)  # once: the experts read frames alike
+        walk = first.read_texts(texts) if ctx and frames else None
+        columns = [walk.totals if walk else first.score(texts), *(lm.score(texts) for _, lm in rest)]
         mixed = [logsumexp([w + s for (w, _), s in zip(self.experts, values)]) for values in zip(*columns)]
         if walk is None:
             return mixed
