@@ -433,9 +433,10 @@ def test_auto_precision_without_bf16_reads_fp16_weights_and_scores_as_fp32_does(
     def missing(*args):
         raise RuntimeError("no fbgemm")
 
-    monkeypatch.setattr(torch.ops.quantized, "linear_prepack_fp16", missing)
-    fallback = LMScorer(loaded)
-    assert not fallback.half and fallback.score(texts) == pytest.approx(exact.score(texts), abs=1e-5)
+    for op in ("linear_dynamic_fp16", "linear_prepack_fp16"):  # a CPU it cannot run on; a build without it
+        monkeypatch.setattr(torch.ops.quantized, op, missing)
+        fallback = LMScorer(loaded)
+        assert not fallback.half and fallback.score(texts) == pytest.approx(exact.score(texts), abs=1e-5)
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, pytest.param(torch.bfloat16, marks=needs_bf16)])

@@ -97,9 +97,14 @@ def _half_weights(weight: torch.Tensor, bias: torch.Tensor | None = None) -> Pro
         packed = torch.ops.quantized.linear_prepack_fp16(
             weight.detach().float(), None if bias is None else bias.detach().float()
         )
-    except (AttributeError, NotImplementedError, RuntimeError):  # a build without fbgemm
+
+        def product(x: torch.Tensor) -> torch.Tensor:
+            return torch.ops.quantized.linear_dynamic_fp16(x.float(), packed)
+
+        product(torch.zeros(1, weight.shape[1]))  # a CPU fbgemm cannot run on fails here, not in a completion
+    except (AttributeError, NotImplementedError, RuntimeError):  # a build or a CPU without fbgemm
         return None
-    return lambda x: torch.ops.quantized.linear_dynamic_fp16(x.float(), packed)
+    return product
 
 
 class _OneStep:
