@@ -194,9 +194,8 @@ class LMScorer:
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
         self._step = _OneStep(self._rnn, self.half)
         self._unk = self.vocab.words.index(UNK)
-        self._start: tuple[int, tuple] | None = None  # (<s>, the LSTM's output and state after it)
-        with torch.no_grad():
-            self._prefix([self.vocab.words.index(BOS)])
+        with torch.no_grad():  # the LSTM's output and state after <s>, where every text starts (`_prefix`)
+            self._start = self._lstm(self.model.embed(torch.tensor([[self.vocab.words.index(BOS)]])), few_rows=True)
 
     def _lstm(self, x: torch.Tensor, state=None, few_rows: bool = False):
         """The LSTM on `x` (B, T, E) from `state`, in the scorer's precision; fp32 in and out. One step
@@ -212,11 +211,9 @@ class LMScorer:
         return out.float(), (h.float(), c.float())
 
     def _prefix(self, ids: list[int]) -> tuple[torch.Tensor, tuple[torch.Tensor, torch.Tensor]]:
-        """The LSTM over a shared prefix, from the state after <s> (every text's first token, read once
-        when the checkpoint is loaded: the same for every text, so no request pays for it)."""
-        if self._start is None or ids[0] != self._start[0]:
-            self._start = (ids[0], self._lstm(self.model.embed(torch.tensor([ids[:1]])), few_rows=True))
-        first, state = self._start[1]
+        """The LSTM over a shared prefix (`ids`, <s> first as `encode` gives it), from the state after <s>
+        that `__init__` read: the same for every text, so no request pays for it."""
+        first, state = self._start
         if len(ids) == 1:
             return first, state
         out, state = self._lstm(self.model.embed(torch.tensor([ids[1:]])), state, few_rows=True)
