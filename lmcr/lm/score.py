@@ -187,9 +187,10 @@ class LMScorer:
         self.precision = pick_precision(precision, decoder.weight.device)
         dtype = torch.bfloat16 if self.precision == "bf16" else decoder.weight.dtype
         self._decoder = (decoder.weight.detach().to(dtype), decoder.bias.detach())
-        # "auto" without bf16: fp16 weights where this build has fbgemm's kernel for them
-        self.half = precision == "auto" and self.precision == "fp32" and _half_weights(torch.zeros(1, 1)) is not None
-        self._decode = _half_weights(self._decoder[0]) if self.half else _prepacked(self._decoder[0])
+        # "auto" without bf16: fp16 weights (the decoder's, then the LSTM's) where fbgemm's kernel runs here
+        half = _half_weights(self._decoder[0]) if precision == "auto" and self.precision == "fp32" else None
+        self.half = half is not None
+        self._decode = half or _prepacked(self._decoder[0])
         # The LSTM in the same precision, a copy: the model's own weights stay fp32 for training code.
         self._rnn = copy.deepcopy(self.model.rnn).to(dtype) if dtype != decoder.weight.dtype else self.model.rnn
         self._step = _OneStep(self._rnn, self.half)
