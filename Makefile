@@ -47,7 +47,7 @@ bench: setup
 	$(BIN)/python bench/bench_srl.py
 
 clean:
-	rm -rf $(VENV) data/staging data/lmcr.duckdb annotation/browser/node_modules
+	rm -rf $(VENV) data/staging data/lmcr.duckdb data/lmcr.duckdb.wal annotation/browser/node_modules
 
 # Spoken dev instructions (espeak-ng voices x rates, clean / 20 dB noise / telephone) and the recogniser
 # bench on them: `make speech-audio SHARED=/path/to/shared` (or $$LMCR_SHARED_DIR); LMCR_DATA_DIR names a

@@ -22,7 +22,6 @@ import math
 import time
 from pathlib import Path
 
-import duckdb
 import torch
 from record import add_json_option, write_results
 from scipy.stats import spearmanr
@@ -37,6 +36,7 @@ from lmcr.lm.score import LMScorer
 from lmcr.lm.train import TrainConfig, train_lm
 from lmcr.lm.vocab import Vocab
 from lmcr.setting import Setting
+from lmcr.store import read_connection
 from lmcr.workspace import Workspace
 
 OBJECTS = load_lexicon().objects
@@ -133,7 +133,7 @@ def normalisation_check(path: Path, ratings_csv: Path) -> dict:
 def training_speed(db: Path | None, tokens: int, max_epochs: int) -> dict:
     """The reference trainer for one epoch, ours until it reaches the reference's perplexity."""
     paths = Workspace.from_env(db=db)
-    con = duckdb.connect(str(paths.db), read_only=True)
+    con = read_connection(paths.db)
     text = training_text(con, Setting("sentence", "recipes"))
     train, budget = [], tokens
     for seq in text.train:

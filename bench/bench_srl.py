@@ -22,6 +22,7 @@ from lmcr.jsonl import read_jsonl
 from lmcr.srl.evaluate import instruction_correct, score_frames
 from lmcr.srl.instruction import NoPredicateError, parse_instruction
 from lmcr.srl.parser import load_parser
+from lmcr.store import read_connection
 from lmcr.workspace import Workspace
 
 
@@ -96,7 +97,7 @@ def main() -> None:
         scores = dev_scores(srl, args.shared / "eval")
         print(f"dev, repair={'on ' if repair else 'off'}: " + " ".join(f"{k}={v}" for k, v in scores.items()))
         figures |= {f"dev set, imperative repair {'on' if repair else 'off'}: {k}": v for k, v in scores.items()}
-    con = duckdb.connect(str(paths.db), read_only=True)
+    con = read_connection(paths.db)
     found = first_predicates(con, resources)
     print(
         "corpus sentences starting with a robot predicate, the predicate found: "

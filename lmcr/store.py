@@ -26,6 +26,9 @@ QUERY_CONFIG = {
     "autoload_known_extensions": False,
     "autoinstall_known_extensions": False,
 }
+# What every open of the store runs under: no extension is ever downloaded. Replaying a WAL that holds
+# migration 010's macros, DuckDB 2.0 tries to install ICU although it is built in, and offline that fails.
+STORE_CONFIG = {"autoinstall_known_extensions": False}
 
 
 class MigrationError(LMCRError, RuntimeError):
@@ -47,7 +50,7 @@ class QueryError(LMCRError, ValueError):
 def _open(db: str | Path, read_only: bool, config: dict | None = None) -> duckdb.DuckDBPyConnection:
     """duckdb.connect, with a held lock as StoreBusyError and an unreadable file as MigrationError."""
     try:
-        return duckdb.connect(str(db), read_only=read_only, config=config or {})
+        return duckdb.connect(str(db), read_only=read_only, config={**STORE_CONFIG, **(config or {})})
     except duckdb.ConnectionException:  # open in this process in the other mode: `read_connection` decides
         raise
     except duckdb.Error as exc:  # a held lock; not a DuckDB file, a newer storage version, ...
@@ -106,14 +109,23 @@ class Migration:
 
 
 def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.DuckDBPyConnection:
-    """Open the store (creating its folder) and bring its schema up to date unless read-only."""
+    """Open the store (creating its folder) and bring its schema up to date unless read-only.
+
+    A writer's commits stay in DuckDB's write-ahead log (`<db>.wal`) when it closes, instead of being
+    checkpointed into the file: a checkpoint rewrites the file's metadata blocks in place, and a process
+    killed (SIGKILL, the OOM killer) during that write leaves a block whose checksum fails, so the store no
+    longer opens. A WAL cut short by a kill loses only its uncommitted tail when it is replayed. DuckDB
+    still checkpoints by itself, when the log passes `checkpoint_threshold` or a commit is large, and
+    schema changes are checkpointed at once, so that any DuckDB client can replay what the log holds."""
     if str(db) != ":memory:":
         check_output_file(Path(db))  # a data folder that is a file: one line naming it, not mkdir's errno
         Path(db).parent.mkdir(parents=True, exist_ok=True)
     con = _open(db, read_only)
     con.execute("set enable_progress_bar = false")  # library calls report progress their own way
     if not read_only:
-        migrate(con, sql_dir)
+        con.execute("pragma disable_checkpoint_on_shutdown")
+        if migrate(con, sql_dir):
+            con.execute("checkpoint")
     return con
 
 
