@@ -212,6 +212,26 @@ POUR = {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
             "I can't reach far enough to pour the water into the cup.",
         ),
         (
+            {
+                "frame": POUR,
+                "feasible": False,
+                "out_of_reach": True,
+                "unreachable": "the water",
+                "chosen_object": "cup",
+            },
+            "I can't reach the water.",
+        ),
+        (
+            {
+                "frame": POUR,
+                "feasible": False,
+                "out_of_reach": True,
+                "unreachable": "the cup#2",
+                "chosen_object": "cup",
+            },
+            "I can't reach the second cup.",
+        ),
+        (
             {"frame": POUR, "feasible": False, "blocker": "the pot#2", "reason": "..."},
             "I can't pour the water into the cup: the second pot is in the way.",
         ),

@@ -352,6 +352,7 @@ def test_an_infeasible_choice_is_asked_about_and_nothing_moves(sim, tmp_path):
     assert out["chosen_object"] == "cup" and "cannot reach" in out["reason"]
     assert out["question"] == "I can't reach the cup: should I pour the water into the glass instead?"
     assert out["reply"] == out["question"] and out["out_of_reach"] and out["chosen_id"] == "cup"
+    assert out["unreachable"] == "the cup"
     assert out["suggestion"] == {"Destination": "glass"} and out["suggestion_ids"] == {"Destination": "glass"}
     ranked = [(r["object"], r["feasible"]) for r in out["ranking"]]
     assert ranked[0] == ("glass", True) and ("cup", False) in ranked
@@ -1036,6 +1037,29 @@ def test_a_dip_whose_straight_way_down_is_out_of_reach_is_refused_saying_so(sim,
     monkeypatch.setattr(planning, "_straight_line", lambda *args: None)
     refused = planner.plan(PROGRAMS["dip"], strawberry, batter, holding=False)
     assert isinstance(refused, Infeasible) and "cannot go straight down to 'dip'" in refused.reason, refused
+
+
+@pytest.mark.parametrize(
+    ("verb", "held", "target", "unreachable"),
+    [
+        ("stir", ("spoon", (0.0, -0.1)), ("soup", (0.9, 0.0)), "the soup"),
+        ("pour", ("water", (0.9, 0.0)), ("cup", (0.0, -0.1)), "the water"),
+    ],
+)
+def test_a_refusal_for_want_of_reach_names_what_is_out_of_reach(sim, tmp_path, verb, held, target, unreachable):
+    """The pose out of reach is at the held object while it is picked up, at the target after that:
+    stirring a soup too far away is the soup's distance, not the spoon's (the robot said "I can't reach
+    the spoon"), and a bottle too far away is the bottle's."""
+    from lmcr.robot.plan import Infeasible, Planner
+    from lmcr.robot.scene import Scene, SceneObject
+    from lmcr.robot.tasks import TASKS, TOOL_MOTIONS
+
+    scene = Scene([SceneObject(*held), SceneObject(*target)])
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table)
+    task = {**TASKS, **TOOL_MOTIONS}[verb]
+    refused = planner.plan(task, scene.find(held[0]), scene.find(target[0]), holding=False)
+    assert isinstance(refused, Infeasible) and refused.out_of_reach, refused
+    assert refused.unreachable == unreachable, refused
 
 
 def test_no_joint_angles_take_the_gripper_past_the_arms_reach(sim, tmp_path):

@@ -347,7 +347,12 @@ def _ranking(completion: Completion, tried: list) -> list[dict]:
 def _refusal(out: dict, result: Infeasible, tried: list, lexicon: Lexicon) -> dict:
     """Why nothing moved (`out` the result so far), and the question to ask when another candidate is
     feasible (`suggestion` its objects by label, `suggestion_ids` by id)."""
-    why = {"reason": result.reason, "out_of_reach": result.out_of_reach, "blocker": result.blocker or None}
+    why = {
+        "reason": result.reason,
+        "out_of_reach": result.out_of_reach,
+        "unreachable": result.unreachable or None,
+        "blocker": result.blocker or None,
+    }
     alternative = next(((c, objects) for _, c, objects, r in tried if isinstance(r, Plan)), None)
     if alternative is None:
         return why

@@ -92,6 +92,7 @@ class Infeasible:
     progress: int = 0  # steps planned before the one that failed (the best attempt's reason is reported)
     out_of_reach: bool = False  # it failed for want of an IK solution (not an obstacle in the way)
     blocker: str = ""  # else what was in the way, as a clash names it ("the pot")
+    unreachable: str = ""  # with out_of_reach: the object the pose out of reach is at, named so ("the soup")
 
 
 @dataclass
@@ -411,7 +412,7 @@ class Planner:
         for i, step in enumerate(steps):
             short = min((arm.beyond_reach(x) for x in step.positions), default=0.0)
             if short > IK_POSITION:
-                return Infeasible(_cannot_reach(arm, step, short), i, True)
+                return Infeasible(_cannot_reach(arm, step, short), i, True, unreachable=_at(steps, i, held, target))
         q, segments, released = start, [], False
         searched: list[tuple[int, Callable]] = []  # segments a search found, each with its clearance check
         standing = _save(held)
@@ -483,7 +484,7 @@ class Planner:
                 found = (path, path[-1], position, not straight)
                 break
             if found is None:
-                return Infeasible(why, i, reach, blocker)
+                return Infeasible(why, i, reach, blocker, _at(steps, i, held, target) if reach else "")
             if found[3]:
                 searched.append((len(segments), clash))
             segments.append(Segment(step, found[0], found[2]))
@@ -522,7 +523,7 @@ def _hemmed_in(
         for i, step in deciding:
             short, hit = _reached_clear(arm, clearance, step, carried, target)
             if short > IK_POSITION:
-                return Infeasible(_cannot_reach(arm, step, short), i, True)
+                return Infeasible(_cannot_reach(arm, step, short), i, True, unreachable=_at(steps, i, held, target))
             if hit:
                 return Infeasible(f"'{step.name}' would put the {arm.side} arm against {hit}", i, False, hit)
         return None
@@ -552,6 +553,12 @@ def _reached_clear(
 def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
     """Why a step is out of reach: the arm and how far short of it the gripper stays (metres)."""
     return f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)"
+
+
+def _at(steps: list[Step], i: int, held: SceneObject, target: SceneObject) -> str:
+    """The object step `i`'s pose is at, as a clash names it: the held one while it is picked up, the
+    target after that ("stand it up over soup" out of reach: the soup is, not the spoon)."""
+    return _named(held if i < pick_steps(steps) else target)
 
 
 def _simulated_grasp(

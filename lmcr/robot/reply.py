@@ -109,10 +109,10 @@ def spoken(ident: str) -> str:
 def say(outcome: Mapping, lexicon: Lexicon | None = None) -> str:
     """What the robot says about `outcome`, a mapping with (some of) the fields of `lmcr execute`'s and
     `lmcr robot`'s JSON: `frame` ({"predicate", "roles"} or a Frame), `feasible`, `success`, `checks`,
-    `reason`, `out_of_reach`, `blocker`, `chosen_object`, `suggestion`, `question`, `left`, and for an
-    error `error` with `error_kind` ("unknown_predicate", "incomplete" with the parsed `frame`, "absent"
-    with the `absent` label, "unfit" with what it was asked, `doing`, and why its tool cannot, `reason`;
-    see `error_outcome`)."""
+    `reason`, `out_of_reach`, `unreachable`, `blocker`, `chosen_object`, `suggestion`, `question`, `left`,
+    and for an error `error` with `error_kind` ("unknown_predicate", "incomplete" with the parsed `frame`,
+    "absent" with the `absent` label, "unfit" with what it was asked, `doing`, and why its tool cannot,
+    `reason`; see `error_outcome`)."""
     lexicon = lexicon or load_lexicon()
     if outcome.get("error"):
         return _error(outcome, lexicon)
@@ -178,9 +178,14 @@ def _cannot_do(predicate: str | None, lexicon: Lexicon) -> str:
 
 def _refusal(outcome: Mapping, frame, lexicon: Lexicon) -> str:
     """Why the robot did not move, and the other object it offers when one would do."""
-    chosen = outcome.get("chosen_object")
+    # what stands out of reach as the planner names it ("the soup"), else the object the completion chose
+    unreachable = (outcome.get("unreachable") or "").removeprefix("the ") or outcome.get("chosen_object")
     if outcome.get("out_of_reach"):
-        why = f"I can't reach the {chosen}" if chosen else f"I can't reach far enough to {phrase(frame, lexicon)}"
+        why = (
+            f"I can't reach {spoken(unreachable)}"
+            if unreachable
+            else f"I can't reach far enough to {phrase(frame, lexicon)}"
+        )
     elif outcome.get("blocker"):  # a clash's name: "the pot", "the cup#2"
         blocker = outcome["blocker"]
         why = f"I can't {phrase(frame, lexicon)}: {spoken(blocker.removeprefix('the '))} is in the way"
