@@ -64,16 +64,27 @@ def kill_once(db: Path, sql: Path, seconds: float, checkpoint_on_close: bool) ->
     return None
 
 
+def window(text: str) -> tuple[float, float]:
+    """`--window LOW,HIGH`: two numbers of seconds, 0 <= LOW <= HIGH."""
+    try:
+        low, high = (float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected LOW,HIGH in seconds, e.g. 0.3,1.5") from None
+    if not 0 <= low <= high:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected 0 <= LOW <= HIGH")
+    return low, high
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--kills", type=int, default=400)
-    parser.add_argument("--window", default="0.3,1.5", help="seconds after start to kill within: LOW,HIGH")
+    parser.add_argument("--window", type=window, default="0.3,1.5", help="seconds after start to kill within: LOW,HIGH")
     parser.add_argument("--busy", action="store_true", help="a process spinning on one core beside the writer")
     parser.add_argument("--checkpoint-on-close", action="store_true", help="the writer checkpoints when it closes")
     parser.add_argument("--seed", type=int, default=0)
     add_json_option(parser, "bench_store_kills")
     args = parser.parse_args()
-    low, high = (float(x) for x in args.window.split(","))
+    low, high = args.window
     rng, errors = random.Random(args.seed), collections.Counter()
     spinner = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if args.busy else None
     started = time.perf_counter()
