@@ -112,11 +112,12 @@ def connect(db: str | Path, sql_dir: Path, read_only: bool = False) -> duckdb.Du
     """Open the store (creating its folder) and bring its schema up to date unless read-only.
 
     A writer's commits stay in DuckDB's write-ahead log (`<db>.wal`) when it closes, instead of being
-    checkpointed into the file: a checkpoint rewrites the file's metadata blocks in place, and a process
-    killed (SIGKILL, the OOM killer) during that write leaves a block whose checksum fails, so the store no
-    longer opens. A WAL cut short by a kill loses only its uncommitted tail when it is replayed. DuckDB
-    still checkpoints by itself, when the log passes `checkpoint_threshold` or a commit is large, and
-    schema changes are checkpointed at once, so that any DuckDB client can replay what the log holds."""
+    checkpointed into the file as DuckDB does by default: a checkpoint rewrites the file's metadata blocks
+    in place, and a writer killed (SIGKILL, the OOM killer) while it checkpointed on close has left a store
+    whose first block failed its checksum, a store that no longer opens. A WAL cut short by a kill loses
+    only its uncommitted tail when it is replayed. DuckDB still checkpoints by itself, when the log passes
+    `checkpoint_threshold` or a commit is large, and schema changes are checkpointed at once, so that any
+    DuckDB client can replay what the log holds."""
     if str(db) != ":memory:":
         check_output_file(Path(db))  # a data folder that is a file: one line naming it, not mkdir's errno
         Path(db).parent.mkdir(parents=True, exist_ok=True)
