@@ -51,11 +51,13 @@ def kill_once(db: Path, sql: Path, seconds: float, checkpoint_on_close: bool) ->
     env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
     args = [sys.executable, "-c", WRITER, str(db), str(sql), "1" if checkpoint_on_close else "0"]
     child = subprocess.Popen(args, stdout=subprocess.PIPE, env=env)
-    child.stdout.readline()
-    time.sleep(seconds)
-    child.send_signal(signal.SIGKILL)
-    child.wait()
-    child.stdout.close()
+    try:
+        child.stdout.readline()
+        time.sleep(seconds)
+    finally:  # killed also when the benchmark is interrupted: the writer loops for ever
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+        child.stdout.close()
     try:
         with duckdb.connect(str(db)) as con:
             con.execute("select count(*) from quarantine").fetchone()

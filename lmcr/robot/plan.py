@@ -412,7 +412,7 @@ class Planner:
         for i, step in enumerate(steps):
             short = min((arm.beyond_reach(x) for x in step.positions), default=0.0)
             if short > IK_POSITION:
-                return Infeasible(_cannot_reach(arm, step, short), i, True, unreachable=_at(steps, i, held, target))
+                return _out_of_reach(arm, steps, i, short, held, target)
         q, segments, released = start, [], False
         searched: list[tuple[int, Callable]] = []  # segments a search found, each with its clearance check
         standing = _save(held)
@@ -523,7 +523,7 @@ def _hemmed_in(
         for i, step in deciding:
             short, hit = _reached_clear(arm, clearance, step, carried, target)
             if short > IK_POSITION:
-                return Infeasible(_cannot_reach(arm, step, short), i, True, unreachable=_at(steps, i, held, target))
+                return _out_of_reach(arm, steps, i, short, held, target)
             if hit:
                 return Infeasible(f"'{step.name}' would put the {arm.side} arm against {hit}", i, False, hit)
         return None
@@ -553,6 +553,13 @@ def _reached_clear(
 def _cannot_reach(arm: Arm, step: Step, short: float) -> str:
     """Why a step is out of reach: the arm and how far short of it the gripper stays (metres)."""
     return f"the {arm.side} arm cannot reach '{step.name}' ({short * 100:.0f} cm short)"
+
+
+def _out_of_reach(
+    arm: Arm, steps: list[Step], i: int, short: float, held: SceneObject, target: SceneObject
+) -> Infeasible:
+    """Step `i` lies `short` metres beyond the arm's reach: why, and the object the pose is at."""
+    return Infeasible(_cannot_reach(arm, steps[i], short), i, True, unreachable=_at(steps, i, held, target))
 
 
 def _at(steps: list[Step], i: int, held: SceneObject, target: SceneObject) -> str:
