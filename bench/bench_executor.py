@@ -13,8 +13,9 @@ oven), an incomplete
 instruction on `--placements` random layouts: the two objects the frame needs plus `--distractors` random
 other objects (obstacles, and other candidates for the completion; for the learned verbs drawn from the
 household's receptacles too), placed at random with a seed. The learned verbs need a frame build that
-learned them ($LMCR_DATA_DIR). With `--holding` the stated object starts in the robot's
-hand instead of on the table (for fill and season it is the target: the robot puts it down first).
+learned them ($LMCR_DATA_DIR); one the store did not learn, or learned as a class with no motion, is
+printed as not measured with the reason and left out of the totals. With `--holding` the stated object
+starts in the robot's hand instead of on the table (for fill and season it is the target: the robot puts it down first).
 The task's own object is given as the answer, so the run measures execution; how often the language
 model (the published checkpoint of $LMCR_DATA_DIR) would have chosen another object is counted beside it.
 Prints per predicate: executed successfully / executed, refused before moving (infeasible), then a
@@ -31,6 +32,7 @@ import os
 import random
 import statistics
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from record import add_json_option, write_results
@@ -41,6 +43,7 @@ from lmcr.robot.execute import execute
 from lmcr.robot.render import VIDEO_EVERY, Recorder
 from lmcr.robot.scene import make_scene, robot_objects
 from lmcr.scorers.registry import COMPLETION_METHOD
+from lmcr.srl.instruction import NoPredicateError
 from lmcr.workspace import Workspace
 
 # predicate -> (incomplete instruction, the object it needs that is stated, the one to be filled in, its role)
@@ -151,6 +154,53 @@ def random_scene(
     raise RuntimeError(f"{seed}: no layout fits")
 
 
+@dataclass
+class Tally:
+    """What the rows add up to: each instruction's time (and the slowest), failure and refusal reasons."""
+
+    times: list = field(default_factory=list)
+    slowest: list = field(default_factory=list)
+    reasons: collections.Counter = field(default_factory=collections.Counter)
+    refusals: collections.Counter = field(default_factory=collections.Counter)
+
+
+def measure_row(predicate: str, args, ws, scorer, config, nlp, pool: tuple, tally: Tally) -> collections.Counter:
+    """One predicate on `args.placements` random layouts: executed, succeeded, refused, replanned and how
+    often the LM would have chosen another object. Raises NoPredicateError when the store cannot carry
+    the predicate out at all (never learned, or no motion for its class)."""
+    instruction, stated, expected, role = TASKS[predicate]
+    row = collections.Counter()
+    for k in range(args.placements):
+        holding = stated if args.holding else None
+        scene = random_scene(
+            f"{args.seed}:{predicate}:{k}", stated, expected, pool, args.distractors, holding, ALSO.get(predicate, ())
+        )
+        started = time.perf_counter()
+        recorder = Recorder(scene, every=VIDEO_EVERY) if args.videos else None
+        out = execute(
+            instruction, scene, nlp, scorer, config, ws.robot, recorder, answer={role: expected}, urdf=ws.baxter_urdf
+        )
+        # the pictures of a video are no part of planning or acting: their time is left out
+        taking_pictures = recorder.seconds if recorder is not None else 0.0
+        tally.times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"] - taking_pictures)
+        tally.slowest.append((tally.times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
+        lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
+        row["other_choice"] += lm_choice != expected
+        if not out["feasible"]:
+            row["refused"] += 1
+            tally.refusals[refusal_reason(out)] += 1
+            continue
+        row["executed"] += 1
+        row["ok"] += out["success"]
+        row["replanned"] += out["replanned_after_grasp"]
+        if not out["success"]:
+            held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
+            tally.reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
+            if recorder is not None:
+                print(f"  video: {recorder.save_video(args.videos / f'{args.seed}-{predicate}-{k}.gif')}")
+    return row
+
+
 def main() -> None:
     parser_ = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser_.add_argument("--placements", type=int, default=20)
@@ -172,74 +222,40 @@ def main() -> None:
     ws = Workspace.from_env()
     scorer, config = ws.completion_scorer(args.method)
     nlp = ws.parser()
-    objects = load_lexicon().objects
-    household_too = sorted(robot_objects())
-    times, slowest, reasons, refusals = [], [], collections.Counter(), collections.Counter()
-    totals, per_predicate = collections.Counter(), {}
+    tally, totals, per_predicate = Tally(), collections.Counter(), {}
     for predicate in args.predicates.split(","):
-        instruction, stated, expected, role = TASKS[predicate]
-        row = collections.Counter()
-        for k in range(args.placements):
-            scene = random_scene(
-                f"{args.seed}:{predicate}:{k}",
-                stated,
-                expected,
-                household_too if predicate in LEARNED else objects,
-                args.distractors,
-                stated if args.holding else None,
-                ALSO.get(predicate, ()),
-            )
-            started = time.perf_counter()
-            recorder = Recorder(scene, every=VIDEO_EVERY) if args.videos else None
-            out = execute(
-                instruction,
-                scene,
-                nlp,
-                scorer,
-                config,
-                ws.robot,
-                recorder,
-                answer={role: expected},
-                urdf=ws.baxter_urdf,
-            )
-            # the pictures of a video are no part of planning or acting: their time is left out
-            taking_pictures = recorder.seconds if recorder is not None else 0.0
-            times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"] - taking_pictures)
-            slowest.append((times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
-            lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
-            row["other_choice"] += lm_choice != expected
-            if not out["feasible"]:
-                row["refused"] += 1
-                refusals[refusal_reason(out)] += 1
-                continue
-            row["executed"] += 1
-            row["ok"] += out["success"]
-            row["replanned"] += out["replanned_after_grasp"]
-            if not out["success"]:
-                held, target = (stated, expected) if predicate in HELD_IS_STATED else (expected, stated)
-                reasons[f"{predicate}: {failure_reason(out, held, target)}"] += 1
-                if recorder is not None:
-                    print(f"  video: {recorder.save_video(args.videos / f'{args.seed}-{predicate}-{k}.gif')}")
+        pool = tuple(sorted(robot_objects())) if predicate in LEARNED else load_lexicon().objects
+        try:
+            row = measure_row(predicate, args, ws, scorer, config, nlp, pool, tally)
+        except NoPredicateError as exc:
+            # the store never learned the verb, or has no motion for its class: the row is unmeasured on
+            # this store and said so, not a traceback that loses the rows already run
+            per_predicate[f"{predicate}: not measured"] = str(exc)
+            print(f"{predicate:17s} not measured on this store: {exc}", flush=True)
+            continue
         totals.update(row)
         per_predicate[f"{predicate}: succeeded"] = f"{row['ok']}/{args.placements}"
         print(
             f"{predicate:17s} succeeded {row['ok']}/{args.placements} (executed {row['executed']}, failed "
             f"{row['executed'] - row['ok']}, refused before moving {row['refused']}); the language model "
-            f"would have chosen another object than {expected!r} {row['other_choice']} times",
+            f"would have chosen another object than {TASKS[predicate][2]!r} {row['other_choice']} times",
             flush=True,
         )
     n = totals["executed"] + totals["refused"]
+    if not n:
+        raise SystemExit("bench_executor: no predicate could be measured on this store (each reason is above)")
     print(
         f"overall: succeeded {totals['ok']}/{n} = {totals['ok'] / n:.3f}; of executed plans "
         f"{totals['ok']}/{totals['executed']} = {totals['ok'] / max(totals['executed'], 1):.3f}; "
         f"refused {totals['refused']}; planned afresh after a grasp that shifted the object {totals['replanned']}"
     )
-    print("failures of executed plans:", dict(reasons.most_common()) or "none")
-    print("refusals:", dict(refusals.most_common()) or "none")
+    print("failures of executed plans:", dict(tally.reasons.most_common()) or "none")
+    print("refusals:", dict(tally.refusals.most_common()) or "none")
+    times = tally.times
     print(
         f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
         f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); over {SLOW} s: {sum(t > SLOW for t in times)}; slowest: "
-        + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(slowest)[::-1][:3])
+        + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(tally.slowest)[::-1][:3])
     )
     figures = {
         "robot": "official Baxter URDF" if args.urdf else "built-in Baxter",
