@@ -76,9 +76,9 @@ TASKS = {
     "cover": ("cover the pot", "pot", "lid", "Instrument"),
     # ... and of the serve class: a ladle the robot finds on the table carries the Theme's content
     "serve": ("scoop the soup", "soup", "bowl", "Destination"),
-    # ... and of the cook class: the Theme put where it cooks, its Instrument or its Destination
+    # ... and of the cook class: the Theme put where it cooks (its Instrument), a microwave or an oven
     "cook": ("reheat the soup", "soup", "microwave", "Instrument"),
-    "cook in the oven": ("bake the bread", "bread", "oven", "Destination"),
+    "cook in the oven": ("bake the bread", "bread", "oven", "Instrument"),
 }
 ALSO = {"serve": ("ladle",)}  # on the table too: what the motion needs that the instruction leaves unsaid
 TOOLS = {"stir", "whisk", "wipe", "cut", "cover"}  # the tool is held: the object filled in, not the one stated

@@ -591,6 +591,30 @@ def test_a_learned_verbs_pairs_back_off_to_what_its_class_does(tmp_path):
     assert counts.score_frame(glass) > counts.score_frame(bowl)
 
 
+def test_a_slot_like_neither_role_is_read_as_its_class_prototype_reads_it(tmp_path, monkeypatch):
+    """The robot's places are bowls and glasses, its Instruments microwaves and ovens. 'roast in' holds
+    trays mostly and a few bowls, ovens and microwaves: little like either role (cosine under
+    PROTOTYPE_BELOW), and the bowls would make it a place. Roasting is cooking by its fillers, and 'cook
+    in' an Instrument: so 'roast in' is one. 'put in', read clearly as a place, stays one."""
+    from lmcr.frame_corpus import predicates
+
+    frames = _kitchen()
+    frames += [("cook", {"Theme": "chicken", "in": "microwave"}, False)] * 20
+    frames += [("cook", {"Theme": "beef", "in": "oven"}, False)] * 10
+    frames += [("roast", {"Theme": "beef", "in": "bowl"}, False)] * 14
+    frames += [("roast", {"Theme": "chicken", "in": "oven"}, False)] * 8
+    frames += [("roast", {"Theme": "chicken", "in": "microwave"}, False)] * 7
+    frames += [("roast", {"Theme": "beef", "in": "tray"}, False)] * 40
+    con = _store(tmp_path, frames)
+    table = learn_predicates(con, HAND)
+    roast = table.predicates["roast"]
+    assert roast.motion == "cook" and roast.roles == ("Theme", "Instrument") and roast.slots["in"] == "Instrument"
+    assert roast.sentence == "roast {Theme} in the {Instrument}"
+    assert table.predicates["put"].slots["in"] == "Destination" and table.settings["prototype_below"] > 0
+    monkeypatch.setattr(predicates, "PROTOTYPE_BELOW", 0.0)  # the fillers alone
+    assert learn_predicates(con, HAND).predicates["roast"].roles == ("Theme", "Destination")
+
+
 def test_without_a_prototype_no_class_is_guessed(tmp_path):
     frames = [f for f in _kitchen() if f[0] != "put"]
     table = learn_predicates(_store(tmp_path, frames), HAND)

@@ -11,10 +11,13 @@ in the fridge": predicate `put away`, slots object=milk, in=fridge). Learning tu
   the same for every verb, not knowledge of objects.
 - The corpus decides among them, and whether the slot holds things at all: a slot's fillers are compared
   (cosine of filler counts) with the fillers the eleven robot predicates' roles take in the same corpus.
-  "bake in the oven" reads like heat's Instrument, "put in the bowl" like pour's Destination. Only fillers
+  "reheat in the microwave" reads like heat's Instrument, "put in the bowl" like pour's Destination. Only fillers
   that role takes count as things: "cut into cubes" names none and is no role here, and "bring to a boil"
   does not make a boil a place things are brought to. A with-phrase is an Instrument whatever it holds
   (the eleven's Instruments are no tools, so a knife would not count).
+- A slot whose fillers are like neither role's (cosine under `PROTOTYPE_BELOW`) is read as the prototype
+  of the verb's class of motion reads it: the eleven's places are mostly bowls and their Instruments
+  mostly skillets, so "bake in the oven" is like neither, and "cook in the pot" says it is an Instrument.
 - A phrasal verb's counts are smoothed towards its base verb's (`PHRASAL_PRIOR` frames of it), so "put
   away", seldom said with its place, still knows that putting has a Destination.
 
@@ -43,7 +46,7 @@ import duckdb
 from lmcr.files import atomic_path
 from lmcr.lexicon import PREDICATES_FILE, Lexicon
 
-VERSION = 3  # 2: each predicate's class of motion; 3: the cook class
+VERSION = 4  # 2: each predicate's class of motion; 3: the cook class; 4: unclear slots read as the prototype's
 # Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
 PREP_ROLES: dict[str, tuple[str, ...]] = {
     "into": ("Destination",),
@@ -85,6 +88,10 @@ MOTION_CLASSES = {
     "serve": "scoop",
     "cook": "cook",
 }
+# A slot English lets introduce two roles whose fillers are this little like either role's (cosine) is read
+# as its class's prototype reads it (`_as_prototype`); chosen among 0.1, 0.2 and 0.3 on the external
+# request sets (docs/guide/frames.md): 0.2 and 0.3 gave the same, 0.1 lost one right role.
+PROTOTYPE_BELOW = 0.3
 CLASS_ROLES = ("Theme", "Destination", "Instrument")  # whose fillers are compared, each role alike
 OPEN_ROLES = ("Destination", "Instrument")  # the roles a request can leave for the robot to choose
 # prepositions that can introduce the Theme of a prepositional verb ("of")
@@ -196,17 +203,25 @@ def _role_pools(con: duckdb.DuckDBPyConnection) -> dict[str, Counter]:
     return pools
 
 
-def _label(slot: str, fillers: Counter, total: int, pools: dict[str, Counter], min_share: float) -> tuple[str, float]:
-    """The role a slot fills and how many of its frames name a thing in it: the object is the Theme; a
-    preposition's candidate roles (`PREP_ROLES`) are decided by whose fillers it shares (cosine), and only
-    fillers that role takes in the robot frames count as things ("cut into cubes" names none). A slot whose
-    things are under `min_share` of it fills no role ("", 0)."""
+def _label(
+    slot: str, fillers: Counter, total: int, pools: dict[str, Counter], min_share: float
+) -> tuple[str, float, float]:
+    """The role a slot fills, how many of its frames name a thing in it, and how like that role's fillers
+    its fillers are: the object is the Theme; a preposition's candidate roles (`PREP_ROLES`) are decided by
+    whose fillers it shares (cosine), and only fillers that role takes in the robot frames count as things
+    ("cut into cubes" names none). A slot whose things are under `min_share` of it fills no role ("", 0)."""
     if slot == OBJECT_SLOT or slot in THEME_PREPS:  # an of-phrase's being the Theme's: the verb's evidence
-        return "Theme", float(total)
+        return "Theme", float(total), 1.0
     candidates = PREP_ROLES[slot]
     if candidates == ("Instrument",):  # "with": English leaves no other role; tools the eleven never use count
-        return "Instrument", float(total)
-    role = max(candidates, key=lambda r: (_cosine(fillers, pools[r]), -candidates.index(r)))
+        return "Instrument", float(total), 1.0
+    likeness = {r: _cosine(fillers, pools[r]) for r in candidates}
+    role = max(candidates, key=lambda r: (likeness[r], -candidates.index(r)))
+    return (*_things(role, fillers, total, pools, min_share), likeness[role])
+
+
+def _things(role: str, fillers: Counter, total: int, pools: dict[str, Counter], min_share: float) -> tuple[str, float]:
+    """(role, frames naming a thing the role takes) for a slot read as `role`; ("", 0) under `min_share`."""
     things = sum(n for value, n in fillers.items() if pools[role][value] >= MIN_POOL)
     return (role, float(things)) if total and things / total >= min_share else ("", 0.0)
 
@@ -224,27 +239,58 @@ def learn_predicates(
     min_share: float = MIN_SHARE,
     min_alternative_frames: float = MIN_ALTERNATIVE_FRAMES,
 ) -> LearnedTable:
-    """The learned table of the store's frame corpus (see the module's docstring)."""
+    """The learned table of the store's frame corpus (see the module's docstring). Its classes of motion
+    come from the slots as the fillers read them; slots that read like neither role are then read as their
+    class's prototype reads them, and the table is learned again from those."""
     frames, fillers, totals = _slot_counts(con)
     pools = _role_pools(con)
     labelled = {key: _label(key[1], counter, totals[key], pools, min_share) for key, counter in fillers.items()}
+    settings = {
+        "min_frames": min_frames,
+        "min_rate": min_rate,
+        "min_share": min_share,
+        "phrasal_prior": PHRASAL_PRIOR,
+        "min_alternative_frames": min_alternative_frames,
+        "prototype_below": PROTOTYPE_BELOW,
+    }
+    motions = motion_classes(_table(frames, labelled, totals, lex, settings).predicates, fillers)
+    labelled = _as_prototype(labelled, motions, fillers, totals, pools, min_share)
+    table = _table(frames, labelled, totals, lex, settings)
+    for name, predicate in table.predicates.items():
+        table.predicates[name] = replace(predicate, motion=motions.get(name))
+    return table
+
+
+def _as_prototype(
+    labelled: dict, motions: dict[str, str], fillers: dict, totals: Counter, pools: dict[str, Counter], min_share: float
+) -> dict:
+    """The slots English lets introduce two roles whose fillers are under PROTOTYPE_BELOW like either
+    role's, read as the prototype of the verb's class reads the same preposition. The eleven robot
+    predicates' places are mostly bowls and pans, so a slot of ovens is like neither role ("bake in the
+    oven": cosine 0.08 with the places, 0.01 with the Instruments, which are mostly skillets) and the
+    larger of two small numbers decided it; "cook in the pot" says what a verb of the cook class does."""
+    out = dict(labelled)
+    for (name, slot), (role, _, likeness) in labelled.items():
+        proto = MOTION_CLASSES.get(motions.get(name, ""))
+        if proto in (None, name) or len(PREP_ROLES.get(slot, ())) < 2 or likeness >= PROTOTYPE_BELOW:
+            continue
+        proto_role = labelled.get((proto, slot), ("",))[0]
+        if proto_role and proto_role != role:
+            key = (name, slot)
+            out[key] = (*_things(proto_role, fillers[key], totals[key], pools, min_share), 0.0)
+    return out
+
+
+def _table(frames: Counter, labelled: dict, totals: Counter, lex: Lexicon, settings: dict) -> LearnedTable:
+    """The predicates (without classes) and refused verbs of the slots as `labelled` reads them."""
     slots_of: dict[str, dict[str, str]] = defaultdict(dict)
-    for (predicate, slot), (role, _) in labelled.items():
+    raw_rates: dict[str, Counter] = defaultdict(Counter)
+    for (predicate, slot), (role, things, _) in labelled.items():
         if role:
             slots_of[predicate][slot] = role
-    raw_rates: dict[str, Counter] = defaultdict(Counter)
-    for (predicate, _slot), (role, things) in labelled.items():
-        if role and frames[predicate]:
-            raw_rates[predicate][role] += things / frames[predicate]
-    table = LearnedTable(
-        settings={
-            "min_frames": min_frames,
-            "min_rate": min_rate,
-            "min_share": min_share,
-            "phrasal_prior": PHRASAL_PRIOR,
-            "min_alternative_frames": min_alternative_frames,
-        }
-    )
+            if frames[predicate]:
+                raw_rates[predicate][role] += things / frames[predicate]
+    table = LearnedTable(settings=dict(settings))
     for name, n in frames.items():
         base, particle = _split(name)
         if name in lex.predicates or base in lex.predicates:
@@ -254,13 +300,12 @@ def learn_predicates(
         # the frames' worth behind the rates (a phrasal verb's include its base verb's prior): at least 1
         worth = n + (PHRASAL_PRIOR if base_rates is not None else 0.0)
         slots = dict(sorted(slots_of[name].items()))
-        learned = _predicate(name, n, rates, slots, totals, min_rate, min_alternative_frames / worth)
-        if n >= min_frames and learned is not None:
+        alternative_rate = settings["min_alternative_frames"] / worth
+        learned = _predicate(name, n, rates, slots, totals, settings["min_rate"], alternative_rate)
+        if n >= settings["min_frames"] and learned is not None:
             table.predicates[name] = learned
         elif n >= REFUSED_LISTED:
             table.refused[name] = n
-    for name, motion in motion_classes(table.predicates, fillers).items():
-        table.predicates[name] = replace(table.predicates[name], motion=motion)
     return table
 
 

@@ -1164,8 +1164,8 @@ SERVE = Task("Instrument", "Destination", program_serve, check_served, motion="s
 # why a tool motion's tool cannot act on its Theme (None when it can): a template of {tool} and {theme}
 TOOL_UNFIT = {"wipe": why_not_wipe, "cut": why_not_cut, "cover": why_not_cover, "stir": why_not_stir}
 # a verb of the cook class puts the Theme in or on what cooks it, as the paper's heat does: the Instrument
-# ("reheat the soup in the microwave") or, when the verb takes none, the Destination ("bake the bread in
-# the oven"); by the role it is put at
+# ("reheat the soup in the microwave", "bake the bread in the oven") or, when the verb takes none, the
+# Destination; by the role it is put at
 COOK = {
     role: Task("Theme", role, program_place, check_in_target, motion="cook") for role in ("Instrument", "Destination")
 }
