@@ -2,7 +2,7 @@
 
 Usage: python bench/bench_complete.py --instructions instructions_dev.jsonl [--method sentence_lm+frame_counts]
        [--corpus all] [--mixture household=30|plain] [--context-weight 1] [--no-context] [--scene-size 40]
-       [--json PATH]
+       [--busy N] [--json PATH]
 Uses the store, checkpoints, chosen mixture and context weight of $LMCR_DATA_DIR and the calibration `lmcr evaluate`
 wrote there.
 1. Accuracy: an instruction counts as right when the completed frame is the expected one, with or
@@ -10,7 +10,8 @@ wrote there.
    --scene-size N fills each scene with robot-vocabulary objects up to N: the same instructions among
    many distractors (what a cap on the frames that read the context could lose).
 2. Latency: one completion of "pour me some water" and of "pour me some water for my tea" (context) with
-   40 detected objects (the robot vocabulary but the theme), median and p90 of 200 runs after 20 warm-ups.
+   40 detected objects (the robot vocabulary but the theme), median and p90 of 200 runs after 20 warm-ups;
+   with --busy N while N processes spin, one core each (a busy machine: `lmcr.lm.threads`).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from record import add_json_option, write_results
+from record import add_json_option, busy_cores, write_results
 
 from lmcr.complete import complete
 from lmcr.evaluate.instructions import instruction_accuracy, load_instructions
@@ -69,6 +70,7 @@ def main() -> None:
     parser_.add_argument("--no-context", action="store_true", help="score the frame alone")
     parser_.add_argument("--runs", type=int, default=200, help="timed completions per latency figure (0: none)")
     parser_.add_argument("--scene-size", type=int, default=0, help="fill each scene with other objects up to this")
+    parser_.add_argument("--busy", type=int, default=0, help="processes spinning beside the latency runs")
     add_json_option(parser_, "bench_complete")
     args = parser_.parse_args()
     ws = Workspace.from_env()
@@ -101,8 +103,11 @@ def main() -> None:
         "questions asked": accuracy.asked,
         "questions whose best guess is right": accuracy.asked_right,
     }
+    if args.busy:
+        figures["latency beside spinning processes"] = args.busy
     for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
-        took = latency(parser, scorer, config, instruction, runs=args.runs)
+        with busy_cores(args.busy):
+            took = latency(parser, scorer, config, instruction, runs=args.runs)
         print(
             f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
             f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)"

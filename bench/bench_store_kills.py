@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 import duckdb
-from record import REPO_ROOT, add_json_option, write_results
+from record import REPO_ROOT, add_json_option, busy_cores, write_results
 
 from lmcr.errors import one_line
 
@@ -88,23 +88,17 @@ def main() -> None:
     args = parser.parse_args()
     low, high = args.window
     rng, errors = random.Random(args.seed), collections.Counter()
-    spinner = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if args.busy else None
     started = time.perf_counter()
-    try:
-        with tempfile.TemporaryDirectory() as scratch:
-            db = Path(scratch) / "0" / "lmcr.duckdb"
-            for k in range(args.kills):
-                why = kill_once(db, REPO_ROOT / "sql", rng.uniform(low, high), args.checkpoint_on_close)
-                if why is not None:
-                    errors[why.split(":")[0]] += 1
-                    print(f"kill {k + 1}: the store no longer opens: {why}", flush=True)
-                    db = Path(scratch) / str(k + 1) / "lmcr.duckdb"  # a new store; the broken one stays aside
-                if (k + 1) % 50 == 0:
-                    print(f"{k + 1}/{args.kills} kills, {sum(errors.values())} stores lost", flush=True)
-    finally:
-        if spinner is not None:
-            spinner.kill()
-            spinner.wait()
+    with busy_cores(1 if args.busy else 0), tempfile.TemporaryDirectory() as scratch:
+        db = Path(scratch) / "0" / "lmcr.duckdb"
+        for k in range(args.kills):
+            why = kill_once(db, REPO_ROOT / "sql", rng.uniform(low, high), args.checkpoint_on_close)
+            if why is not None:
+                errors[why.split(":")[0]] += 1
+                print(f"kill {k + 1}: the store no longer opens: {why}", flush=True)
+                db = Path(scratch) / str(k + 1) / "lmcr.duckdb"  # a new store; the broken one stays aside
+            if (k + 1) % 50 == 0:
+                print(f"{k + 1}/{args.kills} kills, {sum(errors.values())} stores lost", flush=True)
     lost = sum(errors.values())
     print(
         f"writer {'checkpointing' if args.checkpoint_on_close else 'leaving its commits in the WAL'} on close: "

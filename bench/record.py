@@ -15,7 +15,8 @@ import platform
 import shlex
 import subprocess
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -23,6 +24,19 @@ from lmcr.errors import LMCRError
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 RESULTS_DIR = REPO_ROOT / "bench" / "results"
+
+
+@contextmanager
+def busy_cores(n: int) -> Iterator[None]:
+    """`n` processes spinning (one core each) while the block runs, killed after it whatever happens: what
+    a benchmark measures on a busy machine."""
+    spinners = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+    try:
+        yield
+    finally:
+        for spinner in spinners:
+            spinner.kill()
+            spinner.wait()
 
 
 def add_json_option(parser: argparse.ArgumentParser, name: str) -> None:

@@ -23,6 +23,7 @@ from lmcr.frame import Frame
 from lmcr.grounding import ground_roles, objects_named, referents, served_vessel, speaker_destination
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
+from lmcr.lm.threads import request_threads
 from lmcr.scorers.registry import Scorer, make_scorer, scorer_fingerprint
 from lmcr.srl.context import Purpose, purpose_of, utterance_context
 from lmcr.srl.instruction import read_instruction
@@ -280,6 +281,7 @@ def complete(
     )
 
 
+@request_threads()  # one request's few texts: one thread (`lmcr.lm.threads`)
 def _purpose_scores(scorer: Scorer, purpose: Purpose, fillings: list[dict[str, str]]) -> list[float]:
     """Each filling's Theme scored as the thing its purpose frame needs ("cut bread with the knife"); the
     purpose is that frame, so it is no context of it."""
@@ -287,6 +289,7 @@ def _purpose_scores(scorer: Scorer, purpose: Purpose, fillings: list[dict[str, s
     return list(scorer(frames, ""))
 
 
+@request_threads()  # one request's few texts: one thread (`lmcr.lm.threads`)
 def _scores(scorer: Scorer, frames: list[Frame], fillings: list[dict[str, str]], context: str) -> list[float]:
     """The frames' scores. Where the fillings span several open roles and the scorer has terms that only
     rank fillers within a role (`SummedScorer.with_roles`), each role's best scores as it does without

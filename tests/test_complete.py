@@ -327,3 +327,29 @@ def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(
     assert roles == {"Theme": "eggs", "Destination": None} and not unresolved
     poured = complete(parser, scorer, "pour the carrots into the bowl", ["carrots", "bowl", "cup"])
     assert poured.frame.role_map["Theme"] == "carrots" and not poured.unresolved
+
+
+def test_a_request_is_scored_on_one_thread_and_the_setting_comes_back(parser):
+    """A completion's few texts run faster on one torch thread, above all on a busy machine
+    (`lmcr.lm.threads`); the process's own setting is back afterwards, also when the scorer fails."""
+    import torch
+
+    seen = []
+
+    def counting(frames, context=""):
+        seen.append(torch.get_num_threads())
+        return scorer(frames, context)
+
+    def failing(frames, context=""):
+        raise RuntimeError("scorer broke")
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        complete(parser, counting, "pour me some water for my tea", ["cup", "bowl", "water"])
+        assert seen and set(seen) == {1} and torch.get_num_threads() == 2
+        with pytest.raises(RuntimeError, match="scorer broke"):
+            complete(parser, failing, "pour me some water", ["cup", "bowl", "water"])
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
