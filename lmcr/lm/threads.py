@@ -1,13 +1,13 @@
 """How many threads torch's kernels use while one request is scored.
 
 A completion scores a few dozen to a few thousand short texts: kernels too small to gain much from a
-second thread, and a thread that waits at every kernel's end for the other to finish. On an idle 2-core
-machine the sentence LM's part of a completion among 40 objects took 2.6-2.8 ms on two threads and
-3.1-3.2 ms on one, and the whole completion about the same (7.7-7.9 ms against 7.6-8.1 ms p50, the full
-store's LM). With both cores busy (two spinning processes) the completion took 40-56 ms on two threads
-and 11-12 ms on one: each kernel's end waits for a thread the scheduler has put aside. So a request
-runs on REQUEST_THREADS; batch scoring (an evaluation's ratings, training) keeps torch's default, where
-two threads gain 15-20% on an idle machine.
+second thread, and a thread that waits at every kernel's end for the other to finish. With the full
+store's sentence LM among 40 objects on 2 cores (`bench/bench_complete.py [--busy 2]`, p50), two threads
+took 7.2 ms idle and 35.3 ms with both cores busy (two spinning processes; p90 148 ms), one thread 7.4
+and 9.2 ms (p90 22 ms): on a busy machine each kernel's end waits for a thread the scheduler has put
+aside. With a context to read ("for my tea") one thread costs 1.8 ms idle (10.1 -> 11.9 ms) and saves
+39 ms busy (53.7 -> 14.7 ms). So a request runs on REQUEST_THREADS; batch scoring (an evaluation's
+ratings, training) keeps torch's default, where two threads gain 15-20% on an idle machine.
 
 torch is only touched when something already imported it: a count-only completion loads no torch.
 """
