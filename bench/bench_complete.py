@@ -11,7 +11,8 @@ wrote there.
    many distractors (what a cap on the frames that read the context could lose).
 2. Latency: one completion of "pour me some water" and of "pour me some water for my tea" (context) with
    40 detected objects (the robot vocabulary but the theme), median and p90 of 200 runs after 20 warm-ups;
-   with --busy N while N processes spin, one core each (a busy machine: `lmcr.lm.threads`).
+   with --busy N while N processes spin, one core each, from BUSY_SETTLE seconds before (a busy machine:
+   a request takes the cores the load average leaves idle, `lmcr.lm.threads`).
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ from lmcr.lexicon import load_lexicon
 from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.registry import COMPLETION_METHOD
 from lmcr.workspace import Workspace
+
+BUSY_SETTLE = 30  # seconds: the one-minute load average has risen past half a busy core by then
 
 
 def latency(parser, scorer, config, instruction: str, n_objects: int = 40, runs: int = 200) -> dict:
@@ -105,16 +108,16 @@ def main() -> None:
     }
     if args.busy:
         figures["latency beside spinning processes"] = args.busy
-    for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
-        with busy_cores(args.busy):
+    with busy_cores(args.busy if args.runs else 0, settle=BUSY_SETTLE):
+        for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
             took = latency(parser, scorer, config, instruction, runs=args.runs)
-        print(
-            f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
-            f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)"
-        )
-        figures |= {
-            f"latency {instruction!r}, {took['objects']} objects: {k}": v for k, v in took.items() if k != "objects"
-        }
+            print(
+                f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "
+                f"p90 {took['p90 ms']:.2f} ms ({args.runs} runs)"
+            )
+            figures |= {
+                f"latency {instruction!r}, {took['objects']} objects: {k}": v for k, v in took.items() if k != "objects"
+            }
     write_results(args.json, "bench_complete", __doc__.splitlines()[0], figures)
 
 

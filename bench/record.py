@@ -15,6 +15,7 @@ import platform
 import shlex
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from datetime import UTC, datetime
@@ -27,11 +28,13 @@ RESULTS_DIR = REPO_ROOT / "bench" / "results"
 
 
 @contextmanager
-def busy_cores(n: int) -> Iterator[None]:
+def busy_cores(n: int, settle: float = 0.0) -> Iterator[None]:
     """`n` processes spinning (one core each) while the block runs, killed after it whatever happens: what
-    a benchmark measures on a busy machine."""
+    a benchmark measures on a busy machine. `settle`: seconds they spin before the block, for what reads
+    the load average (a one-minute mean) to see them."""
     spinners = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
     try:
+        time.sleep(settle if n else 0.0)
         yield
     finally:
         for spinner in spinners:

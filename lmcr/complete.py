@@ -281,7 +281,7 @@ def complete(
     )
 
 
-@request_threads()  # one request's few texts: one thread (`lmcr.lm.threads`)
+@request_threads()  # one request's few texts: on the idle cores only (`lmcr.lm.threads`)
 def _purpose_scores(scorer: Scorer, purpose: Purpose, fillings: list[dict[str, str]]) -> list[float]:
     """Each filling's Theme scored as the thing its purpose frame needs ("cut bread with the knife"); the
     purpose is that frame, so it is no context of it."""
@@ -289,7 +289,7 @@ def _purpose_scores(scorer: Scorer, purpose: Purpose, fillings: list[dict[str, s
     return list(scorer(frames, ""))
 
 
-@request_threads()  # one request's few texts: one thread (`lmcr.lm.threads`)
+@request_threads()  # one request's few texts: on the idle cores only (`lmcr.lm.threads`)
 def _scores(scorer: Scorer, frames: list[Frame], fillings: list[dict[str, str]], context: str) -> list[float]:
     """The frames' scores. Where the fillings span several open roles and the scorer has terms that only
     rank fillers within a role (`SummedScorer.with_roles`), each role's best scores as it does without

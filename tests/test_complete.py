@@ -329,10 +329,15 @@ def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(
     assert poured.frame.role_map["Theme"] == "carrots" and not poured.unresolved
 
 
-def test_a_request_is_scored_on_one_thread_and_the_setting_comes_back(parser):
-    """A completion's few texts run faster on one torch thread, above all on a busy machine
-    (`lmcr.lm.threads`); the process's own setting is back afterwards, also when the scorer fails."""
+def test_a_request_is_scored_on_the_idle_cores_and_the_setting_comes_back(parser, monkeypatch):
+    """A completion's kernels on two threads wait for the slower one, and on a busy machine that is one
+    the scheduler put aside (`lmcr.lm.threads`): a request runs on the cores the load average leaves idle;
+    the process's own setting is back afterwards, also when the scorer fails."""
+    import os
+
     import torch
+
+    from lmcr.lm.threads import idle_cores
 
     seen = []
 
@@ -343,13 +348,25 @@ def test_a_request_is_scored_on_one_thread_and_the_setting_comes_back(parser):
     def failing(frames, context=""):
         raise RuntimeError("scorer broke")
 
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
     before = torch.get_num_threads()
     torch.set_num_threads(2)
     try:
-        complete(parser, counting, "pour me some water for my tea", ["cup", "bowl", "water"])
-        assert seen and set(seen) == {1} and torch.get_num_threads() == 2
+        for load, threads in ((3.1, 1), (1.6, 1), (1.0, 2), (0.2, 2)):  # two busy cores ... an idle machine
+            monkeypatch.setattr(os, "getloadavg", lambda load=load: (load, load, load))
+            assert idle_cores() == threads
+            seen.clear()
+            complete(parser, counting, "pour me some water for my tea", ["cup", "bowl", "water"])
+            assert seen and set(seen) == {threads} and torch.get_num_threads() == 2
+        monkeypatch.setattr(os, "getloadavg", lambda: (3.1, 3.1, 3.1))
         with pytest.raises(RuntimeError, match="scorer broke"):
             complete(parser, failing, "pour me some water", ["cup", "bowl", "water"])
         assert torch.get_num_threads() == 2
+
+        def unreadable():
+            raise OSError("no load average here")
+
+        monkeypatch.setattr(os, "getloadavg", unreadable)
+        assert idle_cores() == 1
     finally:
         torch.set_num_threads(before)
