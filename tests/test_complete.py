@@ -349,6 +349,7 @@ def test_a_request_is_scored_on_the_idle_cores_and_the_setting_comes_back(parser
         raise RuntimeError("scorer broke")
 
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
     before = torch.get_num_threads()
     torch.set_num_threads(2)
     try:

@@ -36,7 +36,13 @@ def idle_cores() -> int:
         load = os.getloadavg()[0]
     except (AttributeError, OSError):  # not on every platform
         return 1
-    return max(1, math.floor((os.cpu_count() or 1) - max(load - 1.0, 0.0)))
+    return max(1, math.floor(cores() - max(load - 1.0, 0.0)))
+
+
+def cores() -> int:
+    """The cores this process may run on (its affinity where the platform says, as torch counts them)."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
 
 
 @contextmanager
