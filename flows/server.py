@@ -53,6 +53,9 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child between 
 def _start(port: int) -> subprocess.Popen:
     env = {**os.environ, "PREFECT_UI_ENABLED": "0", "PREFECT__SERVER_EPHEMERAL": "1", "PREFECT__SERVER_FINAL": "1"}
     env.pop("PREFECT_API_URL", None)
+    # the run's private server sends no usage telemetry unless asked to: offline (CI, a lab machine) it
+    # logged "Failed to send telemetry" as an ERROR every few minutes of a run
+    env.setdefault("PREFECT_SERVER_ANALYTICS_ENABLED", "false")
     command = [
         sys.executable,
         "-m",

@@ -218,3 +218,24 @@ def test_a_set_api_url_is_used_and_no_server_started(monkeypatch):
     monkeypatch.setenv("PREFECT_API_URL", "http://127.0.0.1:1/api")
     with local_server() as url:
         assert url == "http://127.0.0.1:1/api"
+
+
+@pytest.mark.parametrize(("asked", "sent"), [(None, "false"), ("true", "true")])
+def test_the_runs_own_server_sends_no_telemetry_unless_asked(monkeypatch, asked, sent):
+    """Offline, the server's telemetry logged an ERROR every few minutes of a run; a user who set the
+    variable keeps their choice."""
+    from flows import server
+
+    started = {}
+
+    def popen(command, env, **kwargs):
+        started.update(env)
+        return "process"
+
+    monkeypatch.setattr(server.subprocess, "Popen", popen)
+    if asked is None:
+        monkeypatch.delenv("PREFECT_SERVER_ANALYTICS_ENABLED", raising=False)
+    else:
+        monkeypatch.setenv("PREFECT_SERVER_ANALYTICS_ENABLED", asked)
+    assert server._start(4200) == "process"
+    assert started["PREFECT_SERVER_ANALYTICS_ENABLED"] == sent and "PREFECT_API_URL" not in started
