@@ -30,8 +30,8 @@ from contextlib import contextmanager
 
 
 def idle_cores() -> int:
-    """The cores the one-minute load average leaves to this process, besides the one it uses: at least 1;
-    1 where the load average cannot be read."""
+    """The cores left to this process: its cores less the one-minute load of the others (the load average
+    less the 1 its own running request adds), at least 1; 1 where the load average cannot be read."""
     try:
         load = os.getloadavg()[0]
     except (AttributeError, OSError):  # not on every platform
