@@ -108,8 +108,9 @@ def main() -> None:
     }
     if args.busy:
         figures["latency beside spinning processes"] = args.busy
-    with busy_cores(args.busy if args.runs else 0, settle=BUSY_SETTLE):
-        for instruction in ("pour me some water", "pour me some water for my tea") if args.runs else ():
+    timed = ("pour me some water", "pour me some water for my tea") if args.runs else ()
+    with busy_cores(args.busy if timed else 0, settle=BUSY_SETTLE):
+        for instruction in timed:
             took = latency(parser, scorer, config, instruction, runs=args.runs)
             print(
                 f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "

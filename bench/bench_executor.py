@@ -156,10 +156,10 @@ def random_scene(
 
 @dataclass
 class Tally:
-    """What the rows add up to: each instruction's time (and the slowest), failure and refusal reasons."""
+    """What the rows add up to: each instruction's (seconds, name, executed or refused), failure and
+    refusal reasons."""
 
-    times: list = field(default_factory=list)
-    slowest: list = field(default_factory=list)
+    runs: list = field(default_factory=list)
     reasons: collections.Counter = field(default_factory=collections.Counter)
     refusals: collections.Counter = field(default_factory=collections.Counter)
 
@@ -182,8 +182,8 @@ def measure_row(predicate: str, args, ws, scorer, config, nlp, pool: tuple, tall
         )
         # the pictures of a video are no part of planning or acting: their time is left out
         taking_pictures = recorder.seconds if recorder is not None else 0.0
-        tally.times.append(time.perf_counter() - started - out["seconds"]["perceive_and_complete"] - taking_pictures)
-        tally.slowest.append((tally.times[-1], f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
+        seconds = time.perf_counter() - started - out["seconds"]["perceive_and_complete"] - taking_pictures
+        tally.runs.append((seconds, f"{predicate} {k}", "refused" if not out["feasible"] else "executed"))
         lm_choice = max(out["ranking"], key=lambda r: r["probability"])["object"] if out["ranking"] else None
         row["other_choice"] += lm_choice != expected
         if not out["feasible"]:
@@ -222,9 +222,10 @@ def main() -> None:
     ws = Workspace.from_env()
     scorer, config = ws.completion_scorer(args.method)
     nlp = ws.parser()
+    objects, household_too = load_lexicon().objects, tuple(sorted(robot_objects()))
     tally, totals, per_predicate = Tally(), collections.Counter(), {}
     for predicate in args.predicates.split(","):
-        pool = tuple(sorted(robot_objects())) if predicate in LEARNED else load_lexicon().objects
+        pool = household_too if predicate in LEARNED else objects
         try:
             row = measure_row(predicate, args, ws, scorer, config, nlp, pool, tally)
         except NoPredicateError as exc:
@@ -251,11 +252,11 @@ def main() -> None:
     )
     print("failures of executed plans:", dict(tally.reasons.most_common()) or "none")
     print("refusals:", dict(tally.refusals.most_common()) or "none")
-    times = tally.times
+    times = [seconds for seconds, _, _ in tally.runs]
     print(
         f"plan and execute one instruction: median {statistics.median(times):.2f} s, max {max(times):.2f} s "
         f"(wall clock, 2 cores; simulation at 240 Hz, DIRECT); over {SLOW} s: {sum(t > SLOW for t in times)}; slowest: "
-        + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(tally.slowest)[::-1][:3])
+        + ", ".join(f"{name} {seconds:.1f} s ({what})" for seconds, name, what in sorted(tally.runs)[::-1][:3])
     )
     figures = {
         "robot": "official Baxter URDF" if args.urdf else "built-in Baxter",

@@ -50,9 +50,10 @@ def request_threads() -> Iterator[None]:
     """Run the block with torch on at most `idle_cores()` threads, as before afterwards. A no-op where torch
     is not loaded. Process-wide, like torch's setting: requests are served one at a time (`lmcr serve`)."""
     torch = sys.modules.get("torch")
-    before = torch.get_num_threads() if torch is not None else 0
-    threads = idle_cores() if torch is not None else 0
-    if torch is None or before <= threads:
+    threads = before = torch.get_num_threads() if torch is not None else 0
+    if before > 1:  # one thread (or no torch) is as few as it gets: no load average to read
+        threads = min(before, idle_cores())
+    if threads == before:
         yield
         return
     torch.set_num_threads(threads)
