@@ -81,6 +81,16 @@ def test_the_term_prefers_the_learned_place_and_weighs_it(model):
     assert commonsense_scorer(model)([Frame.of("heat", {"Theme": "soup"})]) == [0.0]
 
 
+def test_the_methods_term_leaves_the_predicates_it_is_not_given_alone(model):
+    """The method passes the learned predicates: the eleven's frames (pour, ...) then score 0."""
+    frames = [
+        Frame.of(p, {"Theme": "butter", "Destination": d}) for p in ("store", "pour") for d in ("fridge", "closet")
+    ]
+    fridge, closet, *eleven = commonsense_scorer(model, 1.0, frozenset({"store"}))(frames)
+    assert fridge > closet and eleven == [0.0, 0.0]
+    assert commonsense_scorer(model, 1.0, frozenset({"store"}))(frames)[:2] == commonsense_scorer(model)(frames)[:2]
+
+
 def test_the_term_ranks_fillers_within_a_role_and_leaves_the_role_choice_alone(model):
     # centred per (predicate, roles): the Destination frames and the Instrument frames each sum to 0
     frames = [

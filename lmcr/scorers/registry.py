@@ -38,9 +38,11 @@ if TYPE_CHECKING:
 # are anyway (lmcr/scorers/rarity.py), plus what the instruction's purpose says of each filler
 # (lmcr/scorers/context_pmi.py; 0 without one, so on the rated frames), and, within a role, how much
 # likelier a learned verb itself fills it with each object than the verbs of its class do
-# (`FrameCountScorer.verb_preference`; 0 for the eleven). The household weight under which it runs is
-# chosen on both dev sets (lmcr/evaluate/choose_mixture.py); its figures are in the README.
-COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi+verb_fillers"
+# (`FrameCountScorer.verb_preference`; 0 for the eleven) and how much likelier the sentence LM finds it
+# there with the Theme said than unsaid (lmcr/scorers/theme_pmi.py; 0 for the eleven). The household
+# weight under which it runs is chosen on both dev sets (lmcr/evaluate/choose_mixture.py); its figures
+# are in docs/guide/complete.md.
+COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi+verb_fillers+theme_pmi"
 
 
 class Scorer(Protocol):
@@ -87,15 +89,26 @@ class SummedScorer:
         return full, roles
 
 
+# The last LM scorer built, by its linearisation, resources and checkpoint manifests (a checkpoint trained
+# again is loaded again): `theme_pmi` reads the sentence LM that `sentence_lm` loaded just before it,
+# instead of loading the checkpoints twice.
+_LAST_LM: dict[tuple, Callable[..., list[float]]] = {}
+
+
 def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
     def build(res: MethodResources):
         from lmcr.lm.score import MixedLM
 
+        key = (linearization, res, _lm_fingerprint(linearization)(res))
+        if key in _LAST_LM:
+            return _LAST_LM[key]
         experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
         lex = load_lexicon(learned=res.predicates)
         for _, expert in experts:
             expert.lex = lex  # the parser's predicates: the eleven and those learned beside the store
-        return experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
+        _LAST_LM.clear()
+        _LAST_LM[key] = experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
+        return _LAST_LM[key]
 
     return build
 
@@ -266,13 +279,25 @@ def _commonsense(res: MethodResources) -> Scorer:
 
     progress = lambda line: print(line, file=sys.stderr)  # noqa: E731 - training shows its epochs
     model = trained_model(_conceptnet_edges(res, "commonsense"), word_vectors(res), cache_dir(res), progress)
-    return commonsense_scorer(model, WEIGHT)
+    return commonsense_scorer(model, WEIGHT, load_lexicon(learned=res.predicates).learned)
 
 
 def _commonsense_fingerprint(res: MethodResources) -> str:
     from lmcr.scorers.commonsense import WEIGHT, model_digest
 
     return f"{model_digest(_conceptnet_edges(res, 'commonsense'), word_vectors(res))}*{WEIGHT:g}"
+
+
+def _theme_pmi(res: MethodResources) -> Scorer:
+    from lmcr.scorers.theme_pmi import theme_pmi_scorer
+
+    return theme_pmi_scorer(_lm_scorer("sentence")(res), load_lexicon(learned=res.predicates).learned)
+
+
+def _theme_pmi_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.theme_pmi import WEIGHT
+
+    return f"{_lm_fingerprint('sentence')(res)}*{WEIGHT:g}"
 
 
 def _random(res: MethodResources) -> Scorer:
@@ -298,6 +323,8 @@ SCORERS: dict[str, ScorerSpec] = {
     "commonsense": ScorerSpec(_commonsense, _commonsense_fingerprint, within_role=True),  # a term, as rarity
     # a term, as rarity; it orders the fillers of one role only
     "verb_fillers": ScorerSpec(_verb_fillers, _frame_counts_fingerprint, within_role=True),
+    # a term, as rarity; it orders the fillers of one role only
+    "theme_pmi": ScorerSpec(_theme_pmi, _theme_pmi_fingerprint, reads_context=True, within_role=True),
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
     "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
@@ -305,7 +332,7 @@ SCORERS: dict[str, ScorerSpec] = {
 
 METHODS = tuple(SCORERS)
 # added to methods ('a+rarity'), not compared as methods of their own
-TERMS = ("rarity", "context_pmi", "commonsense", "verb_fillers")
+TERMS = ("rarity", "context_pmi", "commonsense", "verb_fillers", "theme_pmi")
 # what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
 # its third expert
 EVALUATED = (
