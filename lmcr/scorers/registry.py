@@ -39,10 +39,10 @@ if TYPE_CHECKING:
 # (lmcr/scorers/context_pmi.py; 0 without one, so on the rated frames), and, within a role, how much
 # likelier a learned verb itself fills it with each object than the verbs of its class do
 # (`FrameCountScorer.verb_preference`; 0 for the eleven) and how much likelier the sentence LM finds it
-# there with the Theme said than unsaid (lmcr/scorers/theme_pmi.py; 0 for the eleven). The household
-# weight under which it runs is chosen on both dev sets (lmcr/evaluate/choose_mixture.py); its figures
-# are in docs/guide/complete.md.
-COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi+verb_fillers+theme_pmi"
+# there with the request's stated words than without (lmcr/scorers/stated_pmi.py; 0 for the eleven).
+# The household weight under which it runs is chosen on both dev sets (lmcr/evaluate/choose_mixture.py);
+# its figures are in docs/guide/complete.md.
+COMPLETION_METHOD = "sentence_lm+frame_counts+similar_verbs+rarity+context_pmi+verb_fillers+stated_pmi"
 
 
 class Scorer(Protocol):
@@ -90,7 +90,7 @@ class SummedScorer:
 
 
 # The last LM scorer built, by its linearisation, resources and checkpoint manifests (a checkpoint trained
-# again is loaded again): `theme_pmi` reads the sentence LM that `sentence_lm` loaded just before it,
+# again is loaded again): `stated_pmi` reads the sentence LM that `sentence_lm` loaded just before it,
 # instead of loading the checkpoints twice.
 _LAST_LM: dict[tuple, Callable[..., list[float]]] = {}
 
@@ -288,14 +288,14 @@ def _commonsense_fingerprint(res: MethodResources) -> str:
     return f"{model_digest(_conceptnet_edges(res, 'commonsense'), word_vectors(res))}*{WEIGHT:g}"
 
 
-def _theme_pmi(res: MethodResources) -> Scorer:
-    from lmcr.scorers.theme_pmi import theme_pmi_scorer
+def _stated_pmi(res: MethodResources) -> Scorer:
+    from lmcr.scorers.stated_pmi import stated_pmi_scorer
 
-    return theme_pmi_scorer(_lm_scorer("sentence")(res), load_lexicon(learned=res.predicates).learned)
+    return stated_pmi_scorer(_lm_scorer("sentence")(res), load_lexicon(learned=res.predicates).learned)
 
 
-def _theme_pmi_fingerprint(res: MethodResources) -> str:
-    from lmcr.scorers.theme_pmi import WEIGHT
+def _stated_pmi_fingerprint(res: MethodResources) -> str:
+    from lmcr.scorers.stated_pmi import WEIGHT
 
     return f"{_lm_fingerprint('sentence')(res)}*{WEIGHT:g}"
 
@@ -324,7 +324,7 @@ SCORERS: dict[str, ScorerSpec] = {
     # a term, as rarity; it orders the fillers of one role only
     "verb_fillers": ScorerSpec(_verb_fillers, _frame_counts_fingerprint, within_role=True),
     # a term, as rarity; it orders the fillers of one role only
-    "theme_pmi": ScorerSpec(_theme_pmi, _theme_pmi_fingerprint, reads_context=True, within_role=True),
+    "stated_pmi": ScorerSpec(_stated_pmi, _stated_pmi_fingerprint, reads_context=True, within_role=True),
     "rarity": ScorerSpec(_rarity, _rarity_fingerprint),  # a term of sums ('a+rarity'), not a method alone
     "context_pmi": ScorerSpec(_context_pmi, _context_pmi_fingerprint, reads_context=True),  # a term, as rarity
 }
@@ -332,7 +332,7 @@ SCORERS: dict[str, ScorerSpec] = {
 
 METHODS = tuple(SCORERS)
 # added to methods ('a+rarity'), not compared as methods of their own
-TERMS = ("rarity", "context_pmi", "commonsense", "verb_fillers", "theme_pmi")
+TERMS = ("rarity", "context_pmi", "commonsense", "verb_fillers", "stated_pmi")
 # what `lmcr evaluate` compares by default: the methods, and the default with and without its terms and
 # its third expert
 EVALUATED = (
