@@ -1175,3 +1175,21 @@ def test_a_straight_motion_stays_in_one_arm_configuration_to_its_end(sim, tmp_pa
     assert all(np.max(np.abs(b - a)) <= BRANCH_JUMP for a, b in zip(path, path[1:]))
     arm.set_config(path[-1])
     assert np.linalg.norm(np.subtract(arm.ee_pose()[0], np.add(here, [0.03, 0.0, -0.02]))) < 0.003
+
+
+def test_an_absent_object_is_refused_with_what_the_camera_saw_not_the_scene_file():
+    """A plastic knife hidden from the camera: "put the plastic knife away" reads the vocabulary's knife,
+    and the refusal lists what the robot saw (a scene file's ground truth is not the robot's to know)."""
+    from types import SimpleNamespace
+
+    from lmcr.frame import Frame
+    from lmcr.robot.execute import ExecutionError, _instances
+
+    hidden, sink = SimpleNamespace(id="plastic knife", label="plastic knife"), SimpleNamespace(id="sink", label="sink")
+    scene = SimpleNamespace(present=[hidden, sink], holding=None, instances=lambda label: [])
+    frame = Frame.of("put away", {"Theme": "knife", "Destination": "sink"})
+    with pytest.raises(ExecutionError, match=r"no 'knife' on the table \(the camera sees: sink\)$") as err:
+        _instances(scene, frame, SimpleNamespace(source_role=None), "Theme", {"sink"})
+    assert err.value.absent == "knife"
+    with pytest.raises(ExecutionError, match=r"\(the camera sees: nothing\)$"):
+        _instances(scene, frame, SimpleNamespace(source_role=None), "Theme", set())

@@ -262,10 +262,10 @@ def _instances(scene: Scene, frame: Frame, task: Task, role: str, seen: set[str]
             raise ExecutionError(f"cannot {frame.predicate} here: nothing to scoop with on the table")
         return found
     found = [o for o in scene.instances(label) if o is scene.holding or o.id in seen] or scene.instances(label)
-    if not found:
-        there = ", ".join(o.id for o in scene.objects)
+    if not found:  # what the robot knows of the table is what its camera saw, not the scene file
+        there = ", ".join(o.id for o in scene.present if o.id in seen or o is scene.holding) or "nothing"
         raise ExecutionError(
-            f"cannot {frame.predicate} here: no {label!r} on the table (there are: {there})", absent=label
+            f"cannot {frame.predicate} here: no {label!r} on the table (the camera sees: {there})", absent=label
         )
     return found
 
