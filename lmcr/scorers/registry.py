@@ -89,9 +89,9 @@ class SummedScorer:
         return full, roles
 
 
-# The last LM scorer built, by its linearisation, resources and checkpoint manifests (a checkpoint trained
-# again is loaded again): `stated_pmi` reads the sentence LM that `sentence_lm` loaded just before it,
-# instead of loading the checkpoints twice.
+# The last LM scorer built, by its linearisation, resources, checkpoint manifests and experts' shares (a
+# checkpoint trained again is loaded again): `stated_pmi` reads the sentence LM that `sentence_lm` loaded
+# just before it, instead of loading the checkpoints twice.
 _LAST_LM: dict[tuple, Callable[..., list[float]]] = {}
 
 
@@ -99,10 +99,11 @@ def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., 
     def build(res: MethodResources):
         from lmcr.lm.score import MixedLM
 
-        key = (linearization, res, _lm_fingerprint(linearization)(res))
+        shares = [(corpus, w) for corpus, w in lm_experts(res) if w > 0]
+        key = (linearization, res, _lm_fingerprint(linearization)(res), tuple(shares))
         if key in _LAST_LM:
             return _LAST_LM[key]
-        experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in lm_experts(res) if w > 0]
+        experts = [(w, load_lm(res, linearization, corpus)) for corpus, w in shares]
         lex = load_lexicon(learned=res.predicates)
         for _, expert in experts:
             expert.lex = lex  # the parser's predicates: the eleven and those learned beside the store
