@@ -121,12 +121,14 @@ def main() -> None:
     }
     if args.busy:
         figures["latency beside spinning processes"] = args.busy
-    timed = [t for t in TIMED if t[2] in parser.lex.predicates] if args.runs else []
-    for instruction, _, predicate in TIMED if args.runs else ():
-        if predicate not in parser.lex.predicates:
+    timed = []
+    for instruction, theme, predicate in TIMED if args.runs else ():
+        if predicate in parser.lex.predicates:
+            timed.append((instruction, theme))
+        else:
             print(f"latency of {instruction!r}: not measured, this store learned no {predicate!r}")
     with busy_cores(args.busy if timed else 0, settle=BUSY_SETTLE):
-        for instruction, theme, _ in timed:
+        for instruction, theme in timed:
             took = latency(parser, scorer, config, instruction, runs=args.runs, theme=theme)
             print(
                 f"latency of {instruction!r} with {took['objects']} objects: median {took['median ms']:.2f} ms, "

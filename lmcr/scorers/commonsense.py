@@ -27,6 +27,7 @@ import numpy as np
 from lmcr.errors import LMCRError, one_line
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
+from lmcr.scorers.within_role import centred, role_sets
 
 # The ConceptNet relation that states a role of a frame, and which way round (see the module's docstring).
 RELATION_OF_ROLE = {"Destination": "AtLocation", "Source": "AtLocation", "Instrument": "UsedFor"}
@@ -294,19 +295,11 @@ def commonsense_scorer(
             for f in frames
         ]
         flat = model.log_prob([t for e in edges for t in e])
-        raw, at = [], 0
-        for e in edges:
-            raw.append(sum(flat[at : at + len(e)]))
+        raw, at = {}, 0
+        for i, e in enumerate(edges):
+            raw[i] = sum(flat[at : at + len(e)])
             at += len(e)
-        groups: dict[tuple, list[int]] = {}
-        for i, f in enumerate(frames):
-            groups.setdefault((f.predicate, tuple(sorted(f.role_map))), []).append(i)
-        out = [0.0] * len(frames)
-        for members in groups.values():
-            mean = sum(raw[i] for i in members) / len(members)
-            for i in members:
-                out[i] = weight * (raw[i] - mean)
-        return out
+        return centred(raw, role_sets(frames), len(frames), weight)
 
     return score
 

@@ -40,6 +40,7 @@ from __future__ import annotations
 from collections.abc import Callable, Collection
 
 from lmcr.frame import Frame
+from lmcr.scorers.within_role import centred, role_sets
 
 WEIGHT = 0.75
 PLACEHOLDER = "it"  # what a stated filler is said as: an object pronoun the sentence templates read as such
@@ -64,6 +65,11 @@ def masked(frame: Frame, roles: Collection[str]) -> Frame:
     return Frame.of(frame.predicate, {r: PLACEHOLDER if r in roles else v for r, v in frame.roles})
 
 
+def _read(frame: Frame, learned: Collection[str]) -> bool:
+    """Whether the term reads a frame's group: a learned predicate's, with a Theme and another role."""
+    return frame.predicate in learned and "Theme" in frame.role_map and len(frame.roles) > 1
+
+
 def stated_pmi_scorer(
     lm: LMScores, learned: Collection[str], weight: float = WEIGHT
 ) -> Callable[[list[Frame], str], list[float]]:
@@ -72,25 +78,15 @@ def stated_pmi_scorer(
     tool role; 0 for the others (the eleven among them)."""
 
     def score(frames: list[Frame], context: str = "") -> list[float]:
-        groups: dict[tuple, list[int]] = {}
-        for i, frame in enumerate(frames):
-            if frame.predicate in learned and "Theme" in frame.role_map and len(frame.roles) > 1:
-                groups.setdefault((frame.predicate, tuple(sorted(frame.role_map))), []).append(i)
+        groups = [g for g in role_sets(frames) if _read(frames[g[0]], learned)]
         nulls: dict[int, Frame] = {}
-        for members in groups.values():
+        for members in groups:
             hide = stated_roles([frames[i] for i in members])
             if hide and not TOOLS & (set(frames[members[0]].role_map) - set(hide)):
                 nulls |= {i: masked(frames[i], hide) for i in members}
         # each distinct masked frame once: when the Theme is masked, candidates of one place share one
         texts = sorted(set(nulls.values()), key=lambda n: n.key)
         logp = dict(zip(texts, lm(texts, context))) if texts else {}
-        out = [0.0] * len(frames)
-        for members in groups.values():
-            if members[0] not in nulls:
-                continue
-            mean = sum(logp[nulls[i]] for i in members) / len(members)
-            for i in members:
-                out[i] = -weight * (logp[nulls[i]] - mean)
-        return out
+        return centred({i: -logp[null] for i, null in nulls.items()}, groups, len(frames), weight)
 
     return score
