@@ -21,7 +21,7 @@ from lmcr.robot import tasks
 from lmcr.robot.baxter import ARM_CHAIN, urdf_text
 from lmcr.robot.budget import Budget
 from lmcr.robot.description import baxter_urdf
-from lmcr.robot.detect import detect
+from lmcr.robot.detect import VIEWS, detect
 from lmcr.robot.scene import (
     TABLE_TOP,
     X_LIMIT,
@@ -222,6 +222,20 @@ def test_detection_matches_ground_truth(sim, tmp_path):
     for obj in scene.objects:
         x, y = world_xy(obj.xy)
         assert np.hypot(found[obj.label].position[0] - x, found[obj.label].position[1] - y) < 0.015
+
+
+def test_an_object_hidden_from_above_by_a_cupboard_is_seen_from_the_side(sim, tmp_path):
+    """A sponge lying behind the countertop cupboard (45 cm tall) is under the cupboard's top in the overhead
+    view; the views from above the table's ends see it, and what the overhead view sees keeps its place."""
+    scene = make_scene([("cabinet", [0.003, -0.159]), ("sponge", [0.118, -0.418]), ("cup", [-0.1, 0.2])])
+    build_world(scene, tmp_path)
+    overhead = {d.label: d for d in detect(scene.bodies, views=VIEWS[:1])}
+    assert set(overhead) == {"cabinet", "cup"}
+    found = {d.label: d for d in detect(scene.bodies)}
+    assert set(found) == {"cabinet", "sponge", "cup"}
+    assert found["cup"] == overhead["cup"]
+    x, y = world_xy(scene.objects[1].xy)
+    assert np.hypot(found["sponge"].position[0] - x, found["sponge"].position[1] - y) < 0.03
 
 
 @pytest.fixture(scope="module")
