@@ -291,6 +291,26 @@ def test_context_read_on_from_the_frames_equals_scoring_the_whole_text(overfit, 
     assert scorer.score_frames([], context="for the kettle") == []
 
 
+def test_groups_read_in_one_pass_score_as_each_group_alone(overfit, tmp_path):
+    """A completion's frames and the stated_pmi term's masked frames are read in one walk and one context
+    read: each group's scores, the context read after its own best CONTEXT_TOP, are those it gets alone."""
+    model, vocab, _ = overfit
+    scorer = LMScorer(ckpt.load(ckpt.publish(tmp_path, Setting("sentence"), model, vocab, {}, {})), precision="fp32")
+    cups = [("pour", {"Theme": "water", "Destination": f"cup{i}"}) for i in range(CONTEXT_TOP + 2)]
+    masked = [("pour", {"Theme": "it", "Destination": "cup"}), ("pour", {"Theme": "it", "Destination": "glass"})]
+    groups = [cups, masked, [], cups[:1]]
+    for context in ("", "for my tea"):
+        together = scorer.score_frame_groups(groups, context)
+        alone = [scorer.score_frames(group, context) for group in groups]
+        assert [len(g) for g in together] == [len(g) for g in groups]
+        for one, other in zip(together, alone):
+            assert one == pytest.approx(other, abs=1e-4)
+    mixed = MixedLM([(0.7, scorer), (0.3, scorer)])
+    together = mixed.score_frame_groups(groups, "for my tea")
+    for one, group in zip(together, groups):
+        assert one == pytest.approx(mixed.score_frames(group, "for my tea"), abs=1e-4)
+
+
 def test_a_corpus_mixture_interpolates_the_household_lm(overfit, tmp_path, monkeypatch):
     from lmcr.scorers import lm_checkpoints
     from lmcr.scorers.mixture import Mixture

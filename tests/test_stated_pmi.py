@@ -123,9 +123,10 @@ def test_heating_in_a_glass_is_left_to_the_verb_and_the_eleven_score_zero():
 
 
 def test_the_registry_term_reads_the_sentence_lm_the_method_loaded(tmp_path, monkeypatch):
-    """'sentence_lm+stated_pmi' loads the checkpoint once; a checkpoint trained again is loaded again. The
-    masked frames are read with the context too."""
-    loads, contexts = [], []
+    """'sentence_lm+stated_pmi' loads the checkpoint once, and reads the request's frames and the term's
+    masked frames in one pass, with the context; a checkpoint trained again is loaded again. The sum is
+    what the parts scored alone give."""
+    loads, passes = [], []
 
     class Loaded:
         lex = None
@@ -134,8 +135,12 @@ def test_the_registry_term_reads_the_sentence_lm_the_method_loaded(tmp_path, mon
             loads.append(self)
 
         def score_frames(self, frames, context=""):
-            contexts.append(context)
+            passes.append(([list(frames)], context))
             return StandInLM()(frames, context)
+
+        def score_frame_groups(self, groups, context=""):
+            passes.append((groups, context))
+            return [StandInLM()(group, context) for group in groups]
 
     manifest = {"sha": "a"}
     monkeypatch.setattr(registry, "load_lm", lambda res, lin, corpus: Loaded())
@@ -145,10 +150,14 @@ def test_the_registry_term_reads_the_sentence_lm_the_method_loaded(tmp_path, mon
     res = MethodResources(checkpoints=tmp_path, predicates=False)
     scorer = registry.make_scorer("sentence_lm+stated_pmi", res)
     frames = [put_away("stained shirt", "bed"), put_away("stained shirt", "hamper")]
-    plain = registry.make_scorer("sentence_lm", res)(frames)
+    plain = registry.make_scorer("sentence_lm", res)(frames, "for my tea")
+    term = registry.make_scorer("stated_pmi", res)(frames, "for my tea")
+    passes.clear()
     summed = scorer(frames, "for my tea")
     assert len(loads) == 1 and summed[1] > summed[0] and plain[0] > plain[1]
-    assert contexts[-2:] == ["for my tea", "for my tea"]  # the LM's own reading, then the term's
+    assert summed == pytest.approx([p + t for p, t in zip(plain, term)])
+    masked_frames = [put_away(PLACEHOLDER, "bed"), put_away(PLACEHOLDER, "hamper")]
+    assert passes == [([frames, masked_frames], "for my tea")]  # one pass, the context read after both
     assert registry.SCORERS["stated_pmi"].within_role and "stated_pmi" in registry.TERMS
     manifest["sha"] = "b"  # trained again
     registry.make_scorer("sentence_lm+stated_pmi", res)

@@ -32,6 +32,7 @@ request's best guess unchanged). "fp32" keeps every product in fp32.
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -239,13 +240,17 @@ class LMScorer:
         return [_normed(total, n, norm) for total, n in self.logprobs(texts)]
 
     def score_frames(
-        self, frames: list[tuple[str, dict[str, str]]], context: str = "", norm: str = "sum"
+        self,
+        frames: list[tuple[str, dict[str, str]]],
+        context: str = "",
+        norm: str = "sum",
+        spans: list[tuple[int, int]] | None = None,
     ) -> list[float]:
         """Scores of complete frames (predicate, roles) in this checkpoint's linearisation; with
         `context`, of each frame's text followed by it ("pour milk into mug" + "for my tea"): the score
         adds log P(context | frame), how well the frame serves what was said around it (`add_context`:
-        read after the CONTEXT_TOP best frames). The context continues the LSTM from where each frame's
-        text ended (`_Walk`), so the frames are not read twice."""
+        read after the CONTEXT_TOP best frames of each of `spans`, by default all). The context continues
+        the LSTM from where each frame's text ended (`_Walk`), so the frames are not read twice."""
         if norm not in NORMS:  # a bug: no command or configuration sets `norm`
             raise ValueError(f"norm must be one of {NORMS}")
         ctx = self.context_ids(context)
@@ -259,7 +264,13 @@ class LMScorer:
             extra = self.context_logprobs(walk, top, ctx)
             return [_normed(walk.totals[i] + x, lengths[i] + len(ctx), norm) - scores[i] for i, x in zip(top, extra)]
 
-        return add_context(scores, gains)
+        return add_context(scores, gains, spans)
+
+    def score_frame_groups(
+        self, groups: list[list[tuple[str, dict[str, str]]]], context: str = ""
+    ) -> list[list[float]]:
+        """`score_frames` of each group, all read in one pass (`in_one_pass`)."""
+        return in_one_pass(self.score_frames, groups, context)
 
     def frame_texts(self, frames: list[tuple[str, dict[str, str]]]) -> list[str]:
         return [linearize(self.checkpoint.linearization, predicate, roles, self.lex) for predicate, roles in frames]
@@ -391,14 +402,36 @@ class _Walk:
     states: list[tuple[torch.Tensor, torch.Tensor]]
 
 
-def add_context(scores: list[float], gains_of: Callable[[list[int]], list[float]]) -> list[float]:
-    """`scores` plus each frame's context term: `gains_of(top)` for the CONTEXT_TOP best frames, the
-    lowest of those for the others. Every frame that reads the context costs a softmax over the
-    vocabulary per word, and a frame this far down is not what was meant."""
-    top = sorted(range(len(scores)), key=lambda i: -scores[i])[:CONTEXT_TOP]
-    gains = dict(zip(top, gains_of(top)))
-    floor = min(gains.values())
-    return [s + gains.get(i, floor) for i, s in enumerate(scores)]
+def add_context(
+    scores: list[float], gains_of: Callable[[list[int]], list[float]], spans: list[tuple[int, int]] | None = None
+) -> list[float]:
+    """`scores` plus each frame's context term: `gains_of(tops)` for the CONTEXT_TOP best frames of each
+    span of frames (`spans`, [start, end) each; by default all the frames), the lowest of a span's for its
+    others. Every frame that reads the context costs a softmax over the vocabulary per word, and a frame
+    this far down is not what was meant. The spans' best are read in one call."""
+    spans = [(0, len(scores))] if spans is None else spans
+    tops = [sorted(range(*span), key=lambda i: -scores[i])[:CONTEXT_TOP] for span in spans]
+    read = [i for top in tops for i in top]
+    gains = dict(zip(read, gains_of(read))) if read else {}
+    out = list(scores)
+    for (start, end), top in zip(spans, tops):
+        floor = min((gains[i] for i in top), default=0.0)
+        for i in range(start, end):
+            out[i] += gains.get(i, floor)
+    return out
+
+
+def in_one_pass(
+    score_frames: Callable[..., list[float]], groups: list[list[tuple[str, dict[str, str]]]], context: str
+) -> list[list[float]]:
+    """Each group's scores, as `score_frames(group, context)` gives them, from one call on all the groups'
+    frames: one walk of their texts' trie and one read of the context after the best of each group, not a
+    walk and a read per group (a completion's frames and the stated_pmi term's masked frames)."""
+    frames = [f for group in groups for f in group]
+    ends = list(itertools.accumulate(len(group) for group in groups))
+    spans = list(zip([0, *ends[:-1]], ends))
+    scores = score_frames(frames, context, spans=spans) if frames else []
+    return [scores[start:end] for start, end in spans]
 
 
 class MixedLM:
@@ -417,8 +450,11 @@ class MixedLM:
             raise ValueError("a mixture's LMs must read a frame as the same text")
         self.experts = [(math.log(w), lm) for w, lm in experts]
 
-    def score_frames(self, frames: list[tuple[str, dict[str, str]]], context: str = "") -> list[float]:
-        """log sum_i w_i P_i(frame), plus log P_1(context | frame) with a context."""
+    def score_frames(
+        self, frames: list[tuple[str, dict[str, str]]], context: str = "", spans: list[tuple[int, int]] | None = None
+    ) -> list[float]:
+        """log sum_i w_i P_i(frame), plus log P_1(context | frame) with a context (read after the best of
+        each of `spans`, as `LMScorer.score_frames`)."""
         (_, first), *rest = self.experts
         ctx = first.context_ids(context)
         texts = first.frame_texts(frames)  # once: the experts read frames alike
@@ -427,7 +463,13 @@ class MixedLM:
         mixed = [logsumexp([w + s for (w, _), s in zip(self.experts, values)]) for values in zip(*columns)]
         if walk is None:
             return mixed
-        return add_context(mixed, lambda top: first.context_logprobs(walk, top, ctx))
+        return add_context(mixed, lambda top: first.context_logprobs(walk, top, ctx), spans)
+
+    def score_frame_groups(
+        self, groups: list[list[tuple[str, dict[str, str]]]], context: str = ""
+    ) -> list[list[float]]:
+        """`score_frames` of each group, all read in one pass (`in_one_pass`)."""
+        return in_one_pass(self.score_frames, groups, context)
 
 
 def logsumexp(values: list[float]) -> float:

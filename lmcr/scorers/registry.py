@@ -67,20 +67,48 @@ class ScorerSpec:
     within_role: bool = False
 
 
+class SharedLM:
+    """A loaded LM (`LMScorer` or `MixedLM`) as the scorer of its method, `(frames, context) -> scores`,
+    that other parts of a sum can read frames of their own with, in the same pass as the method's frames
+    (`read_together`): the stated_pmi term's masked frames are a second set of texts after the same verb,
+    and one walk and one context read for both cost about two thirds of two."""
+
+    def __init__(self, lm):
+        self.lm = lm
+        self._read: dict[tuple, list[float]] = {}  # what read_together read, each group until it is asked for
+
+    def __call__(self, frames: list[Frame], context: str = "") -> list[float]:
+        done = self._read.pop((tuple(frames), context), None)
+        return done if done is not None else self.lm.score_frames(frames, context)
+
+    def read_together(self, groups: list[list[Frame]], context: str = "") -> None:
+        """Read the groups of frames in one pass; each group's scores are then what the next call with just
+        those frames and that context returns (the same scores a call of its own gives, up to the last bits
+        of a batched product)."""
+        scores = self.lm.score_frame_groups(groups, context)
+        self._read = {(tuple(group), context): values for group, values in zip(groups, scores)}
+
+
 class SummedScorer:
     """'a+b+...': the parts' scores summed (for log-probability methods, a product of experts).
     `with_roles` also gives the sum of the parts that choose among open roles (all but the within-role
-    terms), each part scored once."""
+    terms), each part scored once. A part that reads frames of its own with an LM the sum scores with
+    (its `lm` is a `SharedLM` part; its `lm_frames(frames)` those frames) has them read in that LM's pass."""
 
     def __init__(self, parts: list[tuple[Scorer, bool]]):
         self.parts = parts
         self.has_within_role = any(within_role for _, within_role in parts)
+        lms = [part for part, _ in parts if isinstance(part, SharedLM)]
+        self.riders = [part for part, _ in parts if any(getattr(part, "lm", None) is lm for lm in lms)]
 
     def __call__(self, frames: list[Frame], context: str = "") -> list[float]:
         return self.with_roles(frames, context)[0]
 
     def with_roles(self, frames: list[Frame], context: str = "") -> tuple[list[float], list[float]]:
         """(the full sums, the sums without the within-role terms)."""
+        for rider in self.riders:
+            if extra := rider.lm_frames(frames):  # none for the eleven's frames: nothing to join
+                rider.lm.read_together([frames, extra], context)
         full, roles = [0.0] * len(frames), [0.0] * len(frames)
         for part, within_role in self.parts:
             for k, score in enumerate(part(frames, context)):
@@ -91,8 +119,8 @@ class SummedScorer:
 
 # The last LM scorer built, by its linearisation, resources, checkpoint manifests and experts' shares (a
 # checkpoint trained again is loaded again): `stated_pmi` reads the sentence LM that `sentence_lm` loaded
-# just before it, instead of loading the checkpoints twice.
-_LAST_LM: dict[tuple, Callable[..., list[float]]] = {}
+# just before it, instead of loading the checkpoints twice (and, in a sum of both, in the same pass).
+_LAST_LM: dict[tuple, SharedLM] = {}
 
 
 def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., list[float]]]:
@@ -108,7 +136,7 @@ def _lm_scorer(linearization: str) -> Callable[[MethodResources], Callable[..., 
         for _, expert in experts:
             expert.lex = lex  # the parser's predicates: the eleven and those learned beside the store
         _LAST_LM.clear()
-        _LAST_LM[key] = experts[0][1].score_frames if len(experts) == 1 else MixedLM(experts).score_frames
+        _LAST_LM[key] = SharedLM(experts[0][1] if len(experts) == 1 else MixedLM(experts))
         return _LAST_LM[key]
 
     return build
@@ -355,6 +383,8 @@ def make_scorer(method: str, res: MethodResources) -> Scorer:
         raise MethodUnavailable(f"unknown method {method!r}; available: {', '.join(METHODS)}")
     spec = SCORERS[method]
     score = spec.build(res)
+    if spec.reads_context and (isinstance(score, SharedLM) or hasattr(score, "lm_frames")):
+        return score  # as built: a sum reads a rider's frames in its LM's pass (`SummedScorer`)
     if spec.reads_context:
         return lambda frames, context="": score(frames, context=context)
     return lambda frames, context="": score(frames)

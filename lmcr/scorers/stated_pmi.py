@@ -31,8 +31,9 @@ masked and no role excepted, it raised their Table I (0.922 to 0.930) but cost a
 the milk" chose the glass, which milk goes with far more than a pot does, once the verb's own dislike of
 heating in a glass was mostly taken out (a tool again). With tools excepted it gave Table I 0.926 and
 the same dev instructions as without it, while a request's LM reading took half as long again or more
-(the masked frames are a second reading of as many texts: "pour me some water" among 40 objects, p50
-6.7 ms without the term, 10.6 ms with it): not worth it where it changes nothing the dev sets see.
+(the masked frames were then a second reading of as many texts: "pour me some water" among 40 objects,
+p50 6.7 ms without the term, 10.6 ms with it): not worth it where it changes nothing the dev sets see.
+The masked frames are now read in the sentence LM's own pass (`lm_frames`, `registry.SharedLM`).
 """
 
 from __future__ import annotations
@@ -70,23 +71,37 @@ def _read(frame: Frame, learned: Collection[str]) -> bool:
     return frame.predicate in learned and "Theme" in frame.role_map and len(frame.roles) > 1
 
 
-def stated_pmi_scorer(
-    lm: LMScores, learned: Collection[str], weight: float = WEIGHT
-) -> Callable[[list[Frame], str], list[float]]:
+class StatedPMI:
     """The term over the sentence LM's frame scorer `lm` (frames and the instruction's context): for the
     frames of the `learned` predicates that have a Theme and another role and whose candidates fill no
-    tool role; 0 for the others (the eleven among them)."""
+    tool role; 0 for the others (the eleven among them). `lm_frames` are the masked frames it reads: a sum
+    with the sentence LM reads them in the LM's own pass (`registry.SummedScorer`)."""
 
-    def score(frames: list[Frame], context: str = "") -> list[float]:
-        groups = [g for g in role_sets(frames) if _read(frames[g[0]], learned)]
+    def __init__(self, lm: LMScores, learned: Collection[str], weight: float = WEIGHT):
+        self.lm, self.learned, self.weight = lm, learned, weight
+
+    def _masked(self, frames: list[Frame]) -> tuple[list[list[int]], dict[int, Frame]]:
+        """(the role sets it reads, the masked frame of each of their frames)."""
+        groups = [g for g in role_sets(frames) if _read(frames[g[0]], self.learned)]
         nulls: dict[int, Frame] = {}
         for members in groups:
             hide = stated_roles([frames[i] for i in members])
             if hide and not TOOLS & (set(frames[members[0]].role_map) - set(hide)):
                 nulls |= {i: masked(frames[i], hide) for i in members}
-        # each distinct masked frame once: when the Theme is masked, candidates of one place share one
-        texts = sorted(set(nulls.values()), key=lambda n: n.key)
-        logp = dict(zip(texts, lm(texts, context))) if texts else {}
-        return centred({i: -logp[null] for i, null in nulls.items()}, groups, len(frames), weight)
+        return groups, nulls
 
-    return score
+    def lm_frames(self, frames: list[Frame]) -> list[Frame]:
+        """The masked frames the term reads for `frames`, each once: when the Theme is masked, candidates
+        for one place share one."""
+        return sorted(set(self._masked(frames)[1].values()), key=lambda n: n.key)
+
+    def __call__(self, frames: list[Frame], context: str = "") -> list[float]:
+        groups, nulls = self._masked(frames)
+        texts = sorted(set(nulls.values()), key=lambda n: n.key)
+        logp = dict(zip(texts, self.lm(texts, context))) if texts else {}
+        return centred({i: -logp[null] for i, null in nulls.items()}, groups, len(frames), self.weight)
+
+
+def stated_pmi_scorer(lm: LMScores, learned: Collection[str], weight: float = WEIGHT) -> StatedPMI:
+    """The term (`StatedPMI`) over the sentence LM's frame scorer `lm`, for the `learned` predicates."""
+    return StatedPMI(lm, learned, weight)
