@@ -20,7 +20,7 @@ from pathlib import Path
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
-from lmcr.grounding import ground_roles, objects_named, referents, served_vessel, speaker_destination
+from lmcr.grounding import ground_roles, grounded, objects_named, referents, served_vessel, speaker_destination
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.lm.threads import request_threads
@@ -250,14 +250,17 @@ def complete(
         return replace(read, frame=Frame.of(frame.predicate, roles), instances=_instances(roles, ids_of))
     spec = parser.lex.predicates[frame.predicate]
     config = config.calibrated_for(frame.predicate in parser.lex.learned)
-    pool = _pool(frame.predicate, roles, missing, [o for o in detected if o not in stated], ignored, config)
+    # "hand me something to cut the bread with": the thing is also scored as what it is for (cut bread with
+    # it), and what the purpose states (the bread) is not the thing, as what the request states is not
+    purpose = purpose_of(doc, frame, parser.lex, parser.compounds) if "Theme" in missing else None
+    for_purpose = {grounded(v, set(detected)) for v in purpose.roles.values()} if purpose else set()
+    free = [o for o in detected if o not in stated and o not in for_purpose]
+    pool = _pool(frame.predicate, roles, missing, free, ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
         scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
-    # "hand me something to cut the bread with": the thing is also scored as what it is for (cut bread with it)
-    purpose = purpose_of(doc, frame, parser.lex, parser.compounds) if "Theme" in missing else None
     if purpose is not None and all("Theme" in f for f in fillings):
         scores = [s + p for s, p in zip(scores, _purpose_scores(scorer, purpose, fillings))]
     probs = softmax(scores, config.temperature)

@@ -627,6 +627,28 @@ def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(le
     assert named.frame.role_map == {"Theme": "spoon", "Destination": "person"} and named.missing is None
 
 
+def test_a_purpose_is_read_with_the_roles_it_states_and_what_it_states_is_not_the_thing(learned_parser):
+    """ "bring me something to wipe": the purpose frame is wipe with a Theme alone, read as "wipe plate"
+    (wipe's sentence has an Instrument; it had stopped the whole batch: "cannot linearise wipe with
+    ['Instrument'] unfilled"). "bring me something to cut the bread with": the bread is what the thing is
+    for, not the thing, however much the scorer likes bringing bread."""
+    from lmcr.complete import CompletionConfig, complete
+    from lmcr.lm.linearize import sentence_text
+
+    liked = {"wipe plate": 4.0, "cut bread with the knife": 2.0}
+
+    def scorer(frames, context=""):
+        texts = [sentence_text(f.predicate, dict(f.role_map), learned_parser.lex) for f in frames]
+        return [liked.get(t, 3.0 if t.startswith("bring bread") else 0.0) for t in texts]
+
+    objects = ["bread", "knife", "plate", "sponge", "person"]
+    wiped = complete(learned_parser, scorer, "bring me something to wipe", objects, CompletionConfig())
+    assert wiped.frame.role_map == {"Theme": "plate", "Destination": "person"}, wiped
+    cut = complete(learned_parser, scorer, "bring me something to cut the bread with", objects, CompletionConfig())
+    assert cut.frame.role_map == {"Theme": "knife", "Destination": "person"}, cut
+    assert "bread" not in [c.object for c in cut.candidates]
+
+
 def test_a_tool_in_the_hand_is_the_one_the_request_names(sim, tmp_path, learned_parser):
     """ "stir the batter with the whisk" with the whisk in the hand: the stated whisk is the held one (no
     whisk on the table, and the word is no kitchen object the lexicon knows), so nothing is asked and the

@@ -16,7 +16,7 @@ from lmcr.lexicon import load_lexicon
 from lmcr.lm import checkpoint as ckpt
 from lmcr.lm import score as score_module
 from lmcr.lm.data import bucket_batches, split_by_document
-from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens
+from lmcr.lm.linearize import frame_text, linearize, sentence_text, tokens, without_roles
 from lmcr.lm.model import LMConfig, RecurrentLM
 from lmcr.lm.score import CONTEXT_TOP, NORMS, LMScorer, MixedLM
 from lmcr.lm.train import (
@@ -54,6 +54,12 @@ def test_linearisations():
     assert frame_text("add", {"Theme": "shallot", "to": "pan"}) == "add shallot pan"
     with pytest.raises(ValueError, match="unfilled"):
         sentence_text("pour", {"Theme": "water", "Destination": None})
+    # a role the frame does not have is not said, nor its preposition (a purpose clause's frame)
+    assert sentence_text("pour", {"Theme": "water"}) == "pour water"
+    assert sentence_text("fill", {"Destination": "pot"}) == "fill the pot"
+    assert sentence_text("season", {"Instrument": "salt"}) == "season with salt"
+    assert without_roles("put {Theme} away in the {Destination}", ["Destination"]) == "put {Theme} away"
+    assert without_roles("dispose of {Theme} in the {Destination}", ["Theme"]) == "dispose in the {Destination}"
     assert tokens("Pour 1 1/2 cups of Milk's foam, then stir.") == [
         "pour",
         "<num>",

@@ -40,16 +40,29 @@ def frame_text(predicate: str, roles: dict[str, str | None], lex: Lexicon | None
 
 def sentence_text(predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:
     """'pour water into the cup': the lexicon's sentence template with every role filled (a learned
-    predicate's template for the roles the frame has)."""
+    predicate's template for the roles the frame has). A role the frame does not have at all is not said,
+    nor the preposition that introduces it (`without_roles`)."""
     lex = lex or load_lexicon()
     spec = lex.predicates.get(predicate)
     if spec is None:
         raise KeyError(f"no sentence template for predicate {predicate!r}")
     template = spec.template(roles)
+    template = without_roles(template, [r for r in re.findall(r"\{(\w+)\}", template) if r not in roles])
     missing = [r for r in re.findall(r"\{(\w+)\}", template) if not roles.get(r)]
     if missing:  # a bug: scorers are only given complete frames
         raise ValueError(f"cannot linearise {predicate} with {missing} unfilled")
     return template.format(**roles)
+
+
+def without_roles(template: str, absent: list[str]) -> str:
+    """The template without the phrases of the `absent` roles: each role's slot with the preposition (and
+    "the") before it ("eat {Theme} with the {Instrument}" without the Instrument: "eat {Theme}"), or the
+    bare slot of an object (without the Theme: "eat with the {Instrument}"). A purpose clause's frame
+    has only the roles the clause states and the thing asked for ("bring me something to eat": eat, Theme
+    the thing), and no template of a verb was written for it."""
+    for role in absent:
+        template = re.sub(rf"(?: [a-z]+(?: the)?)? ?\{{{role}\}}", "", template, count=1)
+    return template.strip()
 
 
 def linearize(linearization: str, predicate: str, roles: dict[str, str], lex: Lexicon | None = None) -> str:
