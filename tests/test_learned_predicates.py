@@ -619,3 +619,39 @@ def test_without_a_prototype_no_class_is_guessed(tmp_path):
     frames = [f for f in _kitchen() if f[0] != "put"]
     table = learn_predicates(_store(tmp_path, frames), HAND)
     assert table.predicates and all(p.motion is None for p in table.predicates.values())
+
+
+@pytest.mark.model
+@pytest.mark.parametrize(
+    "instruction, predicate, roles",
+    [
+        ("get rid of the peel", "get rid", {"Theme": "peel", "Destination": None}),  # get/auxpass rid/ROOT
+        ("the milk has gone sour, get rid of it", "get rid", {"Theme": "it", "Destination": None}),  # rid/acomp
+        ("could you get rid of it in the bowl?", "get rid", {"Theme": "it", "Destination": "bowl"}),
+        ("I got rid of the peel. Can you bake the cake?", "bake", {"Theme": "cake", "Instrument": None}),
+        ("get the milk", "get", {"Theme": "milk"}),  # the light verb alone is itself
+    ],
+)
+def test_get_rid_of_is_one_prepositional_verb_whatever_the_parse(tmp_path, instruction, predicate, roles):
+    """ "get rid of it": the parser reads "rid" as the root with "get" its passive auxiliary, or as get's
+    adjectival complement; either way the pair names the predicate, learned as dispose is (its Theme the
+    of-phrase), and "get" makes no frame of its own (it had read "get rid of it" as get, Theme milk, into
+    the fridge). Without the verb learned, the request is no "get" frame either."""
+    from lmcr.srl.instruction import parse_instruction
+    from lmcr.srl.parser import FrameParser, load_nlp
+
+    frames = _kitchen() + [("get rid", {"of": "peel", "in": "bowl"}, False)] * 25
+    con = _store(tmp_path, frames)
+    table = learn_predicates(con, HAND)
+    assert table.predicates["get rid"].sentence == "get rid of {Theme} in the {Destination}"
+    publish_predicates(con, table, tmp_path / PREDICATES_FILE, "b")
+    con.close()
+    nlp = load_nlp()
+    parser = FrameParser(nlp, load_lexicon(learned=tmp_path / PREDICATES_FILE))
+    if predicate == "get":  # not learned from this corpus: a generic frame
+        assert [(m.predicate, m.roles) for m in parser.parse(instruction)] == [(predicate, roles)]
+        return
+    frame = parse_instruction(parser, instruction)
+    assert (frame.predicate, frame.roles) == (predicate, roles)
+    plain = FrameParser(nlp, HAND).parse(instruction)
+    assert "get" not in [m.predicate for m in plain]

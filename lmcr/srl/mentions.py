@@ -27,6 +27,13 @@ PREP_DEPS = frozenset({"prep", "advmod", "prt", "agent", "dative"})
 ADVERB_PARTICLES = frozenset({"away", "back", "aside", "out", "up", "down", "off"})
 # Prepositions English also uses as particles ("stir in the sugar", "put on the lid"); "into" never is.
 PREP_PARTICLES = frozenset({"in", "on", "over", "off", "through", "around", "along", "about"})
+# English idioms of a light verb and a participle that take their object through a preposition ("get rid
+# of the peel"): the participle -> its verb. The pair names the predicate ("get rid", as "dispose" is named
+# without its "of") and the participle's phrases are its roles. The parser reads the participle as the
+# root with the verb its passive auxiliary ("get/auxpass rid/ROOT of it") or as the verb's adjectival
+# complement ("get/ROOT rid/acomp of it"); either way the verb alone is no frame ("get" the milk).
+LIGHT_VERB_IDIOMS = {"rid": "get"}
+IDIOM_DEPS = frozenset({"acomp", "oprd", "xcomp", "ccomp", "dobj"})
 # Where only a noun can stand: a word tagged as a verb there is a noun the tagger misread.
 NOUN_DEPS = frozenset({"dobj", "pobj", "nsubjpass", "attr", "appos"})
 # Tags of a noun phrase's words (POS: the possessive 's), and those a particle is tagged with; tags, since
@@ -74,8 +81,31 @@ class _Args:
     particles: list[str]
 
 
+def idiom_verb(token: Token) -> Token | None:
+    """The light verb of an idiom whose participle `token` is ("rid" in "get rid of it": the "get"), or None."""
+    verb = LIGHT_VERB_IDIOMS.get(token.lower_)
+    if verb is None:
+        return None
+    paired = [c for c in token.children if c.dep_ in ("auxpass", "aux") and c.i < token.i]
+    if token.dep_ in IDIOM_DEPS and token.head.i < token.i:
+        paired.append(token.head)
+    return next((t for t in paired if lemma_of(t) == verb or t.lower_ == verb), None)
+
+
+def _idiom_participle(token: Token) -> Token | None:
+    """The idiom participle `token` is the light verb of ("get" in "get rid of it"), or None."""
+    return next(
+        (c for c in token.children if c.i > token.i and (v := idiom_verb(c)) is not None and v.i == token.i), None
+    )
+
+
 def predicate_lemma(token: Token, lex: Lexicon) -> str | None:
-    """The predicate a verb token evokes, or None if it is no predicate (aux, adjective, noun, copula)."""
+    """The predicate a verb token evokes, or None if it is no predicate (aux, adjective, noun, copula). An
+    idiom's participle evokes the idiom ("rid" in "get rid of it": "get rid"), its light verb none."""
+    if (verb := idiom_verb(token)) is not None:
+        return f"{lemma_of(verb) or verb.lower_} {token.lower_}"
+    if _idiom_participle(token) is not None:
+        return None
     if not token.tag_.startswith("VB") or token.dep_ in NOT_PREDICATE_DEPS or not token.is_alpha:
         return None
     if _misread_noun(token):
@@ -186,7 +216,8 @@ def _attached_preps(token: Token, skip: frozenset[str]) -> list[tuple[str, Token
 
 
 def _collect(verb: Token, lex: Lexicon, spec: PredicateSpec | None) -> _Args:  # noqa: C901 - one rule per way the parser attaches arguments
-    objects = [c for c in verb.children if c.dep_ in OBJECT_DEPS]
+    # an idiom's passive-looking subject is its subject ("I got rid of the peel"): its object is the of-phrase
+    objects = [c for c in verb.children if c.dep_ in OBJECT_DEPS and not (c.dep_ == "nsubjpass" and idiom_verb(verb))]
     if not objects and any(c.dep_ == "dative" for c in verb.children):
         objects = [c for c in verb.children if c.dep_ == "npadvmod" and c.i > verb.i]  # "fry me an egg"
     if not objects:  # "fry a couple of eggs": the quantity read as an adverbial noun phrase
@@ -331,6 +362,10 @@ def _addressed(verb: Token) -> bool:
     clause that says what a thing is for ("hand me something to cut the bread with": cut)."""
     if verb.dep_ in NOUN_CLAUSE_DEPS:
         return False
+    light = idiom_verb(verb)
+    verb = (
+        light if light is not None and light.i == verb.head.i else verb
+    )  # "I got rid of it": the light verb's subject
     subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass")]
     return all(c.lower_ == "you" for c in subjects)
 
