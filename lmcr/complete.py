@@ -20,7 +20,15 @@ from pathlib import Path
 from lmcr.errors import LMCRError
 from lmcr.files import atomic_path
 from lmcr.frame import Frame
-from lmcr.grounding import ground_roles, grounded, objects_named, referents, served_vessel, speaker_destination
+from lmcr.grounding import (
+    conjoined,
+    ground_roles,
+    grounded,
+    objects_named,
+    referents,
+    served_vessel,
+    speaker_destination,
+)
 from lmcr.instances import assign_ids, ids_by_label
 from lmcr.lexicon import is_object_name
 from lmcr.lm.threads import request_threads
@@ -254,7 +262,8 @@ def complete(
     # it), and what the purpose states (the bread) is not the thing, as what the request states is not
     purpose = purpose_of(doc, frame, parser.lex, parser.compounds) if "Theme" in missing else None
     for_purpose = {grounded(v, set(detected)) for v in purpose.roles.values()} if purpose else set()
-    free = [o for o in detected if o not in stated and o not in for_purpose]
+    # "mix the flour and sugar": the sugar is mixed too, not what it is mixed with
+    free = [o for o in detected if o not in stated | for_purpose | conjoined(doc, frame, detected)]
     pool = _pool(frame.predicate, roles, missing, free, ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)

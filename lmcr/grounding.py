@@ -21,6 +21,19 @@ def grounded(value: str, known: set[str]) -> str | None:
     return next((" ".join(words[i:]) for i in range(len(words)) if " ".join(words[i:]) in known), None)
 
 
+def conjoined(doc, frame: FrameMention, detected: list[str]) -> set[str]:
+    """Detected objects the request names in coordination with a stated filler ("mix the flour and sugar":
+    the sugar is mixed too): they share its role, so none of them is what a missing role asks for (the
+    tool to mix with). English coordination, read from the parse."""
+    seen, found = set(detected), set()
+    for start, end in frame.spans.values():
+        inside = [t for t in doc if start <= t.idx < end]
+        for conj in (c for t in inside for c in t.conjuncts if not start <= c.idx < end and c.tag_.startswith("NN")):
+            name = grounded(doc[conj.left_edge.i : conj.i + 1].text.lower(), seen)
+            found |= {name} if name else set()
+    return found
+
+
 def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
     """Pronoun roles that refer back to a detected object the instruction named before them ("I'd love
     some wine, could you pour it?": Theme wine): the first of `antecedents` that names one and that no

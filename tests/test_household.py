@@ -649,6 +649,21 @@ def test_a_purpose_is_read_with_the_roles_it_states_and_what_it_states_is_not_th
     assert "bread" not in [c.object for c in cut.candidates]
 
 
+def test_an_object_named_beside_a_stated_filler_is_no_candidate_for_a_missing_role(learned_parser):
+    """ "stir the batter and the sugar": the sugar is stirred too, so it is not what to stir with, however
+    much the scorer likes stirring with it ("mix the flour and sugar" chose the sugar as the tool)."""
+    from lmcr.complete import CompletionConfig, complete
+
+    def scorer(frames, context=""):
+        return [3.0 if f.role_map.get("Instrument") == "sugar" else 0.0 for f in frames]
+
+    objects = ["batter", "sugar", "spoon", "bowl"]
+    out = complete(learned_parser, scorer, "stir the batter and the sugar", objects, CompletionConfig())
+    assert out.frame.role_map["Theme"] == "batter" and "sugar" not in [c.object for c in out.candidates], out
+    alone = complete(learned_parser, scorer, "stir the batter", objects, CompletionConfig())
+    assert alone.frame.role_map == {"Theme": "batter", "Instrument": "sugar"}, alone
+
+
 def test_a_tool_in_the_hand_is_the_one_the_request_names(sim, tmp_path, learned_parser):
     """ "stir the batter with the whisk" with the whisk in the hand: the stated whisk is the held one (no
     whisk on the table, and the word is no kitchen object the lexicon knows), so nothing is asked and the
