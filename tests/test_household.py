@@ -622,6 +622,11 @@ def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser)
     # what the verb asked for stays: "bring the cup" names no recipient
     unsaid = complete(learned_parser, _prefers("bowl"), "bring the cup", ["cup", "bowl", "person"])
     assert unsaid.frame.role_map["Destination"] == "bowl"
+    # "here" is where the person who asks is
+    here = complete(learned_parser, _prefers("bowl"), "bring the cup here", ["cup", "bowl", "person"])
+    assert here.frame.role_map["Destination"] == "person" and here.missing is None
+    nobody = complete(learned_parser, _prefers("bowl"), "bring the cup here", ["cup", "bowl"])
+    assert nobody.frame.role_map["Destination"] == "bowl"
 
 
 def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):
