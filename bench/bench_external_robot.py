@@ -26,12 +26,11 @@ from __future__ import annotations
 import argparse
 import collections
 import json
-import statistics
 import sys
 import tempfile
 from pathlib import Path
 
-from bench_end_to_end import SLOW, timed_batch
+from bench_end_to_end import timed_batch, timing
 from record import add_json_option, write_results
 
 from lmcr.evaluate.external import complete_line, right_predicate
@@ -171,7 +170,8 @@ def main() -> None:
     command = [sys.executable, "-m", "lmcr.cli", "execute", "--input", str(inp), "--output", str(outp)]
     command += ["--urdf", args.urdf] if args.urdf else []
     wall, times = timed_batch(command, outp)
-    per, reasons = tally(records, {o["id"]: o for o in map(json.loads, outp.read_text().splitlines())})
+    outs = {o["id"]: o for o in map(json.loads, outp.read_text().splitlines())}
+    per, reasons = tally(records, outs)
     figures = {"seed": args.seed, "items run": len(records)}
     for name in sorted({*per, *wrong, *unfit}):
         c, items = per[name], per[name]["n"] + wrong[name] + unfit[name]
@@ -191,21 +191,18 @@ def main() -> None:
         }
     total = sum(per.values(), collections.Counter())
     print("refused:", json.dumps(dict(reasons.most_common()), indent=1))
-    slow = sum(t > SLOW for t in times)
+    timed, timed_figures = timing(times, list(outs.values()))
     print(
         f"all: of {total['right']} completed right and run, {total['success']} executed successfully "
         f"({total['success'] / max(total['right'], 1):.3f}); {sum(unfit.values())} more did not fit; batch of "
-        f"{len(records)}: {wall:.0f} s; per instruction median {statistics.median(times):.1f} s, max "
-        f"{max(times):.1f} s, over {SLOW:.0f} s: {slow}"
+        f"{len(records)}: {wall:.0f} s; {timed}"
     )
     figures |= {
         "all: executed successfully, of those run": f"{total['success']}/{total['right']}",
         "all: scenes that did not fit": sum(unfit.values()),
         "all: executed plans that failed": total["failed"],
         "batch wall seconds": round(wall, 1),
-        "per instruction median s": round(statistics.median(times), 2),
-        "per instruction max s": round(max(times), 2),
-        f"instructions over {SLOW:.0f} s": slow,
+        **timed_figures,
     }
     write_results(args.json, "bench_external_robot", __doc__.splitlines()[0], figures)
 

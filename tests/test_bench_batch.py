@@ -40,6 +40,22 @@ def test_each_instruction_is_timed_as_its_line_appears(bench, tmp_path):
     assert times[0] >= 0.6 and wall >= sum(times) - 0.01
 
 
+def test_an_instruction_is_timed_on_its_own_clock_too(bench):
+    """The first interval between result lines holds the start of `lmcr execute`; each line's own
+    `seconds` do not, and an error line has none. Each count of those over SLOW is its own."""
+    outs = [
+        {"seconds": {"perceive_and_complete": 0.5, "plan_and_execute": 25.3}},
+        {"error": "no known predicate"},
+        {"seconds": {"perceive_and_complete": 0.2, "plan_and_execute": 1.0}},
+    ]
+    text, figures = bench.timing([31.5, 0.4, 1.3], outs)
+    assert figures["per instruction max s"] == 31.5 and figures["instructions over 30 s"] == 1
+    assert figures["first line s (with the start of lmcr execute)"] == 31.5
+    assert figures["own clock max s"] == 25.8 and figures["own clock over 30 s"] == 0
+    assert figures["own clock median s"] == pytest.approx(13.5)
+    assert "own clock: median 13.5 s, max 25.8 s, over 30 s: 0" in text
+
+
 def test_a_failed_batch_is_an_error(bench, tmp_path):
     with pytest.raises(subprocess.CalledProcessError):
         bench.timed_batch([sys.executable, "-c", "raise SystemExit(3)"], tmp_path / "out.jsonl")
