@@ -414,3 +414,34 @@ def test_proper_noun_tagged_modifiers_are_judged_by_the_corpus():
 )
 def test_quantities_and_phrases_hung_on_other_phrases(doc, expected):
     assert frames(doc) == [expected]
+
+
+def test_a_negated_request_asks_for_nothing():
+    """ "do not pour the milk": the frame is there, said not to be done, so it is no request; a request
+    beside it still is ("pour the milk, don't spill it"), and one asking only what not to do is refused
+    in one line that says so."""
+    from types import SimpleNamespace
+
+    from lmcr.srl.instruction import NoPredicateError, _first_known
+
+    negated = "do/VB/aux/2 not/RB/neg/2 pour/VB/ROOT/2 the/DT/det/4 milk/NN/dobj/2"
+    found = extract_frames(make_doc(negated), LEX)
+    assert [(f.predicate, f.negated) for f in found] == [("pour", True)]
+    with pytest.raises(
+        NoPredicateError, match="nothing to do in 'do not pour the milk': it asks the robot not to pour"
+    ):
+        _first_known(SimpleNamespace(lex=LEX), "do not pour the milk", found)
+    both = "pour/VB/ROOT/0 milk/NN/dobj/0 and/CC/cc/0 do/VB/aux/5 not/RB/neg/5 dump/VB/conj/0 water/NN/dobj/5"
+    chosen = _first_known(SimpleNamespace(lex=LEX), "", extract_frames(make_doc(both), LEX))
+    assert (chosen.predicate, chosen.roles["Theme"], chosen.negated) == ("pour", "milk", False)
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        "get/VB/auxpass/1 rid/VBN/ROOT/1 of/IN/prep/1 the/DT/det/4 peel/NN/pobj/2",  # get rid of the peel
+        "get/VB/ROOT/0 rid/JJ/acomp/0 of/IN/prep/1 the/DT/det/4 peel/NN/pobj/2",
+    ],
+)
+def test_get_rid_of_names_one_generic_frame_whichever_way_it_is_parsed(spec):
+    assert frames(spec) == [("get rid", {"of": "peel"})]

@@ -37,7 +37,7 @@ def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
 
 
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
-    known = [f for f in frames if f.known]
+    known = [f for f in frames if f.known and not f.negated]  # "don't pour the milk" asks for nothing
     if known:
         # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
         # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then what
@@ -56,8 +56,12 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
 
 
 def no_predicate(lex: Lexicon, text: str, frames: list[FrameMention]) -> str:
-    """Why a text with none of the robot's predicates has none, in one line: a verb the corpora say too
-    little about (named, with its evidence), else none of the learned verbs, else the hand-written ones."""
+    """Why a text with none of the robot's predicates has none, in one line: only a verb said not to be
+    done, a verb the corpora say too little about (named, with its evidence), else none of the learned
+    verbs, else the hand-written ones."""
+    negated = [f.predicate for f in frames if f.known and f.negated]
+    if negated:
+        return f"nothing to do in {text!r}: it asks the robot not to {negated[0]}"
     refused = [f.predicate for f in frames if f.predicate in lex.refused]
     if refused:
         return f"no known predicate in {text!r}: {lex.refusal(refused[0])}"

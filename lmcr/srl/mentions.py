@@ -60,6 +60,8 @@ class FrameMention:
     # sugar) instead of the verb and a phrase ("stir", Destination sugar); the corpus decides which
     # (`RolePriors.resolve`), and without its counts the phrase stands.
     particle_reading: FrameMention | None = None
+    # Said not to be done: "don't pour the milk", "never put the knife in the dishwasher".
+    negated: bool = False
 
     def missing(self) -> list[str]:
         return [role for role, value in self.roles.items() if value is None]
@@ -370,6 +372,13 @@ def _addressed(verb: Token) -> bool:
     return all(c.lower_ == "you" for c in subjects)
 
 
+def _negated(verb: Token) -> bool:
+    """Whether the verb (or an idiom's light verb: "don't get rid of it") is negated: "don't", "do not",
+    "never"."""
+    light = idiom_verb(verb)
+    return any(c.dep_ == "neg" for v in (verb, *([light] if light is not None else [])) for c in v.children)
+
+
 def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[FrameMention]:
     """Every predicate occurrence in `doc`, in text order; `compounds` (learned) decides adjective-tagged
     modifiers, without it only noun-tagged modifiers join a name."""
@@ -388,6 +397,7 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
             else _generic_frame(token, name, args, lex, compounds)
         )
         frame.addressed = _addressed(token)
+        frame.negated = _negated(token)
         if (reading := _particle_reading(token, lemma, name, args, lex)) is not None:
             frame.particle_reading = replace(_known_frame(token, *reading, lex, compounds), addressed=frame.addressed)
         frames.append(frame)
