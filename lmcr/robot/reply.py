@@ -142,6 +142,8 @@ def error_outcome(exc: Exception) -> dict:
         out.update(error_kind="incomplete", frame=exc.frame)
     elif getattr(exc, "unfit", None):  # a tool that cannot do what the verb's class does with it
         out.update(error_kind="unfit", doing=exc.unfit[0], reason=exc.unfit[1])
+    elif getattr(exc, "negated", None):  # asked only not to do something
+        out.update(error_kind="negated", predicate=exc.negated)
     elif any(c.__name__ == "NoPredicateError" for c in type(exc).__mro__):  # by name: no spaCy to import
         out["error_kind"] = "unknown_predicate"
         if getattr(exc, "predicate", None):  # understood, but no motion for it
@@ -159,6 +161,8 @@ def _error(outcome: Mapping, lexicon: Lexicon) -> str:
     kind = outcome.get("error_kind")
     if kind == "unknown_predicate":
         return _cannot_do(outcome.get("predicate"), lexicon)
+    if kind == "negated":
+        return f"All right, I won't {outcome['predicate']}."
     if kind == "absent":
         return f"I see no {outcome['absent']} on the table."  # "no" suits a cup and milk alike
     if kind == "unfit":

@@ -16,6 +16,14 @@ class NoPredicateError(LMCRError, ValueError):
     """An instruction with none of the robot's predicates."""
 
 
+class NothingAskedError(NoPredicateError):
+    """An instruction that only says what not to do ("don't pour the milk"); `negated` is that predicate."""
+
+    def __init__(self, message: str, negated: str):
+        super().__init__(message)
+        self.negated = negated
+
+
 def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
     """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
     parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
@@ -52,16 +60,15 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
                 -_open_rate(parser.lex, f),
             ),
         )
+    negated = [f.predicate for f in frames if f.known and f.negated]
+    if negated:
+        raise NothingAskedError(f"nothing to do in {text!r}: it asks the robot not to {negated[0]}", negated[0])
     raise NoPredicateError(no_predicate(parser.lex, text, frames))
 
 
 def no_predicate(lex: Lexicon, text: str, frames: list[FrameMention]) -> str:
-    """Why a text with none of the robot's predicates has none, in one line: only a verb said not to be
-    done, a verb the corpora say too little about (named, with its evidence), else none of the learned
-    verbs, else the hand-written ones."""
-    negated = [f.predicate for f in frames if f.known and f.negated]
-    if negated:
-        return f"nothing to do in {text!r}: it asks the robot not to {negated[0]}"
+    """Why a text with none of the robot's predicates has none, in one line: a verb the corpora say too
+    little about (named, with its evidence), else none of the learned verbs, else the hand-written ones."""
     refused = [f.predicate for f in frames if f.predicate in lex.refused]
     if refused:
         return f"no known predicate in {text!r}: {lex.refusal(refused[0])}"
