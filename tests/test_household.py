@@ -668,6 +668,10 @@ def test_a_purpose_is_read_with_the_roles_it_states_and_what_it_states_is_not_th
     cut = complete(learned_parser, scorer, "bring me something to cut the bread with", objects, CompletionConfig())
     assert cut.frame.role_map == {"Theme": "knife", "Destination": "person"}, cut
     assert "bread" not in [c.object for c in cut.candidates]
+    # the purpose clause's verb is one of the eleven: still no request of its own (it had been chosen first)
+    liked["pour milk"] = 4.0
+    poured = complete(learned_parser, scorer, "bring me something to pour", [*objects, "milk"], CompletionConfig())
+    assert poured.frame.to_json() == {"predicate": "bring", "roles": {"Theme": "milk", "Destination": "person"}}
 
 
 def test_an_object_named_beside_a_stated_filler_is_no_candidate_for_a_missing_role(learned_parser):

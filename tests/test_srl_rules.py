@@ -445,3 +445,20 @@ def test_a_negated_request_asks_for_nothing():
 )
 def test_get_rid_of_names_one_generic_frame_whichever_way_it_is_parsed(spec):
     assert frames(spec) == [("get rid", {"of": "peel"})]
+
+
+def test_a_clause_that_says_what_a_thing_is_for_is_never_the_request():
+    """ "get me something to pour the water into": pour describes the thing; with "get" unknown to the
+    hand-written lexicon, nothing is asked that the robot knows (pour had been chosen, the eleven first)."""
+    from types import SimpleNamespace
+
+    from lmcr.srl.instruction import NoPredicateError, _first_known
+
+    spec = (
+        "get/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 pour/VB/relcl/2 the/DT/det/6 "
+        "water/NN/dobj/4 into/IN/prep/4"
+    )
+    found = extract_frames(make_doc(spec), LEX)
+    assert [(f.predicate, f.describes) for f in found] == [("get", False), ("pour", True)]
+    with pytest.raises(NoPredicateError, match="no known predicate"):
+        _first_known(SimpleNamespace(lex=LEX), "get me something to pour the water into", found)

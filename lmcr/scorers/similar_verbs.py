@@ -69,11 +69,14 @@ class Relation:
             preps.add("with")
         return cls(spec.object_role, other, frozenset(preps))
 
-    def filler_pair(self, frame: Frame) -> tuple[str, str]:
-        """(object-role filler, other-role filler) of a complete frame."""
+    def filler_pair(self, frame: Frame) -> tuple[str, str] | None:
+        """(object-role filler, other-role filler) of a frame; None for a frame that has neither role or only
+        one of them (a purpose clause's frame: "hand me something to pour"). A role it has but left empty
+        is a bug: completion and evaluation fill every role they score."""
         roles = frame.role_map
-        # a bug: completion and evaluation score complete frames only
-        if not roles.get(self.object_role) or not roles.get(self.other_role):
+        if self.object_role not in roles or self.other_role not in roles:
+            return None
+        if not roles[self.object_role] or not roles[self.other_role]:
             raise ValueError(
                 f"similar_verbs scores complete frames: {frame.to_json()} lacks {self.object_role} or {self.other_role}"
             )
@@ -259,13 +262,15 @@ class SimilarVerbs:
 
     def score_frames(self, frames: list[Frame]) -> list[float]:
         """WEIGHT * (log P(o | a) + log P(a | o)) under each frame's predicate's pooled counts; 0 for a predicate
-        learned from the corpus (the tables are the hand-written eleven's, whose rare pairs they back off)."""
+        learned from the corpus (the tables are the hand-written eleven's, whose rare pairs they back off),
+        and for a frame with one filler of the pair (no pair to weigh)."""
         scores = []
         for frame in frames:
-            if frame.predicate not in self.relations:  # a learned predicate: its own counts score it
+            pair = self.relations[frame.predicate].filler_pair(frame) if frame.predicate in self.relations else None
+            if pair is None:  # a learned predicate (its own counts score it), or one filler
                 scores.append(0.0)
                 continue
-            a, o = self.relations[frame.predicate].filler_pair(frame)
+            a, o = pair
             source = self if self.words is None or {a, o} <= self.words else self.complete_counts
             scores.append(WEIGHT * source.tables[frame.predicate].log_p(a, o))
         return scores

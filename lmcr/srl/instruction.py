@@ -45,7 +45,8 @@ def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
 
 
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
-    known = [f for f in frames if f.known and not f.negated]  # "don't pour the milk" asks for nothing
+    # "don't pour the milk" asks for nothing; "get me something to pour the water into" asks to get it
+    known = [f for f in frames if f.known and not f.negated and not f.describes]
     if known:
         # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
         # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then what

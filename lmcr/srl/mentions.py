@@ -62,6 +62,8 @@ class FrameMention:
     particle_reading: FrameMention | None = None
     # Said not to be done: "don't pour the milk", "never put the knife in the dishwasher".
     negated: bool = False
+    # A clause that says what a thing is or is for ("something to pour the water into": pour), no request.
+    describes: bool = False
 
     def missing(self) -> list[str]:
         return [role for role, value in self.roles.items() if value is None]
@@ -398,6 +400,7 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
         )
         frame.addressed = _addressed(token)
         frame.negated = _negated(token)
+        frame.describes = token.dep_ in NOUN_CLAUSE_DEPS
         if (reading := _particle_reading(token, lemma, name, args, lex)) is not None:
             frame.particle_reading = replace(_known_frame(token, *reading, lex, compounds), addressed=frame.addressed)
         frames.append(frame)
