@@ -41,6 +41,9 @@ def test_cooccurrence_counts_and_scores():
     cup, scissors = scorer.score_frames([frame("cup"), frame("scissors")])  # scissors indexed on demand
     assert cup == pytest.approx(10 / (15 * 10) + 10 / (15 * 10) + 10 / (10 * 10))  # pour 15, water 10, cup 10
     assert scissors == pytest.approx(10 / (15 * 10)) and scorer.single["scissors"] == 10  # only co(pour, water)
+    # a purpose clause's frame with one role ("hand me something to pour"): the verb and it, one pair
+    (alone,) = scorer.score_frames([("pour", {"Theme": "cup"})])
+    assert alone == pytest.approx(10 / (15 * 10))
 
 
 def test_vectors_from_a_glove_file_with_oov_policy(tmp_path):

@@ -18,15 +18,16 @@ from lmcr.scorers.baselines.terms import Lemmatizer, TermMatcher
 
 
 def frame_terms(frame: Frame) -> list[str]:
-    """[verb, arg1, arg2] of a complete frame, arguments in role order."""
+    """[verb, arg1, arg2] of a complete frame, arguments in role order ([verb, arg] of a purpose clause's
+    frame with one role: "hand me something to pour")."""
     verb, values = frame
     return [verb, *values.values()]
 
 
 def pair_sum(frame: Frame, pair: Callable[[str, str], float]) -> float:
-    """pair(v, a1) + pair(v, a2) + pair(a1, a2): every baseline's score over a frame's three terms."""
-    v, a1, a2 = frame_terms(frame)
-    return pair(v, a1) + pair(v, a2) + pair(a1, a2)
+    """pair(v, a1) + pair(v, a2) + pair(a1, a2): every baseline's score over a frame's terms, each pair of
+    them once (pair(v, a1) alone for a frame with one role)."""
+    return sum(pair(a, b) for a, b in combinations(frame_terms(frame), 2))
 
 
 class CooccurrenceScorer:
