@@ -447,12 +447,13 @@ def test_get_rid_of_names_one_generic_frame_whichever_way_it_is_parsed(spec):
     assert frames(spec) == [("get rid", {"of": "peel"})]
 
 
-def test_a_clause_that_says_what_a_thing_is_for_is_never_the_request():
-    """ "get me something to pour the water into": pour describes the thing; with "get" unknown to the
-    hand-written lexicon, nothing is asked that the robot knows (pour had been chosen, the eleven first)."""
+def test_a_clause_that_says_what_a_thing_is_for_comes_after_the_request_it_serves():
+    """ "get me something to pour the water into": pour describes the thing, so get (a learned verb) is the
+    request, though the eleven come first otherwise (pour had been chosen); with get unknown the clause is
+    all there is, and is read (a misparse may hang the request there)."""
     from types import SimpleNamespace
 
-    from lmcr.srl.instruction import NoPredicateError, _first_known
+    from lmcr.srl.instruction import _first_known
 
     spec = (
         "get/VB/ROOT/0 me/PRP/dative/0 something/NN/dobj/0 to/TO/aux/4 pour/VB/relcl/2 the/DT/det/6 "
@@ -460,5 +461,8 @@ def test_a_clause_that_says_what_a_thing_is_for_is_never_the_request():
     )
     found = extract_frames(make_doc(spec), LEX)
     assert [(f.predicate, f.describes) for f in found] == [("get", False), ("pour", True)]
-    with pytest.raises(NoPredicateError, match="no known predicate"):
-        _first_known(SimpleNamespace(lex=LEX), "get me something to pour the water into", found)
+    alone = _first_known(SimpleNamespace(lex=LEX), "", found)
+    assert (alone.predicate, alone.roles) == ("pour", {"Theme": "water", "Destination": None})
+    found[0].known = True  # as where get is learned
+    learned = SimpleNamespace(lex=SimpleNamespace(learned={"get"}, predicates=LEX.predicates))
+    assert _first_known(learned, "", found).predicate == "get"

@@ -45,16 +45,18 @@ def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
 
 
 def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> FrameMention:
-    # "don't pour the milk" asks for nothing; "get me something to pour the water into" asks to get it
-    known = [f for f in frames if f.known and not f.negated and not f.describes]
+    known = [f for f in frames if f.known and not f.negated]  # "don't pour the milk" asks for nothing
     if known:
-        # the robot's own predicates first ("I'd love some wine, could you pour it?"), then what is said to the
-        # robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then what
-        # leaves open the role its verb states most often ("take the plates and put them": put states a
-        # destination far more often than take); else the first
+        # not a clause that says what a thing is for ("get me something to pour the water into" asks to get
+        # it; the clause is read only when nothing else is known: a misparse may hang the request there);
+        # then the robot's own predicates ("I'd love some wine, could you pour it?"), then what is said to
+        # the robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then
+        # what leaves open the role its verb states most often ("take the plates and put them": put states
+        # a destination far more often than take); else the first
         return min(
             known,
             key=lambda f: (
+                f.describes,
                 f.predicate in parser.lex.learned,
                 not f.addressed,
                 not f.missing(),
