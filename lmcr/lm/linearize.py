@@ -47,8 +47,9 @@ def sentence_text(predicate: str, roles: dict[str, str], lex: Lexicon | None = N
     if spec is None:
         raise KeyError(f"no sentence template for predicate {predicate!r}")
     template = spec.template(roles)
-    template = without_roles(template, [r for r in re.findall(r"\{(\w+)\}", template) if r not in roles])
-    missing = [r for r in re.findall(r"\{(\w+)\}", template) if not roles.get(r)]
+    slots = re.findall(r"\{(\w+)\}", template)
+    template = without_roles(template, [r for r in slots if r not in roles])
+    missing = [r for r in slots if r in roles and not roles[r]]
     if missing:  # a bug: scorers are only given complete frames
         raise ValueError(f"cannot linearise {predicate} with {missing} unfilled")
     return template.format(**roles)

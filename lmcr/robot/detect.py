@@ -89,8 +89,10 @@ def detect(bodies: dict[int, SceneObject], views: tuple[Camera, ...] = VIEWS, mi
         _, depth, seg = capture(camera)
         points = back_project(depth, camera)
         for body, obj in bodies.items():
+            if body in found:
+                continue
             mask = seg == body
             n = int(mask.sum())
-            if body not in found and n >= min_pixels:
+            if n >= min_pixels:
                 found[body] = Detection(obj.label, tuple(float(v) for v in points[mask].mean(axis=0)), n, obj.id)
     return [found[body] for body in bodies if body in found]

@@ -383,10 +383,8 @@ def make_scorer(method: str, res: MethodResources) -> Scorer:
         raise MethodUnavailable(f"unknown method {method!r}; available: {', '.join(METHODS)}")
     spec = SCORERS[method]
     score = spec.build(res)
-    if spec.reads_context and (isinstance(score, SharedLM) or hasattr(score, "lm_frames")):
-        return score  # as built: a sum reads a rider's frames in its LM's pass (`SummedScorer`)
-    if spec.reads_context:
-        return lambda frames, context="": score(frames, context=context)
+    if spec.reads_context:  # as built (a sum reads a rider's frames in its LM's pass: `SummedScorer`)
+        return score
     return lambda frames, context="": score(frames)
 
 

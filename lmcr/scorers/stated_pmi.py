@@ -91,15 +91,20 @@ class StatedPMI:
         return groups, nulls
 
     def lm_frames(self, frames: list[Frame]) -> list[Frame]:
-        """The masked frames the term reads for `frames`, each once: when the Theme is masked, candidates
-        for one place share one."""
-        return sorted(set(self._masked(frames)[1].values()), key=lambda n: n.key)
+        """The masked frames the term reads for `frames` (`_distinct`)."""
+        return _distinct(self._masked(frames)[1])
 
     def __call__(self, frames: list[Frame], context: str = "") -> list[float]:
         groups, nulls = self._masked(frames)
-        texts = sorted(set(nulls.values()), key=lambda n: n.key)
+        texts = _distinct(nulls)
         logp = dict(zip(texts, self.lm(texts, context))) if texts else {}
         return centred({i: -logp[null] for i, null in nulls.items()}, groups, len(frames), self.weight)
+
+
+def _distinct(nulls: dict[int, Frame]) -> list[Frame]:
+    """The masked frames, each once, in a fixed order: when the Theme is masked, the candidates for one
+    place share one."""
+    return sorted(set(nulls.values()), key=lambda n: n.key)
 
 
 def stated_pmi_scorer(lm: LMScores, learned: Collection[str], weight: float = WEIGHT) -> StatedPMI:

@@ -367,9 +367,8 @@ def _addressed(verb: Token) -> bool:
     if verb.dep_ in NOUN_CLAUSE_DEPS:
         return False
     light = idiom_verb(verb)
-    verb = (
-        light if light is not None and light.i == verb.head.i else verb
-    )  # "I got rid of it": the light verb's subject
+    if light is not None and light.i == verb.head.i:  # "I got rid of it": the light verb's subject
+        verb = light
     subjects = [c for c in verb.children if c.dep_ in ("nsubj", "nsubjpass")]
     return all(c.lower_ == "you" for c in subjects)
 
@@ -377,8 +376,7 @@ def _addressed(verb: Token) -> bool:
 def _negated(verb: Token) -> bool:
     """Whether the verb (or an idiom's light verb: "don't get rid of it") is negated: "don't", "do not",
     "never"."""
-    light = idiom_verb(verb)
-    return any(c.dep_ == "neg" for v in (verb, *([light] if light is not None else [])) for c in v.children)
+    return any(c.dep_ == "neg" for v in (verb, idiom_verb(verb)) if v is not None for c in v.children)
 
 
 def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = None) -> list[FrameMention]:
