@@ -54,22 +54,18 @@ def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]
 MADE_AT_DESTINATION = frozenset({"cut", "cook"})
 
 
-# where the person who asks is, said as a place: "bring the cup here"
-SPEAKER_PLACES = frozenset({"here"})
-
-
 def _to_speaker(child, lex) -> bool:
     """Whether a word the verb governs says the person who asks receives the Theme: "me" or "us" as its
     recipient ("bring me the soap"), or "here" as where it goes ("bring the soap here")."""
     if child.dep_ == "dative":
         return child.lower_ in lex.speaker_pronouns
-    return child.dep_ == "advmod" and child.lower_ in SPEAKER_PLACES
+    return child.dep_ == "advmod" and child.lower_ in lex.speaker_places
 
 
 def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
     """ "bring me the soap", "get me something to drink from", "bring it here": a learned verb said to the
     person who asks as its recipient ("me", "us": `Lexicon.speaker_pronouns`), or to where they are
-    (`SPEAKER_PLACES`), puts its Theme in their hands, so the detected object that is that person
+    (`Lexicon.speaker_places`), puts its Theme in their hands, so the detected object that is that person
     (`Lexicon.speaker_labels`) fills its open Destination. Not for a
     verb of a class that makes something at its Destination (`MADE_AT_DESTINATION`); the paper's verbs
     keep their own reading ("pour me some water": into a cup)."""

@@ -115,6 +115,7 @@ class Lexicon:
     courtesy_words: frozenset[str] = frozenset()  # "please": closes a request, never part of a name
     speaker_pronouns: frozenset[str] = frozenset()  # "me", "us": the person who asks
     speaker_labels: frozenset[str] = frozenset()  # "person": the label a scene gives the person who asks
+    speaker_places: frozenset[str] = frozenset()  # "here": where the person who asks is
     objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
     # the predicates learned from the frame corpus (a subset of `predicates`), and the verbs the corpus uses
     # too seldom to learn (verb -> frames): a request with one of those is refused by name
@@ -176,6 +177,7 @@ def _hand_written(path: str) -> Lexicon:
         courtesy_words=frozenset(data.get("courtesy_words", ())),
         speaker_pronouns=frozenset(data.get("speaker_pronouns", ())),
         speaker_labels=frozenset(data.get("speaker_labels", ())),
+        speaker_places=frozenset(data.get("speaker_places", ())),
     )
 
 
