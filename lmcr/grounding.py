@@ -1,8 +1,8 @@
 """Grounding what an instruction says in what the robot sees: a stated filler names a detected object (by
-its label, its label's last words, the same noun in either number, its head word, or the whole label said
-in the instruction) or a word of the robot's object vocabulary; a pronoun names an object said before it;
-"a glass of water" names the glass it is served in; "bring me the soap" names the person who asks as
-where it goes."""
+its label, its label's last words, the same noun in either number, its head word, the whole label said
+in the instruction, or its first words: "the trash" for a trash can) or a word of the robot's object
+vocabulary; a pronoun names an object said before it; "a glass of water" names the glass it is served
+in; "bring me the soap" and "hand it to her" name the person as where it goes."""
 
 from __future__ import annotations
 
@@ -42,7 +42,8 @@ def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]
     referred: dict[str, str] = {}
     for role in frame.roles:
         for name in antecedents(doc, frame, role, parser.lex, parser.compounds):
-            obj = grounded(name, seen)
+            # the antecedent is a lemma: "these chips are stale, toss them" names the chips
+            obj = grounded(name, seen) or named_by_head(name, detected)
             if obj is not None and obj not in stated and obj not in referred.values():
                 referred[role] = obj
                 break
@@ -54,29 +55,31 @@ def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]
 MADE_AT_DESTINATION = frozenset({"cut", "cook"})
 
 
-def _to_speaker(child, lex) -> bool:
-    """Whether a word the verb governs says the person who asks receives the Theme: "me" or "us" as its
-    recipient ("bring me the soap"), or "here" as where it goes ("bring the soap here")."""
-    if child.dep_ == "dative":
-        return child.lower_ in lex.speaker_pronouns
+def _to_person(child, lex) -> bool:
+    """Whether a word the verb governs says a person receives the Theme: a person's pronoun as its
+    recipient ("bring me the soap", "give her the knife") or after "to" ("hand the towel to me", "pass
+    the salt to him": `Lexicon.recipient_pronouns`), or "here" as where it goes ("bring the soap here")."""
+    if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
+        return True
+    if child.dep_ in ("dative", "prep") and child.lower_ == "to":
+        return any(c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns for c in child.children)
     return child.dep_ == "advmod" and child.lower_ in lex.speaker_places
 
 
 def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
-    """ "bring me the soap", "get me something to drink from", "bring it here": a learned verb said to the
-    person who asks as its recipient ("me", "us": `Lexicon.speaker_pronouns`), or to where they are
-    (`Lexicon.speaker_places`), puts its Theme in their hands, so the detected object that is that person
-    (`Lexicon.speaker_labels`) fills its open Destination. Not for a
-    verb of a class that makes something at its Destination (`MADE_AT_DESTINATION`); the paper's verbs
-    keep their own reading ("pour me some water": into a cup)."""
+    """ "bring me the soap", "hand the towel to her", "get me something to drink from", "bring it here": a
+    learned verb said to a person as its recipient (`_to_person`) puts its Theme in their hands, so the
+    detected object that is a person (`Lexicon.speaker_labels`) fills its Destination, open or stated as
+    that pronoun. Not for a verb of a class that makes something at its Destination
+    (`MADE_AT_DESTINATION`); the paper's verbs keep their own reading ("pour me some water": into a cup)."""
     lex, open_role = parser.lex, "Destination"
     spec = lex.predicates.get(frame.predicate)
     if frame.predicate not in lex.learned or spec is None or spec.motion in MADE_AT_DESTINATION:
         return {}
-    if open_role not in frame.roles or frame.roles[open_role] is not None:
+    if open_role not in frame.roles or frame.roles[open_role] not in (None, *lex.recipient_pronouns):
         return {}
     verb = predicate_token(doc, frame)
-    if verb is None or not any(_to_speaker(c, lex) for c in verb.children):
+    if verb is None or not any(_to_person(c, lex) for c in verb.children):
         return {}
     person = next((o for o in detected if o in lex.speaker_labels), None)
     return {open_role: person} if person else {}
@@ -110,7 +113,7 @@ def ground_roles(
 
     def ground(value: str) -> str | None:  # what the person sees first, then what the robot knows
         found = grounded(value, seen) or named_by_head(value, detected) or said_in_full(value, detected, said)
-        return found or grounded(value, words)
+        return found or named_by_modifier(value, detected) or grounded(value, words)
 
     named = {r: v and ground(v) for r, v in roles.items()}
     unresolved = {r: v for r, v in roles.items() if v and named[r] is None}
@@ -148,6 +151,14 @@ def objects_named(value: str, detected: list[str]) -> list[str]:
         return len(label) > 1 and same_noun(label[-1], words[-1])
 
     return [o for o in detected if names(o)]
+
+
+def named_by_modifier(value: str, detected: list[str]) -> str | None:
+    """The one detected object whose label is the stated filler with a noun after it: "throw it in the
+    trash" with a trash can on the floor, "take the clothes to the laundry" with a laundry basket, "put it
+    in the recycling" with a recycling bin; None when no object or several are so named."""
+    found = [o for o in detected if o.startswith(f"{value} ")]
+    return found[0] if len(found) == 1 else None
 
 
 def said_in_full(value: str, detected: list[str], said: str) -> str | None:

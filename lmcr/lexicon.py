@@ -113,8 +113,7 @@ class Lexicon:
     object_pronouns: frozenset[str]
     recipient_pronouns: frozenset[str]
     courtesy_words: frozenset[str] = frozenset()  # "please": closes a request, never part of a name
-    speaker_pronouns: frozenset[str] = frozenset()  # "me", "us": the person who asks
-    speaker_labels: frozenset[str] = frozenset()  # "person": the label a scene gives the person who asks
+    speaker_labels: frozenset[str] = frozenset()  # "person": the label a scene gives a person
     speaker_places: frozenset[str] = frozenset()  # "here": where the person who asks is
     objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
     # the predicates learned from the frame corpus (a subset of `predicates`), and the verbs the corpus uses
@@ -175,7 +174,6 @@ def _hand_written(path: str) -> Lexicon:
         recipient_pronouns=frozenset(data["recipient_pronouns"]),
         objects=tuple(data.get("objects", ())),
         courtesy_words=frozenset(data.get("courtesy_words", ())),
-        speaker_pronouns=frozenset(data.get("speaker_pronouns", ())),
         speaker_labels=frozenset(data.get("speaker_labels", ())),
         speaker_places=frozenset(data.get("speaker_places", ())),
     )

@@ -136,6 +136,9 @@ def test_a_pronoun_refers_back_to_a_detected_object_named_before_it(parser):
     assert unseen.referred == {} and unseen.missing_roles == ("Theme", "Destination")  # no juice: the scene decides
     plain = complete(parser, scorer, "pour it into the cup", ["wine", "water", "cup"])
     assert plain.referred == {} and plain.frame.role_map["Theme"] == "water"
+    # the parser names the antecedent by its lemma ("carrot"): it is the carrots on the table
+    plural = complete(parser, scorer, "These carrots are cooked. Dump them into the bowl.", ["carrots", "bowl", "cup"])
+    assert plural.referred == {"Theme": "carrots"} and plural.frame.role_map["Theme"] == "carrots"
 
 
 def test_the_vessel_a_request_serves_in_is_where_it_goes(parser):
@@ -309,8 +312,9 @@ def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_obje
 def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(parser):
     """The parser's lemma "carrot" is the carrots on the table, "dish" the dishes, "patty" the mint
     patties; an object whose whole label the instruction says is what a filler cut short stands for
-    ("the tank top": Theme 'tank'); a detected object comes before the robot's word for it."""
-    from lmcr.grounding import ground_roles, named_by_head, said_in_full, same_noun
+    ("the tank top": Theme 'tank'); "the trash" names the one trash can; a detected object comes before
+    the robot's word for it."""
+    from lmcr.grounding import ground_roles, named_by_head, named_by_modifier, said_in_full, same_noun
 
     assert same_noun("carrot", "carrots") and same_noun("dishes", "dish") and same_noun("patty", "patties")
     assert not same_noun("cup", "cups of") and not same_noun("pan", "pants")
@@ -323,6 +327,13 @@ def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(
         "stainless steel spoon"
     )
     assert said_in_full("top", ["tank top"], "put the top away") is None  # the label is not said in full
+    # "the trash" is the trash can, "the recycling" the recycling bin: a label's first words, one object
+    assert named_by_modifier("trash", ["trash can", "banana"]) == "trash can"
+    assert named_by_modifier("storage", ["storage box", "storage chest"]) is None  # which: the robot asks
+    assert named_by_modifier("can", ["trash can", "canister"]) is None
+    said = {"Theme": "shirt", "Destination": "laundry"}
+    roles, unresolved = ground_roles(said, ("cup",), ["shirt", "laundry basket"])
+    assert roles == {"Theme": "shirt", "Destination": "laundry basket"} and not unresolved
     roles, unresolved = ground_roles({"Theme": "egg", "Destination": None}, ("egg", "bowl"), ["eggs", "bowl"], "")
     assert roles == {"Theme": "eggs", "Destination": None} and not unresolved
     poured = complete(parser, scorer, "pour the carrots into the bowl", ["carrots", "bowl", "cup"])

@@ -605,7 +605,8 @@ def test_a_learned_verb_is_completed_and_executed_with_its_motion(sim, tmp_path,
 
 def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser):
     """ "bring me the cup": the recipient "me" is the person who asks, so the person in the scene is where
-    the cup goes (nothing is missing; the scorer would have chosen the bowl) and the robot hands it over.
+    the cup goes (nothing is missing; the scorer would have chosen the bowl) and the robot hands it over;
+    so do "bring the cup here", "to me", "to her" and "bring him the cup" (it had gone to the bowl).
     Without a person in the scene the Destination is completed as any other."""
     from lmcr.complete import CompletionConfig, complete
     from lmcr.robot.execute import execute
@@ -627,6 +628,10 @@ def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser)
     assert here.frame.role_map["Destination"] == "person" and here.missing is None
     nobody = complete(learned_parser, _prefers("bowl"), "bring the cup here", ["cup", "bowl"])
     assert nobody.frame.role_map["Destination"] == "bowl"
+    # a person's pronoun after "to", or any person's as the recipient, names the person in the scene
+    for said in ("bring the cup to me", "bring the cup to her", "bring him the cup"):
+        to = complete(learned_parser, _prefers("bowl"), said, ["cup", "bowl", "person"])
+        assert to.frame.role_map["Destination"] == "person" and to.missing is None, said
 
 
 def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):
