@@ -266,6 +266,7 @@ def complete(
     free = [o for o in detected if o not in stated | for_purpose | conjoined(doc, frame, detected)]
     pool = _pool(frame.predicate, roles, missing, free, ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
+    people = parser.lex.recipient_pronouns | parser.lex.speaker_subjects  # "bring it to her": no one seen
     fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
@@ -287,7 +288,9 @@ def complete(
         frame=Frame.of(frame.predicate, chosen),
         missing_roles=tuple(missing),
         candidates=candidates,
-        question=_ask(spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices, named),
+        question=_ask(
+            spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices, named, people
+        ),
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),
     )
@@ -382,6 +385,7 @@ def _ask(
     in_set: list[Candidate],
     max_choices: int,
     named: dict[str, list[str]],
+    people: frozenset[str] = frozenset(),
 ) -> str | None:
     """The clarifying question, or None when the choice is clear: asked when the prediction set `in_set`
     holds more or fewer than one candidate (and there was a choice), and always when the best candidate
@@ -395,16 +399,18 @@ def _ask(
     choices = (in_set if len(in_set) > 1 or one else list(candidates))[: max(max_choices, 2)]
     question = _question(spec, roles, missing, choices)
     if read.unresolved:
-        return f"{_unseen(read.unresolved, named)} {question}"
+        return f"{_unseen(read.unresolved, named, people)} {question}"
     return question
 
 
-def _unseen(unresolved: dict[str, str], named: dict[str, list[str]]) -> str:
-    """What the robot says of the words it could not ground: "I see no side.", or, for a word whose head
-    names several of the objects (`named`: "the chips" with two bags), "I see more than one chip." """
+def _unseen(unresolved: dict[str, str], named: dict[str, list[str]], people: frozenset[str] = frozenset()) -> str:
+    """What the robot says of the words it could not ground: "I see no side.", "I see no one here." for a
+    word that names a person (`people`: "bring it to her" with nobody in the scene), or, for a word whose
+    head names several of the objects (`named`: "the chips" with two bags), "I see more than one chip." """
     several = [w for r, w in unresolved.items() if named.get(r)]
-    unseen = [w for r, w in unresolved.items() if not named.get(r)]
+    unseen = [w for r, w in unresolved.items() if not named.get(r) and w not in people]
     said = [f"I see no {' or '.join(unseen)}."] if unseen else []
+    said += ["I see no one here."] if any(w in people for w in unresolved.values()) else []
     return " ".join(said + ([f"I see more than one {' or '.join(several)}."] if several else []))
 
 

@@ -70,16 +70,21 @@ def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected:
     """ "bring me the soap", "hand the towel to her", "get me something to drink from", "bring it here": a
     learned verb said to a person as its recipient (`_to_person`) puts its Theme in their hands, so the
     detected object that is a person (`Lexicon.speaker_labels`) fills its Destination, open or stated as
-    that pronoun. Not for a verb of a class that makes something at its Destination
-    (`MADE_AT_DESTINATION`); the paper's verbs keep their own reading ("pour me some water": into a cup)."""
+    that pronoun, or as the subject of a request ("can I have the soap": `srl.instruction.with_requests`).
+    Not for a verb of a class that makes something at its Destination (`MADE_AT_DESTINATION`); the
+    paper's verbs keep their own reading ("pour me some water": into a cup)."""
     lex, open_role = parser.lex, "Destination"
     spec = lex.predicates.get(frame.predicate)
     if frame.predicate not in lex.learned or spec is None or spec.motion in MADE_AT_DESTINATION:
         return {}
-    if open_role not in frame.roles or frame.roles[open_role] not in (None, *lex.recipient_pronouns):
+    if open_role not in frame.roles:
         return {}
-    verb = predicate_token(doc, frame)
-    if verb is None or not any(_to_person(c, lex) for c in verb.children):
+    said = frame.roles[open_role]
+    if said is None:
+        verb = predicate_token(doc, frame)
+        if verb is None or not any(_to_person(c, lex) for c in verb.children):
+            return {}
+    elif said not in lex.recipient_pronouns | lex.speaker_subjects:  # "to her"; "can I have" (`asked_for`)
         return {}
     person = next((o for o in detected if o in lex.speaker_labels), None)
     return {open_role: person} if person else {}

@@ -115,6 +115,11 @@ class Lexicon:
     courtesy_words: frozenset[str] = frozenset()  # "please": closes a request, never part of a name
     speaker_labels: frozenset[str] = frozenset()  # "person": the label a scene gives a person
     speaker_places: frozenset[str] = frozenset()  # "here": where the person who asks is
+    # "can I have an apple", "we need a spoon": a verb the person who asks (one of `speaker_subjects`, as its
+    # subject) asks for a thing with, read as the robot doing `request_predicate` to bring it to them
+    request_verbs: frozenset[str] = frozenset()
+    speaker_subjects: frozenset[str] = frozenset()
+    request_predicate: str | None = None
     objects: tuple[str, ...] = ()  # the robot detector's object labels (the simulated kitchen's vocabulary)
     # the predicates learned from the frame corpus (a subset of `predicates`), and the verbs the corpus uses
     # too seldom to learn (verb -> frames): a request with one of those is refused by name
@@ -176,6 +181,9 @@ def _hand_written(path: str) -> Lexicon:
         courtesy_words=frozenset(data.get("courtesy_words", ())),
         speaker_labels=frozenset(data.get("speaker_labels", ())),
         speaker_places=frozenset(data.get("speaker_places", ())),
+        request_verbs=frozenset(data.get("request_verbs", ())),
+        speaker_subjects=frozenset(data.get("speaker_subjects", ())),
+        request_predicate=data.get("request_predicate"),
     )
 
 

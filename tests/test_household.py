@@ -634,6 +634,30 @@ def test_bring_me_hands_it_to_the_person_who_asks(sim, tmp_path, learned_parser)
         assert to.frame.role_map["Destination"] == "person" and to.missing is None, said
 
 
+def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
+    """ "can I have the cup?", "I'd like the cup", "we need the cup": the person who asks is the subject of
+    a verb of wanting (`request_verbs`), read as bringing the thing to them (it had no known predicate,
+    "have" being no frame at all); with nobody in the scene the robot says so and asks where. "I have a
+    cup, pour the milk into it" still pours, "I don't want the cup" asks for nothing, and "they need the
+    cup" (no speaker) is no request."""
+    from lmcr.complete import complete
+    from lmcr.srl.instruction import NoPredicateError, NothingAskedError
+
+    objects = ["cup", "bowl", "person", "milk"]
+    for said in ("can I have the cup?", "I'd like the cup", "we need the cup", "could I get the cup please"):
+        out = complete(learned_parser, _prefers("bowl"), said, objects)
+        assert out.frame.to_json() == {"predicate": "bring", "roles": {"Theme": "cup", "Destination": "person"}}, said
+        assert out.missing is None and out.referred == {"Destination": "person"}, said
+    alone = complete(learned_parser, _prefers("bowl"), "can I have the cup?", ["cup", "bowl", "milk"])
+    assert alone.question.startswith("I see no one here. Should I bring ")
+    poured = complete(learned_parser, _prefers("bowl"), "I have a cup, pour the milk into it", objects)
+    assert poured.frame.predicate == "pour"
+    with pytest.raises(NothingAskedError, match="not to bring"):
+        complete(learned_parser, _prefers("bowl"), "I don't want the cup", objects)
+    with pytest.raises(NoPredicateError):
+        complete(learned_parser, _prefers("bowl"), "they have the cup", objects)
+
+
 def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):
     """ "bring me something to cut the bread with": "something" leaves the Theme to complete, and each
     candidate is also scored as the Instrument of cutting the bread; the scorer likes bringing a spoon,

@@ -8,7 +8,9 @@ from spacy.tokens import Doc
 from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
 from lmcr.lexicon import Lexicon
-from lmcr.srl.mentions import FrameMention
+from lmcr.srl.arguments import argument_value
+from lmcr.srl.lemmas import lemma as lemma_of
+from lmcr.srl.mentions import NOUN_CLAUSE_DEPS, FrameMention, is_negated
 from lmcr.srl.parser import FrameParser
 
 
@@ -27,13 +29,48 @@ class NothingAskedError(NoPredicateError):
 def parse_instruction(parser: FrameParser, text: str) -> FrameMention:
     """The first frame of a robot predicate in a spoken instruction; missing roles are None. Text the
     parser cannot take (over MAX_TEXT_CHARS, lone surrogates) raises InputError."""
-    return _first_known(parser, text, parser.parse(check_text(text, "instruction")))
+    return read_instruction(parser, text)[0]
 
 
 def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]:
     """`parse_instruction`'s frame and the instruction's Doc (for the rest of what it says)."""
     frames, doc = parser.parse_with_doc(check_text(text, "instruction"))
-    return _first_known(parser, text, frames), doc
+    return _first_known(parser, text, with_requests(parser, doc, frames)), doc
+
+
+def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> list[FrameMention]:
+    """The frames, with the person who asks saying they want a thing read as the robot bringing it to them
+    ("can I have an apple?", "I'd like the salt", "we need something to open this with"): a verb of
+    `Lexicon.request_verbs` with one of `Lexicon.speaker_subjects` as its subject, an object and no
+    other role said is `Lexicon.request_predicate` (when the store learned it), its Theme that object,
+    its Destination the subject ("i"), which names the person (`grounding.speaker_destination`). English
+    grammar, not knowledge of things."""
+    lex = parser.lex
+    spec = lex.predicates.get(lex.request_predicate or "")
+    if spec is None or spec.name not in lex.learned or "Destination" not in spec.roles:
+        return frames
+    at = {f.start: f for f in frames}
+    for verb in doc:
+        said = at.get(verb.idx)
+        subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
+        thing = next((c for c in verb.children if c.dep_ == "dobj"), None)
+        if lemma_of(verb) not in lex.request_verbs or subject is None or subject.lower_ not in lex.speaker_subjects:
+            continue
+        found = thing is not None and argument_value(thing, lex, parser.compounds)
+        if not found or (said is not None and any(v for r, v in said.roles.items() if r != "Theme")):
+            continue
+        roles = {spec.object_role: found[0], "Destination": subject.lower_}
+        at[verb.idx] = FrameMention(
+            spec.name,
+            roles,
+            True,
+            verb.idx,
+            verb.idx + len(verb),
+            {spec.object_role: found[1:]},
+            negated=is_negated(verb),
+            describes=verb.dep_ in NOUN_CLAUSE_DEPS,
+        )
+    return sorted(at.values(), key=lambda f: f.start)
 
 
 def _open_rate(lex: Lexicon, frame: FrameMention) -> float:

@@ -373,7 +373,7 @@ def _addressed(verb: Token) -> bool:
     return all(c.lower_ == "you" for c in subjects)
 
 
-def _negated(verb: Token) -> bool:
+def is_negated(verb: Token) -> bool:
     """Whether the verb (or an idiom's light verb: "don't get rid of it") is negated: "don't", "do not",
     "never"."""
     return any(c.dep_ == "neg" for v in (verb, idiom_verb(verb)) if v is not None for c in v.children)
@@ -397,7 +397,7 @@ def extract_frames(doc: Doc | Span, lex: Lexicon, compounds: Compounds | None = 
             else _generic_frame(token, name, args, lex, compounds)
         )
         frame.addressed = _addressed(token)
-        frame.negated = _negated(token)
+        frame.negated = is_negated(token)
         frame.describes = token.dep_ in NOUN_CLAUSE_DEPS
         if (reading := _particle_reading(token, lemma, name, args, lex)) is not None:
             frame.particle_reading = replace(_known_frame(token, *reading, lex, compounds), addressed=frame.addressed)
