@@ -23,6 +23,25 @@ _OBJECT_NAME_RE = re.compile(r"[^\W\d_]+(?:[ '-][^\W\d_]+){0,3}")
 MAX_OBJECT_NAME_CHARS = 40
 
 
+# Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
+PREP_ROLES: dict[str, tuple[str, ...]] = {
+    "into": ("Destination",),
+    "onto": ("Destination",),
+    "to": ("Destination",),
+    "inside": ("Destination", "Instrument"),
+    "in": ("Destination", "Instrument"),
+    "on": ("Destination", "Instrument"),
+    "over": ("Destination",),
+    "under": ("Destination",),
+    "at": ("Destination", "Instrument"),
+    "with": ("Instrument",),
+    "using": ("Instrument",),
+    "from": ("Source",),
+    "off": ("Source",),
+    "of": ("Theme",),
+}
+
+
 def normalize_name(name: str) -> str:
     """A predicate or object name as the lexicon keys it: lowercase, one space between words ("Put  Away"
     -> "put away")."""
@@ -196,7 +215,9 @@ def _with_learned(path: str, table: str, modified_ns: int) -> Lexicon:
     lex = _hand_written(path)
     data = read_resource(Path(table), "learned predicate table", _learned_table)
     learned = {
-        name: _spec(name, entry["spec"]) for name, entry in data["predicates"].items() if name not in lex.predicates
+        name: _with_english_preps(_spec(name, entry["spec"]))
+        for name, entry in data["predicates"].items()
+        if name not in lex.predicates
     }
     return replace(
         lex,
@@ -205,6 +226,19 @@ def _with_learned(path: str, table: str, modified_ns: int) -> Lexicon:
         refused={name: int(n) for name, n in data.get("refused", {}).items()},
         min_frames=data.get("settings", {}).get("min_frames", 0),
     )
+
+
+def _with_english_preps(spec: PredicateSpec) -> PredicateSpec:
+    """A learned spec that also takes, for each of its open roles, the prepositions English gives that role
+    alone (`PREP_ROLES`: "to", "into" a Destination) and the verb's frames left to no role: recipes bring
+    things to a boil, so "to" introduces no place of bring's in the corpora, yet "bring the plates to the
+    sink" says where they go. The learned prepositions stay first (`prep_rank`)."""
+    taken = {p for preps in spec.preps.values() for p in preps}
+    added = {
+        role: tuple(p for p, roles in PREP_ROLES.items() if roles == (role,) and p not in taken)
+        for role in spec.open_roles
+    }
+    return replace(spec, preps={**spec.preps, **{r: (*spec.preps.get(r, ()), *added[r]) for r in added if added[r]}})
 
 
 def _learned_table(value: object) -> dict:

@@ -228,6 +228,8 @@ def _prefer(*order: str):
         ("could you put away the milk?", "put away", {"Theme": "milk", "Destination": None}),
         ("please put the steak seasoning away", "put away", {"Theme": "steak seasoning", "Destination": None}),
         ("put the milk in the bowl", "put", {"Theme": "milk", "Destination": "bowl"}),
+        # the corpus put things "in" only; English gives "into" a place alone, and the request says it
+        ("put the milk into the glass", "put", {"Theme": "milk", "Destination": "glass"}),
         ("dispose of it in the bowl", "dispose", {"Theme": "it", "Destination": "bowl"}),
         ("bake the cake", "bake", {"Theme": "cake", "Instrument": None}),
         ("pour me some water", "pour", {"Theme": "water", "Destination": None}),  # the eleven unchanged

@@ -44,26 +44,9 @@ from pathlib import Path
 import duckdb
 
 from lmcr.files import atomic_path
-from lmcr.lexicon import PREDICATES_FILE, Lexicon
+from lmcr.lexicon import PREDICATES_FILE, PREP_ROLES, Lexicon
 
 VERSION = 4  # 2: each predicate's class of motion; 3: the cook class; 4: unclear slots read as the prototype's
-# Roles a preposition can introduce, most usual first (English grammar, the same for every verb).
-PREP_ROLES: dict[str, tuple[str, ...]] = {
-    "into": ("Destination",),
-    "onto": ("Destination",),
-    "to": ("Destination",),
-    "inside": ("Destination", "Instrument"),
-    "in": ("Destination", "Instrument"),
-    "on": ("Destination", "Instrument"),
-    "over": ("Destination",),
-    "under": ("Destination",),
-    "at": ("Destination", "Instrument"),
-    "with": ("Instrument",),
-    "using": ("Instrument",),
-    "from": ("Source",),
-    "off": ("Source",),
-    "of": ("Theme",),
-}
 OBJECT_SLOT = "Theme"  # the generic frame's direct object
 MIN_FRAMES = 20  # frames a verb needs before it is learned
 MIN_RATE = 0.02  # how often its best role must be stated
