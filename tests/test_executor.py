@@ -649,6 +649,31 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(
     assert out["checks"]["knocked"] == []
 
 
+def test_a_target_out_of_reach_is_brought_nearer_first(sim, tmp_path):
+    """Stir the soup at the right arm's far corner with the spoon beside it (bench seed 1, stir 6): no arm
+    reaches over the soup, and setting the spoon down elsewhere does not change that. The soup itself is
+    set down where an arm reaches over it, and then stirred, all planned before anything moves."""
+    from lmcr.robot.act import run_plan
+    from lmcr.robot.execute import plan_task
+    from lmcr.robot.plan import Plan, Planner
+
+    layout = [
+        ("soup", [-0.219, -0.359]),
+        ("spoon", [-0.196, -0.24]),
+        ("recycling bin", [0.086, 0.369]),
+        ("stove", [-0.05, 0.002]),
+        ("oven", [0.104, -0.321]),
+        ("butter", [-0.171, 0.251]),
+    ]
+    scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout], "seed": 0}, "scene")
+    planner = Planner(build_world(scene, tmp_path), scene, scene.table, Budget(seconds=math.inf))
+    spoon, soup = scene.find("spoon"), scene.find("soup")
+    plan = plan_task(planner, scene, tasks.TOOL_MOTIONS["stir"], {"Instrument": spoon, "Theme": soup})
+    assert isinstance(plan, Plan) and plan.first.geometry.held is soup and plan.instead_of.out_of_reach, plan
+    out = run_plan(plan, spoon, soup, [o for o in scene.objects if o not in (spoon, soup)], planner)
+    assert out["success"], out
+
+
 def test_a_search_for_a_place_to_set_down_first_stops_when_its_budget_is_spent(sim, tmp_path):
     """The strawberry out of the arm's reach of the chocolate: the direct plan fails, and the search for
     a spot to set it down first (which would succeed) is stopped by an IK budget just past the direct plan's

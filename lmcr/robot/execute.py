@@ -282,7 +282,7 @@ def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, Sce
     direct = planner.plan_as_it_stands(task, held, target, holding)
     if isinstance(direct, Plan) or planner.stopped:
         return direct
-    for moved in _set_aside(planner, direct, held, holding):
+    for moved in _set_aside(planner, direct, held, target, holding):
         rearranged = planner.plan_via(task, held, target, moved, holding, free_spots(scene, moved.shape))
         if isinstance(rearranged, Plan):
             return replace(rearranged, instead_of=direct)
@@ -291,19 +291,27 @@ def plan_task(planner: Planner, scene: Scene, task: Task, objects: dict[str, Sce
     return direct
 
 
-def _set_aside(planner: Planner, refused: Infeasible, held: SceneObject, holding: bool) -> list[SceneObject]:
-    """What to set down elsewhere first, in the order to try, after `refused`: the held object when no arm
-    reaches all the task as it stands (from the table it may be picked up by either arm, in any grasp);
-    else, with the hand free, the object on the table a pose would put the arm against (unless it is a
-    fixed receptacle), then the held object, moved away from it (a bin beside the banana, a fridge's
+def _set_aside(
+    planner: Planner, refused: Infeasible, held: SceneObject, target: SceneObject, holding: bool
+) -> list[SceneObject]:
+    """What to set down elsewhere first, in the order to try, after `refused`: when no arm reaches all the
+    task as it stands, the held object (from the table it may be picked up by either arm, in any grasp),
+    then, with the hand free, the target when it is no fixed receptacle (the soup to stir brought nearer
+    the robot); else, with the hand free, the object on the table a pose would put the arm against
+    (unless it is fixed), then the held object, moved away from it (a bin beside the banana, a fridge's
     open lid in the way to the milk)."""
     if refused.out_of_reach:
-        return [held]
+        free = not holding and target is not held and target in planner.scene.objects  # a hand to move it
+        return [held, *([target] if free and not _fixed(target) else [])]
     blocking = None if holding else planner.on_table(refused.blocker)
     if blocking is None:
         return []
-    fixed = getattr(household().get(blocking.shape), "mass", None) == 0
-    return [*([] if fixed else [blocking]), *([] if blocking is held else [held])]
+    return [*([] if _fixed(blocking) else [blocking]), *([] if blocking is held else [held])]
+
+
+def _fixed(obj: SceneObject) -> bool:
+    """Whether `obj` is a receptacle fixed in place (mass 0), which nothing sets down elsewhere."""
+    return getattr(household().get(obj.shape), "mass", None) == 0
 
 
 def _set_down(plan: Plan) -> dict:

@@ -483,17 +483,21 @@ def _random_spot(
     raise InputError(f"{where}: no free spot for the {obj.label} on the table")
 
 
+SPOT_DRAWS = 12  # free spots drawn at random, of which the nearest the robot's edge are tried
+
+
 def free_spots(scene: Scene, label: str, n: int = 3) -> list[tuple[float, float]]:
-    """Up to `n` spots where the `label` would stand clear of the objects on the table (seeded by the
-    scene's seed), nearest the middle of the robot's edge first (both arms reach there): where to put
-    down what the hand holds, or what one arm passes to the other."""
+    """The `n` spots nearest the middle of the robot's edge (both arms reach there), of `SPOT_DRAWS` drawn
+    at random (seeded by the scene's seed), where the `label` would stand clear of the objects on the
+    table: where to put down what the hand holds, or what one arm passes to the other, or what stands out
+    of reach."""
     rng, spots = random.Random(f"{scene.seed}:put down"), set()
-    for _ in range(n):
+    for _ in range(SPOT_DRAWS):
         try:
             spots.add(_random_spot(SceneObject(label, None), scene.objects, rng, "scene"))
         except InputError:
             break
-    return sorted(spots, key=lambda xy: math.hypot(xy[0] + X_LIMIT, xy[1]))
+    return sorted(spots, key=lambda xy: math.hypot(xy[0] + X_LIMIT, xy[1]))[:n]
 
 
 def world_xy(xy: tuple[float, float]) -> tuple[float, float]:
