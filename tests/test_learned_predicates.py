@@ -249,6 +249,19 @@ def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, ins
     assert (frame.predicate, frame.roles) == (predicate, roles)
 
 
+def test_a_frame_that_states_nothing_gives_way_to_one_that_does(learned_parser):
+    """ "can you help me put the milk away?": help is said to the robot and states nothing; put away, whose
+    subject is "me" in the parse, states the milk. The task is putting the milk away (help had been read,
+    with both its roles to fill)."""
+    from lmcr.srl.instruction import _first_known
+    from lmcr.srl.mentions import FrameMention
+
+    helps = FrameMention("bake", {"Theme": None, "Instrument": None}, True, 8, 12, addressed=True)
+    puts = FrameMention("put away", {"Theme": "milk", "Destination": None}, True, 16, 19, addressed=False)
+    assert _first_known(learned_parser, "can you help me put the milk away?", [helps, puts]) is puts
+    assert _first_known(learned_parser, "can you help?", [helps]) is helps  # alone it is still read
+
+
 @pytest.mark.model
 @pytest.mark.parametrize(
     "instruction, predicate, roles",

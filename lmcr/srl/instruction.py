@@ -86,7 +86,8 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
     if known:
         # not a clause that says what a thing is for ("get me something to pour the water into" asks to get
         # it; the clause is read only when nothing else is known: a misparse may hang the request there);
-        # then the robot's own predicates ("I'd love some wine, could you pour it?"), then what is said to
+        # then one that says something ("can you help me put the milk away": help says nothing, put away
+        # is the task); then the robot's own predicates ("I'd love some wine, could you pour it?"), then what is said to
         # the robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then
         # what leaves open the role its verb states most often ("take the plates and put them": put states
         # a destination far more often than take); else the first
@@ -94,6 +95,7 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
             known,
             key=lambda f: (
                 f.describes,
+                not any(f.roles.values()),
                 f.predicate in parser.lex.learned,
                 not f.addressed,
                 not f.missing(),
