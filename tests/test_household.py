@@ -638,8 +638,9 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     """ "can I have the cup?", "I'd like the cup", "we need the cup": the person who asks is the subject of
     a verb of wanting (`request_verbs`), read as bringing the thing to them (it had no known predicate,
     "have" being no frame at all); with nobody in the scene the robot says so and asks where. "I have a
-    cup, pour the milk into it" still pours, "I don't want the cup" asks for nothing, and "they need the
-    cup" (no speaker) is no request."""
+    cup, pour the milk into it" still pours, "I don't want the cup" asks for nothing, and "they have the
+    cup" (no speaker) is no request. "grab me the cup" and "fetch the cup for her", verbs the robot does not
+    know, bring it to the person too."""
     from lmcr.complete import complete
     from lmcr.srl.instruction import NoPredicateError, NothingAskedError
 
@@ -656,6 +657,12 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
         complete(learned_parser, _prefers("bowl"), "I don't want the cup", objects)
     with pytest.raises(NoPredicateError):
         complete(learned_parser, _prefers("bowl"), "they have the cup", objects)
+    # a verb the robot does not know, said with a person as its recipient, brings the thing to them
+    for said in ("grab me the cup", "fetch the cup for her"):
+        out = complete(learned_parser, _prefers("bowl"), said, objects)
+        assert out.frame.to_json() == {"predicate": "bring", "roles": {"Theme": "cup", "Destination": "person"}}, said
+    with pytest.raises(NoPredicateError):  # with nobody to bring it to, it is still no verb the robot knows
+        complete(learned_parser, _prefers("bowl"), "fetch the cup", objects)
 
 
 def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):

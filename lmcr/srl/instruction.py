@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from spacy.tokens import Doc
+from spacy.tokens import Doc, Token
 
 from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
@@ -39,12 +39,14 @@ def read_instruction(parser: FrameParser, text: str) -> tuple[FrameMention, Doc]
 
 
 def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> list[FrameMention]:
-    """The frames, with the person who asks saying they want a thing read as the robot bringing it to them
-    ("can I have an apple?", "I'd like the salt", "we need something to open this with"): a verb of
-    `Lexicon.request_verbs` with one of `Lexicon.speaker_subjects` as its subject, an object and no
-    other role said is `Lexicon.request_predicate` (when the store learned it), its Theme that object,
-    its Destination the subject ("i"), which names the person (`grounding.speaker_destination`). English
-    grammar, not knowledge of things."""
+    """The frames, with a request for a thing for a person read as the robot bringing it to them: the
+    person who asks saying they want it ("can I have an apple?", "I'd like the salt", "we need something
+    to open this with": a verb of `Lexicon.request_verbs` with one of `Lexicon.speaker_subjects` as its
+    subject), or a verb the robot does not know said with a person as recipient ("grab me a towel",
+    "fetch the milk for her": `recipient`). With an object and no other role said, it is
+    `Lexicon.request_predicate` (when the store learned it), its Theme that object, its Destination the
+    word for the person ("i", "her"), which names them (`grounding.speaker_destination`). English grammar,
+    not knowledge of things."""
     lex = parser.lex
     spec = lex.predicates.get(lex.request_predicate or "")
     if spec is None or spec.name not in lex.learned or "Destination" not in spec.roles:
@@ -52,17 +54,14 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
     at = {f.start: f for f in frames}
     for verb in doc:
         said = at.get(verb.idx)
-        subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
-        thing = next((c for c in verb.children if c.dep_ == "dobj"), None)
-        if lemma_of(verb) not in lex.request_verbs or subject is None or subject.lower_ not in lex.speaker_subjects:
+        person = _wanting(verb, lex) or (recipient(verb, lex) if said is not None and not said.known else None)
+        thing = next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ not in lex.recipient_pronouns), None)
+        found = person is not None and thing is not None and argument_value(thing, lex, parser.compounds)
+        if not found or (said is not None and any(v for r, v in said.roles.items() if r not in ("Theme", "for"))):
             continue
-        found = thing is not None and argument_value(thing, lex, parser.compounds)
-        if not found or (said is not None and any(v for r, v in said.roles.items() if r != "Theme")):
-            continue
-        roles = {spec.object_role: found[0], "Destination": subject.lower_}
         at[verb.idx] = FrameMention(
             spec.name,
-            roles,
+            {spec.object_role: found[0], "Destination": person},
             True,
             verb.idx,
             verb.idx + len(verb),
@@ -71,6 +70,27 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
             describes=verb.dep_ in NOUN_CLAUSE_DEPS,
         )
     return sorted(at.values(), key=lambda f: f.start)
+
+
+def _wanting(verb: Token, lex: Lexicon) -> str | None:
+    """The subject ("i", "we") of a verb of `Lexicon.request_verbs` the person who asks says ("can I have"),
+    or None."""
+    subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
+    wanted = lemma_of(verb) in lex.request_verbs and subject is not None and subject.lower_ in lex.speaker_subjects
+    return subject.lower_ if wanted else None
+
+
+def recipient(verb: Token, lex: Lexicon) -> str | None:
+    """The person's pronoun a verb is said with as its recipient: "grab me a towel", "fetch the milk for
+    her", "pass it to us" (`Lexicon.recipient_pronouns`); None when it has none."""
+    for child in verb.children:
+        if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
+            return child.lower_
+        if child.dep_ in ("dative", "prep") and child.lower_ in ("to", "for"):
+            found = next((c for c in child.children if c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns), None)
+            if found is not None:
+                return found.lower_
+    return None
 
 
 def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
