@@ -843,7 +843,8 @@ def test_why_a_tool_cannot_do_its_class_motion_is_said_in_the_frames_words(motio
 
 def test_a_tool_that_cannot_do_it_is_refused_with_the_reason(sim, tmp_path, learned_parser):
     """ "cut the cake": the knife is the only tool, and its blade cannot saw through a cake that wide: the
-    robot says so, in one line and in its reply, instead of that it knows no motion for cutting."""
+    robot says so, in one line and in its reply, instead of that it knows no motion for cutting; also when
+    the likeliest reading names no tool ("whisk the egg" in the bowl: the whisk cannot stir a lone egg)."""
     from lmcr.complete import CompletionConfig
     from lmcr.robot.execute import NoMotionError, execute
     from lmcr.robot.reply import error_outcome, say
@@ -856,6 +857,13 @@ def test_a_tool_that_cannot_do_it_is_refused_with_the_reason(sim, tmp_path, lear
     assert (
         say(error_outcome(refused.value), learned_parser.lex) == f"Sorry, I can't cut the cake with the knife: {why}."
     )
+    # the likeliest reading names no tool ("whisk the egg in the bowl": no motion); the tool's is still why
+    scene = make_scene([("egg", [0.1, -0.15]), ("whisk", [-0.15, 0.3]), ("bowl", [0.15, 0.15])])
+    into = lambda frames, context="": [  # noqa: E731
+        1.0 if "Destination" in f.role_map else 0.5 if f.role_map.get("Instrument") == "whisk" else 0.0 for f in frames
+    ]
+    with pytest.raises(NoMotionError, match="cannot whisk the egg with the whisk: the egg is not in a kitchen"):
+        execute("whisk the egg", scene, learned_parser, into, CompletionConfig(), tmp_path)
 
 
 def _prefers(label: str):

@@ -73,7 +73,10 @@ def _with_tasks(
         (frame, candidate, task_for(_as_built(frame, shapes), _verb_motion(frame, lex))) for frame, candidate in options
     ]
     if all(task is None for _, _, task in found):
-        raise NoMotionError(completion.frame.predicate, _unfit(options[0][0], shapes, lex))
+        # why the first option with a tool cannot ("whisk the eggs": into the bowl has no motion, and the
+        # whisk cannot stir an egg that is in nothing)
+        unfit = next((u for frame, _ in options if (u := _unfit(frame, shapes, lex)) is not None), None)
+        raise NoMotionError(completion.frame.predicate, unfit)
     return found
 
 
