@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 
-from lmcr.srl.context import antecedents, predicate_token, served_in
+from lmcr.srl.context import antecedents, predicate_token, recipient, served_in
 from lmcr.srl.mentions import FrameMention
 from lmcr.srl.parser import FrameParser
 from lmcr.text import plural_forms
@@ -55,22 +55,12 @@ def referents(parser: FrameParser, doc, frame: FrameMention, detected: list[str]
 MADE_AT_DESTINATION = frozenset({"cut", "cook"})
 
 
-def _to_person(child, lex) -> bool:
-    """Whether a word the verb governs says a person receives the Theme: a person's pronoun as its
-    recipient ("bring me the soap", "give her the knife") or after "to" ("hand the towel to me", "pass
-    the salt to him": `Lexicon.recipient_pronouns`), or "here" as where it goes ("bring the soap here")."""
-    if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
-        return True
-    if child.dep_ in ("dative", "prep") and child.lower_ == "to":
-        return any(c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns for c in child.children)
-    return child.dep_ == "advmod" and child.lower_ in lex.speaker_places
-
-
 def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected: list[str]) -> dict[str, str]:
     """ "bring me the soap", "hand the towel to her", "get me something to drink from", "bring it here": a
-    learned verb said to a person as its recipient (`_to_person`) puts its Theme in their hands, so the
-    detected object that is a person (`Lexicon.speaker_labels`) fills its Destination, open or stated as
-    that pronoun, or as the subject of a request ("can I have the soap": `srl.instruction.with_requests`).
+    learned verb said to a person as its recipient (`srl.context.recipient`), or to where the person who
+    asks is (`Lexicon.speaker_places`: "here"), puts its Theme in their hands, so the detected object
+    that is a person (`Lexicon.speaker_labels`) fills its Destination, open or stated as that pronoun, or
+    as the subject of a request ("can I have the soap": `srl.instruction.with_requests`).
     Not for a verb of a class that makes something at its Destination (`MADE_AT_DESTINATION`); the
     paper's verbs keep their own reading ("pour me some water": into a cup)."""
     lex, open_role = parser.lex, "Destination"
@@ -82,9 +72,10 @@ def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected:
     said = frame.roles[open_role]
     if said is None:
         verb = predicate_token(doc, frame)
-        if verb is None or not any(_to_person(c, lex) for c in verb.children):
+        here = verb is not None and any(c.dep_ == "advmod" and c.lower_ in lex.speaker_places for c in verb.children)
+        if verb is None or not (here or recipient(verb, lex)):
             return {}
-    elif said not in lex.recipient_pronouns | lex.speaker_subjects:  # "to her"; "can I have" (`asked_for`)
+    elif said not in lex.recipient_pronouns | lex.speaker_subjects:  # "to her"; "can I have" (`with_requests`)
         return {}
     person = next((o for o in detected if o in lex.speaker_labels), None)
     return {open_role: person} if person else {}

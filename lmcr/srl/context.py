@@ -138,6 +138,20 @@ def antecedents(
     return list(dict.fromkeys(name for *_, name in sorted(found)))
 
 
+def recipient(verb: Token, lex: Lexicon, preps: tuple[str, ...] = ("to",)) -> str | None:
+    """The person's pronoun (`Lexicon.recipient_pronouns`) a verb is said with as its recipient, as its
+    indirect object ("grab me a towel", "give her the knife") or after one of `preps` ("hand the towel to
+    me"; with "for": "fetch the milk for her"); None when it has none. English grammar."""
+    for child in verb.children:
+        if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
+            return child.lower_
+        if child.dep_ in ("dative", "prep") and child.lower_ in preps:
+            found = next((c for c in child.children if c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns), None)
+            if found is not None:
+                return found.lower_
+    return None
+
+
 # Dependents of a measure noun that count or divide it ("two glasses", "half a cup"): then it is a quantity.
 COUNTING_DEPS = frozenset({"nummod", "predet", "quantmod"})
 

@@ -9,6 +9,7 @@ from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
 from lmcr.lexicon import Lexicon
 from lmcr.srl.arguments import argument_value
+from lmcr.srl.context import recipient
 from lmcr.srl.lemmas import lemma as lemma_of
 from lmcr.srl.mentions import NOUN_CLAUSE_DEPS, FrameMention, is_negated
 from lmcr.srl.parser import FrameParser
@@ -43,7 +44,7 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
     person who asks saying they want it ("can I have an apple?", "I'd like the salt", "we need something
     to open this with": a verb of `Lexicon.request_verbs` with one of `Lexicon.speaker_subjects` as its
     subject), or a verb the robot does not know said with a person as recipient ("grab me a towel",
-    "fetch the milk for her": `recipient`). With an object and no other role said, it is
+    "fetch the milk for her": `srl.context.recipient`). With an object and no other role said, it is
     `Lexicon.request_predicate` (when the store learned it), its Theme that object, its Destination the
     word for the person ("i", "her"), which names them (`grounding.speaker_destination`). English grammar,
     not knowledge of things."""
@@ -54,7 +55,8 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
     at = {f.start: f for f in frames}
     for verb in doc:
         said = at.get(verb.idx)
-        person = _wanting(verb, lex) or (recipient(verb, lex) if said is not None and not said.known else None)
+        unknown = said is not None and not said.known  # "grab me a towel": a verb the robot does not know
+        person = _wanting(verb, lex) or (recipient(verb, lex, ("to", "for")) if unknown else None)
         thing = next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ not in lex.recipient_pronouns), None)
         found = person is not None and thing is not None and argument_value(thing, lex, parser.compounds)
         if not found or (said is not None and any(v for r, v in said.roles.items() if r not in ("Theme", "for"))):
@@ -78,19 +80,6 @@ def _wanting(verb: Token, lex: Lexicon) -> str | None:
     subject = next((c for c in verb.children if c.dep_ == "nsubj"), None)
     wanted = lemma_of(verb) in lex.request_verbs and subject is not None and subject.lower_ in lex.speaker_subjects
     return subject.lower_ if wanted else None
-
-
-def recipient(verb: Token, lex: Lexicon) -> str | None:
-    """The person's pronoun a verb is said with as its recipient: "grab me a towel", "fetch the milk for
-    her", "pass it to us" (`Lexicon.recipient_pronouns`); None when it has none."""
-    for child in verb.children:
-        if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
-            return child.lower_
-        if child.dep_ in ("dative", "prep") and child.lower_ in ("to", "for"):
-            found = next((c for c in child.children if c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns), None)
-            if found is not None:
-                return found.lower_
-    return None
 
 
 def _open_rate(lex: Lexicon, frame: FrameMention) -> float:
