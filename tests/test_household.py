@@ -639,8 +639,9 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     a verb of wanting (`request_verbs`), read as bringing the thing to them (it had no known predicate,
     "have" being no frame at all); with nobody in the scene the robot says so and asks where. "I have a
     cup, pour the milk into it" still pours, "I don't want the cup" asks for nothing, and "they have the
-    cup" (no speaker) is no request. "grab me the cup" and "fetch the cup for her", verbs the robot does not
-    know, bring it to the person too."""
+    cup" (no speaker) is no request, nor "can I have some milk in the cup?" (it says where the milk goes).
+    "grab me the cup" and "fetch the cup for her", verbs the robot does not know, bring it to the person
+    too."""
     from lmcr.complete import complete
     from lmcr.srl.instruction import NoPredicateError, NothingAskedError
 
@@ -655,8 +656,9 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     assert poured.frame.predicate == "pour"
     with pytest.raises(NothingAskedError, match="not to bring"):
         complete(learned_parser, _prefers("bowl"), "I don't want the cup", objects)
-    with pytest.raises(NoPredicateError):
-        complete(learned_parser, _prefers("bowl"), "they have the cup", objects)
+    for said in ("they have the cup", "can I have some milk in the cup?"):  # no speaker; milk put somewhere
+        with pytest.raises(NoPredicateError):
+            complete(learned_parser, _prefers("bowl"), said, objects)
     # a verb the robot does not know, said with a person as its recipient, brings the thing to them
     for said in ("grab me the cup", "fetch the cup for her"):
         out = complete(learned_parser, _prefers("bowl"), said, objects)

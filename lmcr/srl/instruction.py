@@ -7,7 +7,7 @@ from spacy.tokens import Doc, Token
 
 from lmcr.errors import LMCRError
 from lmcr.jsonl import check_text
-from lmcr.lexicon import Lexicon
+from lmcr.lexicon import PREP_ROLES, Lexicon
 from lmcr.srl.arguments import argument_value
 from lmcr.srl.context import recipient
 from lmcr.srl.lemmas import lemma as lemma_of
@@ -44,7 +44,7 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
     person who asks saying they want it ("can I have an apple?", "I'd like the salt", "we need something
     to open this with": a verb of `Lexicon.request_verbs` with one of `Lexicon.speaker_subjects` as its
     subject), or a verb the robot does not know said with a person as recipient ("grab me a towel",
-    "fetch the milk for her": `srl.context.recipient`). With an object and no other role said, it is
+    "fetch the milk for her": `srl.context.recipient`). With an object and no place or tool said, it is
     `Lexicon.request_predicate` (when the store learned it), its Theme that object, its Destination the
     word for the person ("i", "her"), which names them (`grounding.speaker_destination`). English grammar,
     not knowledge of things."""
@@ -59,7 +59,7 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
         person = _wanting(verb, lex) or (recipient(verb, lex, ("to", "for")) if unknown else None)
         thing = next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ not in lex.recipient_pronouns), None)
         found = person is not None and thing is not None and argument_value(thing, lex, parser.compounds)
-        if not found or (said is not None and any(v for r, v in said.roles.items() if r not in ("Theme", "for"))):
+        if not found or _says_where(verb, lex) or _says_where(thing, lex):  # "some milk in my coffee": pouring
             continue
         at[verb.idx] = FrameMention(
             spec.name,
@@ -72,6 +72,17 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
             describes=verb.dep_ in NOUN_CLAUSE_DEPS,
         )
     return sorted(at.values(), key=lambda f: f.start)
+
+
+def _says_where(word: Token, lex: Lexicon) -> bool:
+    """Whether the word (the verb, or its object) has a phrase English gives a place or a tool
+    (`PREP_ROLES`) that names no person: "in my coffee", "into the sink", "with the knife"."""
+    for child in word.children:
+        roles = PREP_ROLES.get(child.lower_, ()) if child.dep_ == "prep" else ()
+        named = [c for c in child.children if c.dep_ == "pobj" and c.lower_ not in lex.recipient_pronouns]
+        if named and {"Destination", "Instrument"} & set(roles):
+            return True
+    return False
 
 
 def _wanting(verb: Token, lex: Lexicon) -> str | None:
