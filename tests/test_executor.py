@@ -649,28 +649,57 @@ def test_what_keeps_a_task_out_of_reach_is_set_down_elsewhere_first(
     assert out["checks"]["knocked"] == []
 
 
-def test_a_target_out_of_reach_is_brought_nearer_first(sim, tmp_path):
-    """Stir the soup at the right arm's far corner with the spoon beside it (bench seed 1, stir 6): no arm
-    reaches over the soup, and setting the spoon down elsewhere does not change that. The soup itself is
-    set down where an arm reaches over it, and then stirred, all planned before anything moves."""
+@pytest.mark.parametrize(
+    "motion, tool, target, layout, out_of_reach",
+    [
+        (  # bench seed 1, stir 6: the soup at the right arm's far corner, the spoon beside it
+            "stir",
+            "spoon",
+            "soup",
+            [
+                ("soup", [-0.219, -0.359]),
+                ("spoon", [-0.196, -0.24]),
+                ("recycling bin", [0.086, 0.369]),
+                ("stove", [-0.05, 0.002]),
+                ("oven", [0.104, -0.321]),
+                ("butter", [-0.171, 0.251]),
+            ],
+            True,
+        ),
+        (  # bench seed 1, cut 12: the bread in the far right corner beside the stove
+            "cut",
+            "knife",
+            "bread",
+            [
+                ("bread", [0.199, -0.379]),
+                ("knife", [-0.027, 0.073]),
+                ("stove", [0.112, -0.168]),
+                ("rice", [-0.233, -0.053]),
+                ("batter", [0.155, 0.215]),
+                ("bell pepper", [-0.082, 0.221]),
+            ],
+            False,
+        ),
+    ],
+)
+def test_a_target_no_arm_can_act_on_is_set_down_elsewhere_first(
+    sim, tmp_path, motion, tool, target, layout, out_of_reach
+):
+    """Stir the soup at the right arm's far corner (no arm reaches over it), cut the bread beside the stove
+    (the arm sawing it would meet the stove, which stays where it is): setting the tool down elsewhere does
+    not help. The target itself is set down elsewhere first, then the task done, all planned before
+    anything moves."""
     from lmcr.robot.act import run_plan
     from lmcr.robot.execute import plan_task
     from lmcr.robot.plan import Plan, Planner
 
-    layout = [
-        ("soup", [-0.219, -0.359]),
-        ("spoon", [-0.196, -0.24]),
-        ("recycling bin", [0.086, 0.369]),
-        ("stove", [-0.05, 0.002]),
-        ("oven", [0.104, -0.321]),
-        ("butter", [-0.171, 0.251]),
-    ]
     scene = scene_from_json({"objects": [{"label": label, "xy": xy} for label, xy in layout], "seed": 0}, "scene")
     planner = Planner(build_world(scene, tmp_path), scene, scene.table, Budget(seconds=math.inf))
-    spoon, soup = scene.find("spoon"), scene.find("soup")
-    plan = plan_task(planner, scene, tasks.TOOL_MOTIONS["stir"], {"Instrument": spoon, "Theme": soup})
-    assert isinstance(plan, Plan) and plan.first.geometry.held is soup and plan.instead_of.out_of_reach, plan
-    out = run_plan(plan, spoon, soup, [o for o in scene.objects if o not in (spoon, soup)], planner)
+    held, acted_on = scene.find(tool), scene.find(target)
+    plan = plan_task(planner, scene, tasks.TOOL_MOTIONS[motion], {"Instrument": held, "Theme": acted_on})
+    assert isinstance(plan, Plan) and plan.first.geometry.held is acted_on, plan
+    assert plan.instead_of.out_of_reach == out_of_reach, plan.instead_of
+    out = run_plan(plan, held, acted_on, [o for o in scene.objects if o not in (held, acted_on)], planner)
     assert out["success"], out
 
 

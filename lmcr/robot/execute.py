@@ -298,18 +298,20 @@ def _set_aside(
     planner: Planner, refused: Infeasible, held: SceneObject, target: SceneObject, holding: bool
 ) -> list[SceneObject]:
     """What to set down elsewhere first, in the order to try, after `refused`: when no arm reaches all the
-    task as it stands, the held object (from the table it may be picked up by either arm, in any grasp),
-    then, with the hand free, the target when it is no fixed receptacle (the soup to stir brought nearer
-    the robot); else, with the hand free, the object on the table a pose would put the arm against
-    (unless it is fixed), then the held object, moved away from it (a bin beside the banana, a fridge's
-    open lid in the way to the milk)."""
+    task as it stands, the held object (from the table it may be picked up by either arm, in any grasp);
+    else, with the hand free, the object on the table a pose would put the arm against (unless it is
+    fixed), then the held object, moved away from it (a bin beside the banana, a fridge's open lid in the
+    way to the milk). Last, with the hand free, the target when it is no fixed receptacle: the soup to
+    stir brought nearer the robot, the bread to cut away from the stove beside it."""
+    free = not holding and target is not held and target in planner.scene.objects  # a hand to move it
+    last = [target] if free and not _fixed(target) else []
     if refused.out_of_reach:
-        free = not holding and target is not held and target in planner.scene.objects  # a hand to move it
-        return [held, *([target] if free and not _fixed(target) else [])]
+        return [held, *last]
     blocking = None if holding else planner.on_table(refused.blocker)
     if blocking is None:
         return []
-    return [*([] if _fixed(blocking) else [blocking]), *([] if blocking is held else [held])]
+    first = [*([] if _fixed(blocking) else [blocking]), *([] if blocking is held else [held])]
+    return [*first, *(o for o in last if o not in first)]
 
 
 def _fixed(obj: SceneObject) -> bool:
