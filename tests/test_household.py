@@ -667,6 +667,21 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
         complete(learned_parser, _prefers("bowl"), "fetch the cup", objects)
 
 
+def test_a_thing_asked_for_a_person_nobody_in_the_scene_is_refused(sim, tmp_path, learned_parser):
+    """ "can I have the cup?" with nobody at the table: the completion fills the place from the objects and
+    asks, and the robot refuses to move rather than put the cup in the bowl (it had said it had no motion
+    for bring); its reply names who is missing."""
+    from lmcr.complete import CompletionConfig
+    from lmcr.robot.execute import ExecutionError, execute
+    from lmcr.robot.reply import error_outcome, say
+
+    scene = make_scene([("cup", [-0.1, 0.25]), ("bowl", [0.1, 0.15])])
+    refusal = r"cannot bring: no one to hand it to \(the camera sees: cup, bowl\)"
+    with pytest.raises(ExecutionError, match=refusal) as no:
+        execute("can I have the cup?", scene, learned_parser, _prefers("bowl"), CompletionConfig(), tmp_path)
+    assert say(error_outcome(no.value), learned_parser.lex) == "I see no person on the table."
+
+
 def test_a_thing_asked_for_by_its_purpose_is_scored_as_what_the_purpose_needs(learned_parser):
     """ "bring me something to cut the bread with": "something" leaves the Theme to complete, and each
     candidate is also scored as the Instrument of cutting the bread; the scorer likes bringing a spoon,

@@ -146,6 +146,8 @@ def execute(
     seen = detect(scene.bodies)
     held = (scene.holding.label,) if scene.holding else ()
     completion = complete(parser, scorer, instruction, [d.label for d in seen], config, [d.id for d in seen], held)
+    if not answer:
+        _check_someone_there(completion, parser.lex, seen)
     options = _with_tasks(completion, _options(completion, answer), parser.lex, scene.shapes())[:MAX_TRIED]
     completed = time.perf_counter()
     planner = Planner(robot, scene, scene.table, budget or Budget())
@@ -203,6 +205,18 @@ def execute(
         "plan_and_execute": round(done - completed, 3),
     }
     return out
+
+
+def _check_someone_there(completion: Completion, lex: Lexicon, seen: list) -> None:
+    """ExecutionError when the request is for a person ("can I have an apple?", "hand the cup to her") and
+    the camera sees no one: what the completion filled in instead (a bowl) is no one's hands."""
+    people = lex.recipient_pronouns | lex.speaker_subjects
+    if any(word in people for word in completion.unresolved.values()):
+        person = min(lex.speaker_labels, default="person")
+        there = ", ".join(d.id for d in seen) or "nothing"
+        raise ExecutionError(
+            f"cannot {completion.frame.predicate}: no one to hand it to (the camera sees: {there})", absent=person
+        )
 
 
 def _search(planner: Planner, scene: Scene, options: list, seen: set[str]) -> list[tuple]:
