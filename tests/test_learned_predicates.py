@@ -252,7 +252,7 @@ def test_requests_with_learned_verbs_parse_into_their_frames(learned_parser, ins
 def test_a_frame_that_states_nothing_gives_way_to_one_that_does(learned_parser):
     """ "can you help me put the milk away?": help is said to the robot and states nothing; put away, whose
     subject is "me" in the parse, states the milk. The task is putting the milk away (help had been read,
-    with both its roles to fill)."""
+    with both its roles to fill). The paper's predicates still come first, stating something or not."""
     from lmcr.srl.instruction import _first_known
     from lmcr.srl.mentions import FrameMention
 
@@ -260,6 +260,10 @@ def test_a_frame_that_states_nothing_gives_way_to_one_that_does(learned_parser):
     puts = FrameMention("put away", {"Theme": "milk", "Destination": None}, True, 16, 19, addressed=False)
     assert _first_known(learned_parser, "can you help me put the milk away?", [helps, puts]) is puts
     assert _first_known(learned_parser, "can you help?", [helps]) is helps  # alone it is still read
+    # the robot's own predicates still come first: "I like my coffee with milk, pour some in"
+    likes = FrameMention("put", {"Theme": "coffee", "Destination": "milk"}, True, 2, 6, addressed=False)
+    pours = FrameMention("pour", {"Theme": None, "Destination": None}, True, 30, 34, addressed=True)
+    assert _first_known(learned_parser, "I like my coffee with milk, pour some in", [likes, pours]) is pours
 
 
 @pytest.mark.model

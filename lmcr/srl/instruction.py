@@ -106,8 +106,9 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
     if known:
         # not a clause that says what a thing is for ("get me something to pour the water into" asks to get
         # it; the clause is read only when nothing else is known: a misparse may hang the request there);
-        # then one that says something ("can you help me put the milk away": help says nothing, put away
-        # is the task); then the robot's own predicates ("I'd love some wine, could you pour it?"), then what is said to
+        # then the robot's own predicates ("I'd love some wine, could you pour it?", "I like my coffee with
+        # milk, pour some in"), then one that says something ("can you help me put the milk away": help
+        # says nothing, put away is the task), then what is said to
         # the robot ("I drank it already. Can you dispose of it?"), then what leaves something to do, then
         # what leaves open the role its verb states most often ("take the plates and put them": put states
         # a destination far more often than take); else the first
@@ -115,8 +116,8 @@ def _first_known(parser: FrameParser, text: str, frames: list[FrameMention]) -> 
             known,
             key=lambda f: (
                 f.describes,
-                not any(f.roles.values()),
                 f.predicate in parser.lex.learned,
+                not any(f.roles.values()),
                 not f.addressed,
                 not f.missing(),
                 -_open_rate(parser.lex, f),
