@@ -232,7 +232,7 @@ def complete(
     # A stated word grounds in any detection: the person named it ("season the cucumbers" with a
     # cucumber seen), so it is no choice of ours even when the robot has no vocabulary for it.
     vocabulary = (*parser.lex.objects, *held) if parser.lex.objects else ()
-    roles, unresolved = ground_roles(roles, vocabulary, detected, instruction)
+    roles, unresolved = ground_roles(roles, vocabulary, detected, instruction, frame.spans)
     # A stated word the robot cannot ground still says what is meant ("pour milk in my coffee", no coffee
     # seen: the mug): its phrase is read as context, as the rest of the utterance is.
     context = utterance_context(doc, frame, said=frozenset(unresolved)) if config.context else ""

@@ -96,22 +96,29 @@ def served_vessel(
 
 
 def ground_roles(
-    roles: dict[str, str | None], vocabulary: tuple[str, ...], detected: list[str], said: str = ""
+    roles: dict[str, str | None],
+    vocabulary: tuple[str, ...],
+    detected: list[str],
+    said: str = "",
+    spans: dict[str, tuple[int, int]] | None = None,
 ) -> tuple[dict[str, str | None], dict[str, str]]:
     """Stated fillers grounded in the detected objects or the robot's object vocabulary, and the ones
     the robot cannot ground ("fry two sunny side up" -> Theme 'side'), which are filled from the
     objects like a missing role. Without a vocabulary in the lexicon every stated filler is kept.
     `said` is the instruction: an object whose whole label it says names the filler the parser cut
-    short ("put the tank top away": Theme 'tank')."""
+    short ("put the tank top away": Theme 'tank'), and so does one it says in full where the filler's
+    phrase ends (`spans`, role -> the phrase's characters: "serve the soup in the blue bowl", 'bowl')."""
     if not vocabulary:
         return roles, {}
     seen, words = set(detected), set(vocabulary)
 
-    def ground(value: str) -> str | None:  # what the person sees first, then what the robot knows
-        found = grounded(value, seen) or named_by_head(value, detected) or said_in_full(value, detected, said)
-        return found or named_by_modifier(value, detected) or grounded(value, words)
+    def ground(role: str, value: str) -> str | None:  # what the person sees first, then what the robot knows
+        end = (spans or {}).get(role, (0, 0))[1]
+        found = said_before(end, value, detected, said) or grounded(value, seen) or named_by_head(value, detected)
+        found = found or said_in_full(value, detected, said) or named_by_modifier(value, detected)
+        return found or grounded(value, words)
 
-    named = {r: v and ground(v) for r, v in roles.items()}
+    named = {r: v and ground(r, v) for r, v in roles.items()}
     unresolved = {r: v for r, v in roles.items() if v and named[r] is None}
     return named, unresolved
 
@@ -155,6 +162,20 @@ def named_by_modifier(value: str, detected: list[str]) -> str | None:
     in the recycling" with a recycling bin; None when no object or several are so named."""
     found = [o for o in detected if o.startswith(f"{value} ")]
     return found[0] if len(found) == 1 else None
+
+
+def said_before(end: int, value: str, detected: list[str], said: str) -> str | None:
+    """The one detected object, its label longer than the filler, that the instruction says in full
+    ending at character `end`, where the filler's phrase ends ("the blue bowl": the parser kept 'bowl',
+    and a blue bowl is on the table beside a bowl); None when none or several are."""
+    words = re.findall(r"[a-z0-9']+", said[:end].lower())
+
+    def ends_with(label: list[str]) -> bool:
+        tail = words[-len(label) :]
+        return len(tail) == len(label) and tail[:-1] == label[:-1] and same_noun(tail[-1], label[-1])
+
+    longer = [o for o in detected if len(o.split()) > len(value.split()) and ends_with(o.split())]
+    return longer[0] if len(longer) == 1 else None
 
 
 def said_in_full(value: str, detected: list[str], said: str) -> str | None:

@@ -312,9 +312,9 @@ def test_a_thing_said_but_not_grounded_is_no_missing_role_and_is_one_of_the_obje
 def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(parser):
     """The parser's lemma "carrot" is the carrots on the table, "dish" the dishes, "patty" the mint
     patties; an object whose whole label the instruction says is what a filler cut short stands for
-    ("the tank top": Theme 'tank'); "the trash" names the one trash can; a detected object comes before
-    the robot's word for it."""
-    from lmcr.grounding import ground_roles, named_by_head, named_by_modifier, said_in_full, same_noun
+    ("the tank top": Theme 'tank'), and one it says where the filler ends ("the blue cup": 'cup'); "the
+    trash" names the one trash can; a detected object comes before the robot's word for it."""
+    from lmcr.grounding import ground_roles, named_by_head, named_by_modifier, said_before, said_in_full, same_noun
 
     assert same_noun("carrot", "carrots") and same_noun("dishes", "dish") and same_noun("patty", "patties")
     assert not same_noun("cup", "cups of") and not same_noun("pan", "pants")
@@ -331,6 +331,13 @@ def test_a_stated_thing_grounds_in_the_object_named_in_either_number_or_in_full(
     assert named_by_modifier("trash", ["trash can", "banana"]) == "trash can"
     assert named_by_modifier("storage", ["storage box", "storage chest"]) is None  # which: the robot asks
     assert named_by_modifier("can", ["trash can", "canister"]) is None
+    # "the blue cup": the parser keeps 'cup', and a blue cup is on the table beside a cup
+    assert said_before(len("pour it into the blue cup"), "cup", ["cup", "blue cup"], "pour it into the blue cup") == (
+        "blue cup"
+    )
+    assert said_before(len("pour it into the cup"), "cup", ["cup", "blue cup"], "pour it into the cup") is None
+    blue = complete(parser, scorer, "pour the water into the blue cup", ["water", "cup", "blue cup"])
+    assert blue.frame.role_map["Destination"] == "blue cup" and blue.missing is None
     said = {"Theme": "shirt", "Destination": "laundry"}
     roles, unresolved = ground_roles(said, ("cup",), ["shirt", "laundry basket"])
     assert roles == {"Theme": "shirt", "Destination": "laundry basket"} and not unresolved
