@@ -142,8 +142,11 @@ def recipient(verb: Token, lex: Lexicon, preps: tuple[str, ...] = ("to",)) -> st
     """The person's pronoun (`Lexicon.recipient_pronouns`) a verb is said with as its recipient, as its
     indirect object ("grab me a towel", "give her the knife") or after one of `preps` ("hand the towel to
     me"; with "for": "fetch the milk for her"); None when it has none. English grammar."""
+    objects = [c for c in verb.children if c.dep_ == "dobj"]
     for child in verb.children:
-        if child.dep_ == "dative" and child.lower_ in lex.recipient_pronouns:
+        # "pass me the spatula" is sometimes parsed with two objects: the pronoun before the other is who gets it
+        first_of_two = child.dep_ == "dobj" and len(objects) > 1 and child.i == objects[0].i
+        if (child.dep_ == "dative" or first_of_two) and child.lower_ in lex.recipient_pronouns:
             return child.lower_
         if child.dep_ in ("dative", "prep") and child.lower_ in preps:
             found = next((c for c in child.children if c.dep_ == "pobj" and c.lower_ in lex.recipient_pronouns), None)
