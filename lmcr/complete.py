@@ -267,7 +267,7 @@ def complete(
     pool = _pool(frame.predicate, roles, missing, free, ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
     people = parser.lex.recipient_pronouns | parser.lex.speaker_subjects  # "bring it to her": no one seen
-    fillings = _candidate_frames(missing, pool, _open_roles(spec, roles, missing), named)
+    fillings = _candidate_frames(missing, pool, _open_roles(spec, missing, unresolved), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
         scores = [s + spec.open_role_prior(next(iter(f))) for s, f in zip(scores, fillings)]
@@ -321,10 +321,12 @@ def _scores(scorer: Scorer, frames: list[Frame], fillings: list[dict[str, str]],
     return [score - best[role] + best_without[role] for role, score in zip(by_role, full)]
 
 
-def _open_roles(spec, roles: dict[str, str | None], missing: list[str]) -> tuple[str, ...]:
+def _open_roles(spec, missing: list[str], unresolved: dict[str, str]) -> tuple[str, ...]:
     """The roles one missing role may be: a learned predicate's open roles when its second role is the
-    missing one ("cut the bread": into the bowl, or with the knife), else just that role."""
-    if len(missing) == 1 and spec.alternatives and missing[0] == spec.roles[1]:
+    missing one ("cut the bread": into the bowl, or with the knife), else just that role; also just that
+    role when a word was said for it that grounds in no one object ("put the cup in the drawer" with two
+    drawers: a drawer, not something to put it with)."""
+    if len(missing) == 1 and spec.alternatives and missing[0] == spec.roles[1] and missing[0] not in unresolved:
         return spec.open_roles
     return tuple(missing)
 

@@ -449,6 +449,21 @@ def test_the_objects_choose_which_open_role_a_request_left_missing(learned_parse
 
 
 @pytest.mark.model
+def test_a_role_a_word_was_said_for_is_not_open_to_the_others():
+    """ "put the cup in the drawer" with a top and a bottom drawer: the word names no one object, so the
+    role is filled from the objects it names, but it is the Destination that was said: the verb's other
+    open role (something to put it with) is no reading of it (a bowl had won as the Instrument)."""
+    from lmcr.complete import _open_roles
+    from lmcr.lexicon import PredicateSpec
+
+    put = PredicateSpec(
+        "put", ("Theme", "Destination"), "Theme", None, {}, frozenset(), False, "put {Theme} in the {Destination}",
+        alternatives={"Instrument": "put {Theme} with the {Instrument}"},
+    )  # fmt: skip
+    assert _open_roles(put, ["Destination"], {}) == ("Destination", "Instrument")
+    assert _open_roles(put, ["Destination"], {"Destination": "drawer"}) == ("Destination",)
+
+
 def test_a_within_role_term_ranks_fillers_but_leaves_the_open_role_to_the_rest(learned_parser):
     from lmcr.complete import complete
     from lmcr.scorers.registry import SummedScorer
