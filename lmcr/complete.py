@@ -266,7 +266,6 @@ def complete(
     free = [o for o in detected if o not in stated | for_purpose | conjoined(doc, frame, detected)]
     pool = _pool(frame.predicate, roles, missing, free, ignored, config)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
-    people = parser.lex.recipient_pronouns | parser.lex.speaker_subjects  # "bring it to her": no one seen
     fillings = _candidate_frames(missing, pool, _open_roles(spec, missing, unresolved), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
     if len(missing) == 1 and spec.alternatives:  # which role was left open: as often as it is stated
@@ -289,7 +288,15 @@ def complete(
         missing_roles=tuple(missing),
         candidates=candidates,
         question=_ask(
-            spec, roles, list(candidates[0].objects), read, candidates, in_set, config.max_choices, named, people
+            spec,
+            roles,
+            list(candidates[0].objects),
+            read,
+            candidates,
+            in_set,
+            config.max_choices,
+            named,
+            parser.lex.person_words,  # "bring it to her" with no one seen
         ),
         instances=_instances(chosen, ids_of),
         prediction_set=tuple(c.object for c in in_set),

@@ -75,7 +75,7 @@ def speaker_destination(parser: FrameParser, doc, frame: FrameMention, detected:
         here = verb is not None and any(c.dep_ == "advmod" and c.lower_ in lex.speaker_places for c in verb.children)
         if verb is None or not (here or recipient(verb, lex)):
             return {}
-    elif said not in lex.recipient_pronouns | lex.speaker_subjects:  # "to her"; "can I have" (`with_requests`)
+    elif said not in lex.person_words:  # "to her"; "can I have" (`with_requests`)
         return {}
     person = next((o for o in detected if o in lex.speaker_labels), None)
     return {open_role: person} if person else {}

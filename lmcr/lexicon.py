@@ -160,6 +160,12 @@ class Lexicon:
         return f"the corpora's {seen:,} frames of {name!r} seldom say where it puts things or with what"
 
     @property
+    def person_words(self) -> frozenset[str]:
+        """The words that name a person in a request: a recipient ("me", "her") or the person who asks as a
+        request's subject ("i", "we")."""
+        return self.recipient_pronouns | self.speaker_subjects
+
+    @property
     def hand_written(self) -> list[str]:
         """The predicates of the hand-written lexicon (the paper's eleven)."""
         return sorted(p for p in self.predicates if p not in self.learned)

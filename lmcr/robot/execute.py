@@ -210,8 +210,7 @@ def execute(
 def _check_someone_there(completion: Completion, lex: Lexicon, seen: list) -> None:
     """ExecutionError when the request is for a person ("can I have an apple?", "hand the cup to her") and
     the camera sees no one: what the completion filled in instead (a bowl) is no one's hands."""
-    people = lex.recipient_pronouns | lex.speaker_subjects
-    if any(word in people for word in completion.unresolved.values()):
+    if any(word in lex.person_words for word in completion.unresolved.values()):
         person = min(lex.speaker_labels, default="person")
         there = ", ".join(d.id for d in seen) or "nothing"
         raise ExecutionError(
