@@ -638,7 +638,8 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     """ "can I have the cup?", "I'd like the cup", "we need the cup": the person who asks is the subject of
     a verb of wanting (`request_verbs`), read as bringing the thing to them (it had no known predicate,
     "have" being no frame at all); with nobody in the scene the robot says so and asks where. "I have a
-    cup, pour the milk into it" still pours, "I don't want the cup" asks for nothing, and "they have the
+    cup, pour the milk into it" still pours, and so does a request said to the robot beside it ("I need the
+    cup for the tea, put the milk in the bowl"); "I don't want the cup" asks for nothing, and "they have the
     cup" (no speaker) is no request, nor "can I have some milk in the cup?" (it says where the milk goes).
     "grab me the cup" and "fetch the cup for her", verbs the robot does not know, bring it to the person
     too."""
@@ -654,6 +655,9 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     assert alone.question.startswith("I see no one here. Should I bring ")
     poured = complete(learned_parser, _prefers("bowl"), "I have a cup, pour the milk into it", objects)
     assert poured.frame.predicate == "pour"
+    # said of the asker, it gives way to a request said to the robot
+    put = complete(learned_parser, _prefers("bowl"), "I need the cup for the tea, put the milk in the bowl", objects)
+    assert put.frame.predicate == "put", put.frame
     with pytest.raises(NothingAskedError, match="not to bring"):
         complete(learned_parser, _prefers("bowl"), "I don't want the cup", objects)
     for said in ("they have the cup", "can I have some milk in the cup?"):  # no speaker; milk put somewhere

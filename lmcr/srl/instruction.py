@@ -56,7 +56,8 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
     for verb in doc:
         said = at.get(verb.idx)
         unknown = said is not None and not said.known  # "grab me a towel": a verb the robot does not know
-        person = _wanting(verb, lex) or (recipient(verb, lex, ("to", "for")) if unknown else None)
+        wanting = _wanting(verb, lex)
+        person = wanting or (recipient(verb, lex, ("to", "for")) if unknown else None)
         thing = next((c for c in verb.children if c.dep_ == "dobj" and c.lower_ not in lex.recipient_pronouns), None)
         found = person is not None and thing is not None and argument_value(thing, lex, parser.compounds)
         if not found or _says_where(verb, lex) or _says_where(thing, lex):  # "some milk in my coffee": pouring
@@ -68,6 +69,9 @@ def with_requests(parser: FrameParser, doc: Doc, frames: list[FrameMention]) -> 
             verb.idx,
             verb.idx + len(verb),
             {spec.object_role: found[1:]},
+            # "I need the bowl" is said of the asker, not to the robot: a request said to it comes first
+            # ("I need the bowl for the salad, put the apples in the fridge")
+            addressed=not wanting and (said is None or said.addressed),
             negated=is_negated(verb),
             describes=verb.dep_ in NOUN_CLAUSE_DEPS,
         )
