@@ -264,7 +264,9 @@ def complete(
     for_purpose = {grounded(v, set(detected)) for v in purpose.roles.values()} if purpose else set()
     # "mix the flour and sugar": the sugar is mixed too, not what it is mixed with
     free = [o for o in detected if o not in stated | for_purpose | conjoined(doc, frame, detected)]
-    pool = _pool(frame.predicate, roles, missing, free, ignored, config)
+    # "can I have the cup?" with nobody and nothing else seen: the error says who is not there
+    unseen = _unseen({r: w for r, w in unresolved.items() if r in missing}, {}, parser.lex.person_words)
+    pool = _pool(frame.predicate, roles, missing, free, ignored, config, unseen)
     named = {r: objects_named(word, pool) for r, word in unresolved.items()}
     fillings = _candidate_frames(missing, pool, _open_roles(spec, missing, unresolved), named)
     scores = _scores(scorer, [Frame.of(frame.predicate, _filled(roles, f)) for f in fillings], fillings, context)
@@ -362,16 +364,18 @@ def _pool(
     unstated: list[str],
     ignored: list[str],
     config: CompletionConfig,
+    unseen: str = "",
 ) -> list[str]:
     """The objects the missing roles may be filled with (the unstated detections that name an object), or
-    CompletionError when there are too few of them or they give too many combinations to score."""
+    CompletionError when there are too few of them (saying first what was named but not seen: `unseen`,
+    "I see no one here.") or they give too many combinations to score."""
     pool = [o for o in unstated if o not in ignored]
     if len(pool) < len(missing):
         stated = sorted({v for v in roles.values() if v})
         shown = [repr(o if len(o) <= 30 else o[:27] + "...") for o in ignored[:3]]  # the error stays one short line
         unnamed = f" ({', '.join(shown)}{', ...' if len(ignored) > 3 else ''}: no object name)" if ignored else ""
         raise CompletionError(
-            f"cannot fill {', '.join(missing)} of {predicate!r}: "
+            f"cannot fill {', '.join(missing)} of {predicate!r}: {unseen.rstrip('.') + '; ' if unseen else ''}"
             f"{'no usable objects' if not pool else 'too few usable objects'} besides "
             f"{stated or 'none'}{unnamed}",
             {"predicate": predicate, "roles": roles},

@@ -643,7 +643,7 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
     cup" (no speaker) is no request, nor "can I have some milk in the cup?" (it says where the milk goes).
     "grab me the cup" and "fetch the cup for her", verbs the robot does not know, bring it to the person
     too."""
-    from lmcr.complete import complete
+    from lmcr.complete import CompletionError, complete
     from lmcr.srl.instruction import NoPredicateError, NothingAskedError
 
     objects = ["cup", "bowl", "person", "milk"]
@@ -653,6 +653,9 @@ def test_a_person_saying_they_want_a_thing_is_asking_for_it(learned_parser):
         assert out.missing is None and out.referred == {"Destination": "person"}, said
     alone = complete(learned_parser, _prefers("bowl"), "can I have the cup?", ["cup", "bowl", "milk"])
     assert alone.question.startswith("I see no one here. Should I bring ")
+    # with nothing else to bring it to, the robot says who it does not see, not only that nothing is left
+    with pytest.raises(CompletionError, match=r"^cannot fill Destination of 'bring': I see no one here; no usable"):
+        complete(learned_parser, _prefers("bowl"), "can I have the cup?", ["cup"])
     poured = complete(learned_parser, _prefers("bowl"), "I have a cup, pour the milk into it", objects)
     assert poured.frame.predicate == "pour"
     # said of the asker, it gives way to a request said to the robot
