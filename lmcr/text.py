@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 import unicodedata
+from collections.abc import Mapping
 
 # Vulgar fractions become ASCII so "1½ cups" and "1 1/2 cups" are one form; NFKC alone would give
 # "1⁄2" with a fraction slash and glue it to the whole number.
@@ -120,6 +121,24 @@ def split_sentences(text: str) -> list[str]:
 def count_words(text: str) -> int:
     """Whitespace-delimited word count, the unit of every words/s figure."""
     return len(text.split())
+
+
+def singular_forms(word: str) -> tuple[str, ...]:
+    """The singulars English spelling can give a plural noun, the inverse of `plural_forms` and of -ves:
+    carrots -> carrot, dishes -> dish, patties -> patty, knives -> knife (and carrot -> carro: which of
+    them is a word is for the caller's counts to say)."""
+    endings = (("s", ""), ("es", ""), ("ies", "y"), ("ves", "f"), ("ves", "fe"))
+    return tuple(word[: -len(end)] + base for end, base in endings if word.endswith(end) and len(word) > len(end))
+
+
+def counted_form(label: str, counts: Mapping[str, float]) -> str:
+    """The form of an object's label its corpus counts name it by: its last word in the singular where the
+    counts know that form better ("eggs" -> egg, "kettle chips" -> "kettle chip"), else the label itself.
+    The frame corpus keeps a filler's head as its lemma, so an object labelled in the plural would read as
+    a filler hardly ever seen."""
+    *name, last = label.split() or [""]
+    forms = [" ".join([*name, f]) for f in singular_forms(last)] if last.endswith("s") else []
+    return max([label, *forms], key=lambda f: counts.get(f, 0.0))
 
 
 def plural_forms(word: str) -> tuple[str, ...]:

@@ -47,6 +47,22 @@ def test_smoothed_estimates_by_hand():
     )
 
 
+def test_an_object_labelled_in_the_plural_is_scored_as_the_corpus_counts_it():
+    """The frame corpus keeps a filler's head as its lemma ("whisk the eggs" counts egg): a label in the
+    plural ("eggs", "plates") is scored as its singular where the counts know that form better, else as
+    it is ("glass" is no plural of "glas")."""
+    fillers, pairs = counted(
+        [("whisk", {"Theme": "egg", "Destination": "bowl"}, 5), ("pour", {"Theme": "water", "Destination": "glass"}, 2)]
+    )
+    m = FrameCountScorer(fillers, pairs, alpha=2.0)
+    singular = ("whisk", {"Theme": "egg", "Destination": "bowl"})
+    assert m.score_frame(("whisk", {"Theme": "eggs", "Destination": "bowls"})) == m.score_frame(singular)
+    assert m.score_frame(("pour", {"Theme": "water", "Destination": "glass"})) > m.score_frame(
+        ("pour", {"Theme": "water", "Destination": "cup"})
+    )
+    assert m.form("glass") == "glass" and m.form("knives") == "knives"  # no knife counted: as labelled
+
+
 def test_a_learned_verbs_pairs_back_off_to_its_class_by_hand():
     # "put away" put a book in a box once and never stated milk's place; "store", of the same class, put milk
     # in the fridge twice

@@ -104,6 +104,8 @@ def test_pair_table_smoothing_by_hand():
     small = table.restricted({"rice", "bowl"})
     assert small.pairs == {("rice", "bowl"): 3.0} and small.objects == {"rice": 4.0} and small.total == 6.0
     assert small.log_p("rice", "bowl") == table.log_p("rice", "bowl")
+    # objects labelled in the plural are counted as the frames keep them, in the singular
+    assert table.log_p("rice", "bowls") == table.log_p("rice", "bowl") != table.log_p("rice", "plates")
 
 
 def test_neighbour_weights_are_similarities_over_the_best():

@@ -5,7 +5,7 @@ import re
 from hypothesis import given
 from hypothesis import strategies as st
 
-from lmcr.text import normalize, split_sentences
+from lmcr.text import counted_form, normalize, plural_forms, singular_forms, split_sentences
 
 
 def test_normalize_fractions_quotes_dashes_spaces():
@@ -58,3 +58,13 @@ def test_fractions_and_numbers_never_split(whole, denominator, unit):
     assert any(f"{whole} 1/{denominator}" in s for s in sentences)
     assert any(f"{whole}.5 cups" in s for s in sentences)
     assert not any(re.fullmatch(r"\d+", s) for s in sentences)
+
+
+@given(st.from_regex(r"[a-z]{2,8}", fullmatch=True))
+def test_a_singular_is_among_the_singular_forms_of_each_of_its_plurals(word):
+    for plural in plural_forms(word):
+        assert word in singular_forms(plural)
+        # the counts decide: the singular where it is counted more, the label where it is not
+        assert counted_form(f"kettle {plural}", {f"kettle {word}": 2.0}) == f"kettle {word}"
+        assert counted_form(plural, {plural: 2.0, word: 1.0}) == plural
+    assert counted_form(word, {}) == word

@@ -45,6 +45,7 @@ from lmcr.lexicon import Lexicon, PredicateSpec
 from lmcr.scorers.frame_counts import add_one, dirichlet, weighted_counts
 from lmcr.scorers.mixture import Mixture
 from lmcr.scorers.resources import MethodUnavailable
+from lmcr.text import counted_form
 
 WEIGHT = 0.25
 NEIGHBOURS = 20
@@ -103,7 +104,9 @@ class PairTable:
         return cls(dict(pairs), dict(objects), dict(others), sum(objects.values()), len(objects), len(others))
 
     def log_p(self, a: str, o: str) -> float:
-        """log P(o | a) + log P(a | o), each smoothed towards the add-one marginal."""
+        """log P(o | a) + log P(a | o), each smoothed towards the add-one marginal; a label in the plural as
+        the counts know it ("eggs": egg, `counted_form`)."""
+        a, o = counted_form(a, self.objects), counted_form(o, self.others)
         joint, c_a, c_o = self.pairs.get((a, o), 0.0), self.objects.get(a, 0.0), self.others.get(o, 0.0)
         p_o, p_a = add_one(c_o, self.total, self.other_types), add_one(c_a, self.total, self.object_types)
         return math.log(dirichlet(joint, c_a, p_o)) + math.log(dirichlet(joint, c_o, p_a))
@@ -270,7 +273,8 @@ class SimilarVerbs:
             if pair is None:  # a learned predicate (its own counts score it), or one filler
                 scores.append(0.0)
                 continue
-            a, o = pair
+            table = self.tables[frame.predicate]
+            a, o = counted_form(pair[0], table.objects), counted_form(pair[1], table.others)
             source = self if self.words is None or {a, o} <= self.words else self.complete_counts
             scores.append(WEIGHT * source.tables[frame.predicate].log_p(a, o))
         return scores
