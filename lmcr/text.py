@@ -125,8 +125,9 @@ def count_words(text: str) -> int:
 
 def singular_forms(word: str) -> tuple[str, ...]:
     """The singulars English spelling can give a plural noun, the inverse of `plural_forms` and of -ves:
-    carrots -> carrot, dishes -> dish, patties -> patty, knives -> knife (and carrot -> carro: which of
-    them is a word is for the caller's counts to say)."""
+    carrots -> carrot, dishes -> dish, patties -> patty, knives -> knife, each with the other strippings
+    (dishes -> dishe too: which of them is a word is for the caller's counts to say); none for a word
+    without a plural ending."""
     endings = (("s", ""), ("es", ""), ("ies", "y"), ("ves", "f"), ("ves", "fe"))
     return tuple(word[: -len(end)] + base for end, base in endings if word.endswith(end) and len(word) > len(end))
 
@@ -137,7 +138,7 @@ def counted_form(label: str, counts: Mapping[str, float]) -> str:
     The frame corpus keeps a filler's head as its lemma, so an object labelled in the plural would read as
     a filler hardly ever seen."""
     *name, last = label.split() or [""]
-    forms = [" ".join([*name, f]) for f in singular_forms(last)] if last.endswith("s") else []
+    forms = [" ".join([*name, f]) for f in singular_forms(last)]
     return max([label, *forms], key=lambda f: counts.get(f, 0.0))
 
 
